@@ -1,0 +1,1 @@
+"""grainflow.cache (under construction: see the open issue)."""

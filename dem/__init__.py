@@ -1,0 +1,1 @@
+"""grainflow.dem (under construction: see the open issue)."""

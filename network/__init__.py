@@ -1,0 +1,1 @@
+"""grainflow.network (under construction: see the open issue)."""

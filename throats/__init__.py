@@ -1,0 +1,1 @@
+"""grainflow.throats (under construction: see the open issue)."""
