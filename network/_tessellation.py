@@ -1,0 +1,253 @@
+r"""Delaunay tessellation of a packing: pores (tetrahedra) and throats (their faces).
+
+Pores are the Delaunay tetrahedra of the sphere centres (thesis 3.5.2.2); throats are the
+triangular faces, each listed once: a face shared by two tetrahedra connects them, a face on
+the convex hull has ``-1`` as its second pore.
+
+Degenerate input
+----------------
+Exact lattices (simple cubic, FCC) have groups of more than four co-spherical centres, so
+their Delaunay tessellation is not unique. Qhull is run with ``Qbb Qc Qz Q12``: ``Qz`` adds a
+point at infinity, which keeps co-spherical input from failing; ``Qbb`` scales the last
+coordinate; ``Qc`` keeps coplanar points; ``Q12`` allows wide facets from nearly flat
+(sliver) simplices. Qhull then triangulates every co-spherical group in some valid way, and
+the choice depends on point order and rounding. Every valid choice tiles the same convex
+hull, so pore volumes always sum to the hull volume to round-off (tested). Ties are detected
+relative to the mean sphere diameter :math:`\bar d`: a tetrahedron is *flat* when its
+volume is below ``flat_tol`` :math:`\bar d^3` (default 1e-9) and two neighbouring tetrahedra are
+*co-spherical* when their circumcentres differ by less than ``tie_tol`` :math:`\bar d`
+(default 1e-6). These flags are returned; merging such groups into one pore body is the
+conduit model's job (``network._merge``).
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import logging
+
+import numpy as np
+from scipy.spatial import Delaunay, QhullError
+
+from ._io import Packing
+
+__all__ = ["Tessellation", "tessellate", "QHULL_OPTIONS"]
+
+log = logging.getLogger(__name__)
+
+#: Qhull options used for the 3-D Delaunay tessellation (see module docstring).
+QHULL_OPTIONS = "Qbb Qc Qz Q12"
+
+# face k of a tetrahedron is opposite vertex k (scipy's ``neighbors`` convention)
+_FACE = np.array([[1, 2, 3], [0, 2, 3], [0, 1, 3], [0, 1, 2]])
+
+
+@dataclasses.dataclass(frozen=True)
+class Tessellation:
+    """Pores and throats of a packing's Delaunay tessellation.
+
+    Attributes
+    ----------
+    packing : Packing
+        The packing tessellated (centres in m, radii in m).
+    pore_vertices : (Np, 4) int ndarray
+        Sphere indices of each tetrahedron.
+    pore_neighbors : (Np, 4) int ndarray
+        Neighbouring pore across the face opposite vertex k, -1 on the hull.
+    pore_throats : (Np, 4) int ndarray
+        Throat index of the face opposite vertex k.
+    pore_centroid : (Np, 3) ndarray, m
+        Mean of the four vertices.
+    pore_volume : (Np,) ndarray, m³
+        Tetrahedron volume.
+    pore_circumcenter : (Np, 3) ndarray, m
+        Circumsphere centre (NaN for flat tetrahedra).
+    throat_pores : (Nt, 2) int ndarray
+        The two pores a throat connects, lower index first; second is -1 for a hull face.
+    throat_vertices : (Nt, 3) int ndarray
+        Sphere indices of the face, ascending.
+    throat_radii : (Nt, 3) ndarray, m
+        Radii [r1, r2, r3] of ``throat_vertices``.
+    throat_sides : (Nt, 3) ndarray, m
+        Side lengths [l12, l13, l23].
+    throat_area : (Nt,) ndarray, m²
+        Area of the triangle (not the open area).
+    throat_centroid : (Nt, 3) ndarray, m
+        Mean of the three vertices.
+    pore_flat : (Np,) bool ndarray
+        Volume below ``flat_tol`` d̄³ (a sliver).
+    throat_tied : (Nt,) bool ndarray
+        Interior face whose two tetrahedra share a circumsphere to ``tie_tol`` d̄ (a face
+        that exists only because of how Qhull broke a tie).
+    coplanar_points : (K,) int ndarray
+        Spheres Qhull left out of every tetrahedron (coincident or nearly so with another).
+    """
+
+    packing: Packing
+    pore_vertices: np.ndarray
+    pore_neighbors: np.ndarray
+    pore_throats: np.ndarray
+    pore_centroid: np.ndarray
+    pore_volume: np.ndarray
+    pore_circumcenter: np.ndarray
+    throat_pores: np.ndarray
+    throat_vertices: np.ndarray
+    throat_radii: np.ndarray
+    throat_sides: np.ndarray
+    throat_area: np.ndarray
+    throat_centroid: np.ndarray
+    pore_flat: np.ndarray
+    throat_tied: np.ndarray
+    coplanar_points: np.ndarray
+
+    def __post_init__(self):
+        np_, nt = self.pore_vertices.shape[0], self.throat_vertices.shape[0]
+        shapes = {
+            "pore_vertices": (np_, 4), "pore_neighbors": (np_, 4), "pore_throats": (np_, 4),
+            "pore_centroid": (np_, 3), "pore_volume": (np_,), "pore_circumcenter": (np_, 3),
+            "throat_pores": (nt, 2), "throat_radii": (nt, 3), "throat_sides": (nt, 3),
+            "throat_area": (nt,), "throat_centroid": (nt, 3), "pore_flat": (np_,),
+            "throat_tied": (nt,),
+        }
+        for name, shape in shapes.items():
+            got = getattr(self, name).shape
+            if got != shape:
+                raise ValueError(f"Tessellation.{name} must have shape {shape}, got {got}")
+
+    @property
+    def n_pores(self) -> int:
+        return int(self.pore_vertices.shape[0])
+
+    @property
+    def n_throats(self) -> int:
+        return int(self.throat_vertices.shape[0])
+
+    @property
+    def interior_throats(self) -> np.ndarray:
+        """Indices of throats shared by two pores (not on the hull)."""
+        return np.flatnonzero(self.throat_pores[:, 1] >= 0)
+
+
+def _circumcenters(p: np.ndarray) -> np.ndarray:
+    """Circumcentres of tetrahedra given as (N, 4, 3) vertex coordinates (NaN when flat)."""
+    a = p[:, 1:] - p[:, :1]                      # (N, 3, 3) edge vectors
+    rhs = 0.5 * np.einsum("nij,nij->ni", a, a)   # |e|^2 / 2
+    det = np.linalg.det(a)
+    ok = np.abs(det) > 0
+    out = np.full((p.shape[0], 3), np.nan)
+    if ok.any():
+        out[ok] = np.linalg.solve(a[ok], rhs[ok][..., None])[..., 0] + p[ok, 0]
+    return out
+
+
+def tessellate(packing: Packing, *, qhull_options: str = QHULL_OPTIONS,
+               flat_tol: float = 1e-9, tie_tol: float = 1e-6) -> Tessellation:
+    r"""Delaunay tessellation of the sphere centres into pores and throats.
+
+    Parameters
+    ----------
+    packing : Packing
+        Sphere centres (N, 3) m and radii (N,) m.
+    qhull_options : str, optional
+        Options for ``scipy.spatial.Delaunay`` (default ``"Qbb Qc Qz Q12"``).
+    flat_tol : float, optional
+        A tetrahedron with volume < ``flat_tol`` :math:`\bar d^3` is flagged flat (default 1e-9).
+    tie_tol : float, optional
+        Interior faces whose two circumcentres are closer than ``tie_tol`` :math:`\bar d` are
+        flagged tied (default 1e-6).
+
+    Returns
+    -------
+    Tessellation
+
+    Raises
+    ------
+    TypeError
+        ``packing`` is not a :class:`Packing`.
+    ValueError
+        All centres are coplanar, or Qhull fails otherwise (its message is chained).
+
+    Notes
+    -----
+    Faces are read from Qhull's neighbour table: face *k* of tetrahedron *t* is opposite its
+    vertex *k* and is kept once, by the tetrahedron with the lower index (or by *t* when the
+    face is on the hull). This is equivalent to sorting the 4 N faces and taking unique rows,
+    in O(N) instead of O(N log N). Side lengths follow the contract order
+    :math:`[l_{12}, l_{13}, l_{23}]` of the ascending vertex triple.
+
+    Examples
+    --------
+    A triangle with one apex above and one below is two tetrahedra sharing one throat, plus
+    six hull faces:
+
+    >>> import numpy as np
+    >>> from network import Packing, tessellate
+    >>> c = np.array([[0, 0, 0], [1, 0, 0], [0, 1, 0], [.3, .3, 1], [.3, .3, -1]])
+    >>> t = tessellate(Packing(c, np.full(5, 0.4)))
+    >>> t.n_pores, t.n_throats, int((t.throat_pores[:, 1] >= 0).sum())
+    (2, 7, 1)
+    """
+    if not isinstance(packing, Packing):
+        raise TypeError(f"packing must be a Packing, got {type(packing).__name__}")
+    pts = packing.centers
+    try:
+        dt = Delaunay(pts, qhull_options=qhull_options)
+    except QhullError as e:
+        raise ValueError(f"Delaunay tessellation failed for {packing.n} centres "
+                         f"(coplanar or degenerate input?): {str(e).splitlines()[0]}") from e
+    simp = np.ascontiguousarray(dt.simplices, dtype=np.int64)
+    neigh = np.ascontiguousarray(dt.neighbors, dtype=np.int64)
+    n_p = simp.shape[0]
+    dbar = packing.mean_diameter
+
+    # pores
+    pv = pts[simp]                                   # (Np, 4, 3)
+    centroid = pv.mean(axis=1)
+    e = pv[:, 1:] - pv[:, :1]
+    volume = np.abs(np.linalg.det(e)) / 6.0
+    circ = _circumcenters(pv)
+    flat = volume < flat_tol * dbar**3
+
+    # throats: face k of t kept when t < neighbour or neighbour is -1
+    t_idx = np.repeat(np.arange(n_p), 4)
+    k_idx = np.tile(np.arange(4), n_p)
+    nb = neigh.ravel()
+    keep = (nb < 0) | (t_idx < nb)
+    ft, fk, fn = t_idx[keep], k_idx[keep], nb[keep]
+    tv = np.sort(simp[ft[:, None], _FACE[fk]], axis=1)
+    n_t = tv.shape[0]
+    # throat id of every (pore, face) slot
+    tid = np.full(n_p * 4, -1, dtype=np.int64)
+    tid[np.flatnonzero(keep)] = np.arange(n_t)
+    # the other side of each interior face: find k' with neigh[fn, k'] == ft
+    inner = fn >= 0
+    other_k = np.argmax(neigh[fn[inner]] == ft[inner, None], axis=1)
+    tid[fn[inner] * 4 + other_k] = np.flatnonzero(inner)
+    pore_throats = tid.reshape(n_p, 4)
+    throat_pores = np.column_stack([ft, fn])
+
+    xyz = pts[tv]                                     # (Nt, 3, 3)
+    r = packing.radii[tv]
+    l12 = np.linalg.norm(xyz[:, 1] - xyz[:, 0], axis=1)
+    l13 = np.linalg.norm(xyz[:, 2] - xyz[:, 0], axis=1)
+    l23 = np.linalg.norm(xyz[:, 2] - xyz[:, 1], axis=1)
+    area = 0.5 * np.linalg.norm(np.cross(xyz[:, 1] - xyz[:, 0], xyz[:, 2] - xyz[:, 0]), axis=1)
+    tied = np.zeros(n_t, dtype=bool)
+    cc = circ[ft[inner]] - circ[fn[inner]]
+    tied[inner] = np.linalg.norm(cc, axis=1) < tie_tol * dbar  # NaN compares False
+    tied[inner] |= flat[ft[inner]] | flat[fn[inner]]
+
+    in_simplex = np.zeros(packing.n, dtype=bool)
+    in_simplex[simp.ravel()] = True
+    coplanar = np.flatnonzero(~in_simplex)
+    if coplanar.size:
+        log.warning("%d sphere(s) are in no tetrahedron (coincident with another centre to "
+                    "Qhull precision)", coplanar.size)
+    log.info("tessellated %d spheres: %d pores (%d flat), %d throats (%d on the hull, %d tied)",
+             packing.n, n_p, int(flat.sum()), n_t, int((~inner).sum()), int(tied.sum()))
+    return Tessellation(
+        packing=packing, pore_vertices=simp, pore_neighbors=neigh, pore_throats=pore_throats,
+        pore_centroid=centroid, pore_volume=volume, pore_circumcenter=circ,
+        throat_pores=throat_pores, throat_vertices=tv, throat_radii=r,
+        throat_sides=np.column_stack([l12, l13, l23]), throat_area=area,
+        throat_centroid=xyz.mean(axis=1), pore_flat=flat, throat_tied=tied,
+        coplanar_points=coplanar)

@@ -1,0 +1,76 @@
+"""read_packing: formats and the messages for bad input (issue 4, item 1)."""
+
+import numpy as np
+import pytest
+
+from network import Packing, read_packing, write_packing_csv
+
+RNG = np.random.default_rng(7)
+C = RNG.random((12, 3))
+R = 0.05 + 0.01 * RNG.random(12)
+
+
+def test_csv_roundtrip(tmp_path):
+    p = tmp_path / "a.csv"
+    write_packing_csv(Packing(C, R), p, digits=17)
+    pk = read_packing(p)
+    np.testing.assert_array_equal(pk.centers, C)
+    np.testing.assert_array_equal(pk.radii, R)
+
+
+def test_csv_column_order_and_extra_columns(tmp_path):
+    p = tmp_path / "b.csv"
+    lines = ["id,r,z,y,x"] + [f"{i},{float(R[i])!r},{float(C[i,2])!r},{float(C[i,1])!r},{float(C[i,0])!r}" for i in range(12)]
+    p.write_text("\n".join(lines) + "\n")
+    pk = read_packing(p)
+    np.testing.assert_array_equal(pk.centers, C)
+    np.testing.assert_array_equal(pk.radii, R)
+
+
+def test_npz(tmp_path):
+    p = tmp_path / "c.npz"
+    np.savez(p, centers=C, radii=R)
+    pk = read_packing(p)
+    np.testing.assert_array_equal(pk.centers, C)
+
+
+def test_lammps_dump(tmp_path):
+    p = tmp_path / "dump.liggghts"
+    rows = "\n".join(f"{i + 1} 1 {float(C[i,0])!r} {float(C[i,1])!r} {float(C[i,2])!r} 0 0 0 {float(R[i])!r}" for i in range(12))
+    snap = ("ITEM: TIMESTEP\n{t}\nITEM: NUMBER OF ATOMS\n12\nITEM: BOX BOUNDS ff ff ff\n"
+            "0 1\n0 1\n0 1\nITEM: ATOMS id type x y z vx vy vz radius\n")
+    # two snapshots: the last one is read
+    first = rows.replace(" 1 0.", " 1 9.", 1)
+    p.write_text(snap.format(t=0) + first + "\n" + snap.format(t=100) + rows + "\n")
+    pk = read_packing(p)
+    np.testing.assert_array_equal(pk.centers, C)
+    np.testing.assert_array_equal(pk.radii, R)
+
+
+@pytest.mark.parametrize("bad, match", [
+    ("x,y,z,r\n" + "0,0,0,1\n" * 0 + "".join(f"{i},0,0,1\n" for i in range(5)) + "5,0,nan,1\n",
+     "line 7: non-finite"),
+    ("x,y,z,r\n" + "".join(f"{i},0,0,1\n" for i in range(5)) + "5,0,0,-1\n", "line 7: radius must be > 0"),
+    ("x,y,z,r\n" + "".join(f"{i},0,0,1\n" for i in range(5)) + "2,0,0,1\n", "line 7: duplicate centre"),
+    ("x,y,z,r\n" + "".join(f"{i},0,0,1\n" for i in range(5)) + "5,0,abc,1\n", "line 7: not a number"),
+    ("x,y,z,r\n" + "".join(f"{i},0,0,1\n" for i in range(5)) + "5,0,1\n", "line 7: expected 4 values"),
+    ("x,y,z,r\n0,0,0,1\n1,0,0,1\n", "too few spheres"),
+    ("a,b,c\n1,2,3\n", "lacks column"),
+])
+def test_bad_csv_messages(tmp_path, bad, match):
+    p = tmp_path / "bad.csv"
+    p.write_text(bad)
+    with pytest.raises(ValueError, match=match):
+        read_packing(p)
+
+
+def test_missing_file():
+    with pytest.raises(FileNotFoundError):
+        read_packing("/nonexistent/packing.csv")
+
+
+def test_packing_shape_checks():
+    with pytest.raises(ValueError, match=r"\(N, 3\)"):
+        Packing(np.zeros((4, 2)), np.ones(4))
+    with pytest.raises(ValueError, match="radii must have shape"):
+        Packing(np.zeros((4, 3)), np.ones(3))
