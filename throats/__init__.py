@@ -1,1 +1,28 @@
-"""grainflow.throats (under construction: see the open issue)."""
+r"""grainflow.throats: dimensionless conductance Q* of triangular pore throats.
+
+A throat is the face shared by two Delaunay tetrahedra of sphere centres, given by the radii
+``[r1, r2, r3]`` and side lengths ``[l12, l13, l23]`` (columns of the CSV
+``r1,r2,r3,l12,l13,l23``).  Its open cross-section is the triangle minus the three disks;
+with lengths scaled by the mean radius r̄ the flow solves −∇²u* = 1, u* = 0 on the disk arcs,
+∂u*/∂n = 0 on the triangle-edge gaps, and Q* = ∫u* dA* (thesis Eq. 3.40–3.42).  The
+dimensional conductance is g = Q* r̄⁴/(μL), formed by ``network``, not here.
+
+Public functions
+----------------
+canonical_form
+    Scale/permutation/mirror-invariant form of a throat (units of r̄).
+contact_type
+    Contact type 'a' | 'b' | 'c' | 'd' (thesis Fig. 3.17).
+open_area
+    Exact open area, also for overlapping disks and disks covering the triangle.
+validate_throats
+    Row checks: ``(ok_mask, messages)``.
+triangle_vertices
+    Planar vertex coordinates of the triangles.
+"""
+
+from ._geometry import (canonical_form, contact_type, open_area, triangle_vertices,
+                        validate_throats)
+
+__all__ = ["canonical_form", "contact_type", "open_area", "triangle_vertices",
+           "validate_throats"]
