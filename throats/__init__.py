@@ -19,10 +19,16 @@ validate_throats
     Row checks: ``(ok_mask, messages)``.
 triangle_vertices
     Planar vertex coordinates of the triangles.
+solve_fem
+    Q* by finite elements (gmsh + scikit-fem), batch, ``rtol``-driven, with an error
+    estimate; returns a ``ThroatSolution``.
+SOLVER_VERSION
+    Version string of the numerical method (bumped whenever results could change).
 """
 
 from ._geometry import (canonical_form, contact_type, open_area, triangle_vertices,
                         validate_throats)
+from ._solve import SOLVER_VERSION, ThroatSolution, solve_fem
 
-__all__ = ["canonical_form", "contact_type", "open_area", "triangle_vertices",
-           "validate_throats"]
+__all__ = ["SOLVER_VERSION", "ThroatSolution", "canonical_form", "contact_type", "open_area",
+           "solve_fem", "triangle_vertices", "validate_throats"]

@@ -239,7 +239,7 @@ def _angle_param(points, centers):
 
 
 def _region_boundary(verts, centers, radii, lines_a=None, lines_b=None, lines_owner=None,
-                     lines_present=None, rects=None, tol=_TOL):
+                     lines_present=None, rects=None, extra_lt=None, extra_cu=None, tol=_TOL):
     r"""Boundary of :math:`\Omega = T \cap \bigcap_i \overline{D_i}^c \cap \bigcap_m R_m^c`.
 
     Vectorised over N throats (lengths in units of r̄).  Primitive curves: the 3 triangle
@@ -257,6 +257,10 @@ def _region_boundary(verts, centers, radii, lines_a=None, lines_b=None, lines_ow
     lines_present : (N, K) bool
     rects : dict of (N, M, ...) arrays ``origin``, ``e``, ``n`` (unit axes), ``x0``, ``x1``,
         ``s1``, ``present``: removed open set {x0 < x < x1, s < s1} in the frame.
+    extra_lt : (N, L', E), optional
+        Extra split parameters on the first L' segments (mesh feature points).
+    extra_cu : (N, 3, E), optional
+        Extra split parameters (clockwise, in [0, 1)) on the circles.
 
     Returns
     -------
@@ -308,7 +312,12 @@ def _region_boundary(verts, centers, radii, lines_a=None, lines_b=None, lines_ow
     with np.errstate(invalid="ignore", divide="ignore"):
         t_lc = np.stack([(-bb - sq) / (2 * aa), (-bb + sq) / (2 * aa)], axis=-1)  # (N,L,3,2)
     t_lc = np.where((disc >= 0)[..., None] & present[:, :, None, None], t_lc, np.nan)
-    lt = np.concatenate([t_ll.reshape(N, L, -1), t_lc.reshape(N, L, -1)], axis=2)
+    lt = [t_ll.reshape(N, L, -1), t_lc.reshape(N, L, -1)]
+    if extra_lt is not None:   # extra split points (mesh features), (N, L' <= L, E)
+        pad = np.full((N, L, extra_lt.shape[2]), np.nan)
+        pad[:, :extra_lt.shape[1]] = extra_lt
+        lt.append(pad)
+    lt = np.concatenate(lt, axis=2)
     lt = np.where((lt > tol) & (lt < 1 - tol), lt, np.nan)
     lt = np.concatenate([np.zeros((N, L, 1)), np.ones((N, L, 1)), lt], axis=2)
     lt = np.sort(lt, axis=2)
@@ -335,7 +344,7 @@ def _region_boundary(verts, centers, radii, lines_a=None, lines_b=None, lines_ow
     pcc = np.stack([base + hq[..., None] * perp, base - hq[..., None] * perp], axis=3)
     u_cc = _angle_param(pcc, C[:, :, None, None, :])                          # (N,3,3,2)
     u_cc = np.where(meet[..., None], u_cc, np.nan).reshape(N, 3, -1)
-    cu = np.concatenate([u_cl, u_cc], axis=2)
+    cu = np.concatenate([u_cl, u_cc] + ([] if extra_cu is None else [extra_cu]), axis=2)
     cu = np.where((cu > 1e-13) & (cu < 1 - 1e-13), cu, np.nan)
     cu = np.concatenate([np.zeros((N, 3, 1)), np.ones((N, 3, 1)), cu], axis=2)
     cu = np.sort(cu, axis=2)

@@ -1,0 +1,439 @@
+r"""Boundary construction (with closing rules) and gmsh meshing of throat cross-sections.
+
+All lengths here are in units of the mean radius r̄ (canonical throats).
+
+Closing rule for narrow passages
+--------------------------------
+Tangent disks leave a zero-angle cusp that no mesh can fill, and gaps down to 1e-4 r̄ would
+need elements that small.  The flow in a passage of width :math:`w` carries
+:math:`\sim w^3` per unit length, so passages narrower than ``delta`` are closed by a short
+no-slip cut where their width reaches ``delta``:
+
+* **disk–disk passage** (pair i, j, gap :math:`g_{ij} = l_{ij} - r_i - r_j < \delta`, also
+  touching or overlapping): at the height :math:`s^*` above edge ij where the distance between
+  the two circles, measured parallel to the edge, equals ``delta``.  With
+  :math:`D = l_{ij} - \delta`, :math:`x = (D^2 + r_i^2 - r_j^2)/(2D)`,
+  :math:`s^* = \sqrt{r_i^2 - x^2}`; the region below the chord is removed.
+* **disk–edge passage** (disk i and the opposite edge jk, :math:`h_i - r_i < \delta/2`, also
+  when the disk crosses the edge): two cuts normal to the edge at
+  :math:`\pm x^*,\ x^* = \sqrt{r_i^2 - (h_i - \delta/2)^2}` from the foot of the altitude,
+  where the arc is ``delta``/2 from the symmetry line (a mirrored channel of width
+  ``delta``); the region between is removed.
+
+Both rules change the geometry continuously as a gap closes (type a → b → d), and the removed
+regions lie in strips narrower than ``delta``.  The error this costs is measured in the tests
+and the benchmark (``throats.bench``) against solves with a ten times smaller ``delta``.
+
+Boundary curves are tagged by construction: pieces of the triangle edges are symmetry
+(physical group ``SYMMETRY``), arcs and cuts are no-slip (group ``NOSLIP``).
+"""
+
+from __future__ import annotations
+
+import logging
+from dataclasses import dataclass
+
+import numpy as np
+
+from ._geometry import _region_boundary, triangle_vertices
+
+__all__ = ["DELTA_DEFAULT", "ThroatGeometry", "build_geometries", "disk_geometry", "mesh_geometry",
+           "polygon_geometry"]
+
+logger = logging.getLogger(__name__)
+
+#: default width (units of r̄) below which a passage is closed by a no-slip cut
+DELTA_DEFAULT = 0.01
+
+NOSLIP, SYMMETRY, FLUID = 1, 2, 3
+
+_PAIRS = ((0, 1), (0, 2), (1, 2))
+_PAIR_COL = {(0, 1): 0, (0, 2): 1, (1, 2): 2}
+
+
+@dataclass(frozen=True)
+class ThroatGeometry:
+    """Boundary of one throat's open region, after the closing rules (units of r̄).
+
+    Attributes
+    ----------
+    points : (P, 2) float
+        Curve end points.
+    lfs : (P,) float
+        Local feature size at each point: distance to the nearest boundary piece not
+        incident to it.
+    curves : list of tuple
+        ``(kind, i0, i1, center, radius, bc)`` with kind 'line' | 'arc', point indices,
+        arc centre (2,) or None, radius, bc ``NOSLIP`` | ``SYMMETRY``; oriented with the
+        fluid on the left.
+    loops : list of list of int
+        Closed loops of curve indices (one per connected piece of the open region).
+    area : float
+        Exact area of the region (after closing), from Green's theorem.
+    """
+
+    points: np.ndarray
+    lfs: np.ndarray
+    curves: list
+    loops: list
+    area: float
+
+
+def _unit(v):
+    return v / np.linalg.norm(v, axis=-1, keepdims=True)
+
+
+def _left(v):
+    return np.stack([-v[..., 1], v[..., 0]], axis=-1)
+
+
+def _closing_rules(verts, radii, delta, feature_width):
+    """Cut segments and removed rectangles of the closing rules, vectorised (see module)."""
+    N = verts.shape[0]
+    segs_a, segs_b, owner, present = [], [], [], []
+    rect = {k: [] for k in ("origin", "e", "n", "x0", "x1", "s1", "present")}
+    extra_line = np.full((N, 3, 2), np.nan)   # extra breakpoints on triangle edges (feature)
+    extra_circ = np.full((N, 3, 1), np.nan)   # extra breakpoints on circles (feature)
+    edge_of_pair = {(0, 1): 0, (1, 2): 1, (0, 2): 2}    # CCW edge index: 1->2, 2->3, 3->1
+    m = 0
+    with np.errstate(invalid="ignore", divide="ignore"):
+        for i, j in _PAIRS:
+            k = 3 - i - j
+            ci, cj, ck = verts[:, i], verts[:, j], verts[:, k]
+            ri, rj = radii[:, i], radii[:, j]
+            length = np.linalg.norm(cj - ci, axis=1)
+            e = _unit(cj - ci)
+            n = _left(e)
+            n = np.where((np.sum(n * (ck - ci), axis=1) < 0)[:, None], -n, n)
+            dd = length - delta
+            x = (dd**2 + ri**2 - rj**2) / (2 * dd)
+            s1 = np.sqrt(ri**2 - x**2)
+            on = (length - ri - rj < delta) & (x**2 < ri**2) & (s1 < np.minimum(ri, rj))
+            a = ci + e * (x - 0.5 * delta)[:, None] + n * s1[:, None]
+            b = ci + e * (x + 1.5 * delta)[:, None] + n * s1[:, None]
+            # fluid (above the chord, +n) must be on the left of the direction
+            flip = (np.sum(_left(e) * n, axis=1) < 0)[:, None]
+            segs_a.append(np.where(flip, b, a))
+            segs_b.append(np.where(flip, a, b))
+            owner.append(4 + m)
+            present.append(on)
+            for key, val in (("origin", ci), ("e", e), ("n", n), ("x0", x), ("x1", x + delta),
+                             ("s1", s1), ("present", on)):
+                rect[key].append(val)
+            m += 1
+        for i in range(3):
+            j, k = [q for q in range(3) if q != i]
+            ci, cj, ck = verts[:, i], verts[:, j], verts[:, k]
+            ri = radii[:, i]
+            e = _unit(ck - cj)
+            foot = cj + e * np.sum((ci - cj) * e, axis=1)[:, None]
+            h = np.linalg.norm(ci - foot, axis=1)
+            n = _unit(ci - foot)
+            xs = np.sqrt(ri**2 - (h - 0.5 * delta) ** 2)
+            on = (h - ri < 0.5 * delta) & np.isfinite(xs)
+            lo, hi = -0.5 * delta, min(delta, 1.0)
+            for sign in (1.0, -1.0):
+                top = foot + e * (sign * xs)[:, None] + n * hi
+                bot = foot + e * (sign * xs)[:, None] + n * lo
+                # right cut (+x side fluid): downwards; left cut: upwards
+                segs_a.append(np.where(on[:, None], top if sign > 0 else bot, 0.0))
+                segs_b.append(np.where(on[:, None], bot if sign > 0 else top, 0.0))
+                owner.append(4 + m)
+                present.append(on)
+            for key, val in (("origin", foot), ("e", e), ("n", n), ("x0", -xs), ("x1", xs),
+                             ("s1", h), ("present", on)):
+                rect[key].append(val)
+            m += 1
+            # feature points of a narrow (not closed) disk-edge passage: foot of the altitude
+            narrow = ~on & (h - ri < feature_width)
+            edge = edge_of_pair[(min(j, k), max(j, k))]
+            va = verts[:, [0, 1, 2][edge]]
+            vb = verts[:, [1, 2, 0][edge]]
+            t = np.sum((foot - va) * _unit(vb - va), axis=1) / np.linalg.norm(vb - va, axis=1)
+            extra_line[:, edge, 0] = np.where(narrow, t, np.nan)
+            th = np.arctan2(-n[:, 1], -n[:, 0])
+            extra_circ[:, i, 0] = np.where(narrow, np.mod(-th, 2 * np.pi) / (2 * np.pi), np.nan)
+    rects = {k: np.stack(v, axis=1) for k, v in rect.items()}
+    return (np.stack(segs_a, axis=1), np.stack(segs_b, axis=1), np.array(owner),
+            np.stack(present, axis=1), rects, extra_line, extra_circ)
+
+
+def build_geometries(radii_star, sides_star, *, delta=DELTA_DEFAULT, feature_width=0.3):
+    """Boundary curves of N canonical throats after the closing rules.
+
+    Parameters
+    ----------
+    radii_star, sides_star : (N, 3) array_like
+        Throats in units of r̄ (see :func:`throats.canonical_form`).
+    delta : float, optional
+        Passage width (units of r̄) below which a passage is closed (module docstring).
+    feature_width : float, optional
+        Disk–edge passages narrower than this get a mesh point at their narrowest place.
+
+    Returns
+    -------
+    list of ThroatGeometry (length N); a throat whose disks cover the triangle has no loops
+    and area 0.
+    """
+    r = np.atleast_2d(np.asarray(radii_star, dtype=float))
+    s = np.atleast_2d(np.asarray(sides_star, dtype=float))
+    verts = triangle_vertices(s)
+    la, lb, owner, present, rects, xl, xc = _closing_rules(verts, r, delta, feature_width)
+    res = _region_boundary(verts, verts, r, la, lb, owner, present, rects,
+                           extra_lt=xl, extra_cu=xc)
+    return [_extract(res, verts, r, q) for q in range(r.shape[0])]
+
+
+def _extract(res, verts, radii, q):
+    """Pieces of throat q → points, curves, loops (small per-throat work)."""
+    tol = 1e-9
+    pieces = []   # (kind, p0, p1, center, radius, bc)
+    lt, lon = res["lt"][q], res["lon"][q]
+    la, lb, own = res["la"][q], res["lb"][q], res["lowner"]
+    for li, ki in zip(*np.nonzero(lon)):
+        d = lb[li] - la[li]
+        p0 = la[li] + lt[li, ki] * d
+        p1 = la[li] + lt[li, ki + 1] * d
+        pieces.append(("line", p0, p1, None, 0.0, SYMMETRY if own[li] == 0 else NOSLIP))
+    cu, con = res["cu"][q], res["con"][q]
+    for ci, ki in zip(*np.nonzero(con)):
+        c, rad = verts[q, ci], radii[q, ci]
+        th0, th1 = -2 * np.pi * cu[ci, ki], -2 * np.pi * cu[ci, ki + 1]
+        nsub = int(np.ceil(abs(th1 - th0) / (0.5 * np.pi)))   # gmsh arcs must be < pi
+        ths = np.linspace(th0, th1, nsub + 1)
+        for a, b in zip(ths[:-1], ths[1:]):
+            pieces.append(("arc", c + rad * np.array([np.cos(a), np.sin(a)]),
+                           c + rad * np.array([np.cos(b), np.sin(b)]), c, rad, NOSLIP))
+    # drop degenerate pieces, snap end points
+    pieces = [p for p in pieces if np.linalg.norm(p[2] - p[1]) > tol]
+    if not pieces:
+        return ThroatGeometry(np.zeros((0, 2)), np.zeros(0), [], [], float(res["area"][q]))
+    ends = np.array([[p[1], p[2]] for p in pieces]).reshape(-1, 2)
+    pts, idx = _snap(ends, 1e-8)
+    idx = idx.reshape(-1, 2)
+    curves = [(p[0], int(i0), int(i1), p[3], p[4], p[5]) for p, (i0, i1) in zip(pieces, idx)]
+    loops = _chain(idx)
+    lfs = _local_feature_size(pts, curves)
+    return ThroatGeometry(pts, lfs, curves, loops, float(res["area"][q]))
+
+
+def _snap(x, tol):
+    """Merge points closer than tol; returns unique points and the index of each input."""
+    n = x.shape[0]
+    idx = -np.ones(n, dtype=int)
+    out = []
+    for a in range(n):
+        if idx[a] >= 0:
+            continue
+        close = np.flatnonzero((np.abs(x - x[a]).max(axis=1) < tol) & (idx < 0))
+        idx[close] = len(out)
+        out.append(x[a])
+    return np.array(out), idx
+
+
+def _chain(idx):
+    """Closed loops from directed pieces (start, end); raises ValueError if not manifold."""
+    starts = {}
+    for c, (a, _) in enumerate(idx):
+        if a in starts:
+            raise ValueError("boundary is not a simple closed curve (two pieces leave one point)")
+        starts[a] = c
+    used = np.zeros(len(idx), dtype=bool)
+    loops = []
+    for c0 in range(len(idx)):
+        if used[c0]:
+            continue
+        loop, c = [], c0
+        while not used[c]:
+            used[c] = True
+            loop.append(c)
+            nxt = starts.get(idx[c][1])
+            if nxt is None:
+                raise ValueError("boundary loop does not close")
+            c = nxt
+        if c != c0:
+            raise ValueError("boundary loop does not close on its start")
+        loops.append(loop)
+    return loops
+
+
+def _local_feature_size(pts, curves):
+    """Distance from each point to the nearest boundary curve not incident to it."""
+    P = pts.shape[0]
+    dist = np.full((P, len(curves)), np.inf)
+    for c, (kind, i0, i1, cen, rad, _) in enumerate(curves):
+        a, b = pts[i0], pts[i1]
+        if kind == "line":
+            d = b - a
+            t = np.clip(((pts - a) @ d) / (d @ d), 0.0, 1.0)
+            dist[:, c] = np.linalg.norm(pts - (a + t[:, None] * d), axis=1)
+        else:
+            # clockwise arc from a to b
+            tha = np.arctan2(*(a - cen)[::-1])
+            thp = np.arctan2(pts[:, 1] - cen[1], pts[:, 0] - cen[0])
+            span = np.mod(tha - np.arctan2(*(b - cen)[::-1]), 2 * np.pi)
+            within = np.mod(tha - thp, 2 * np.pi) <= span
+            d_arc = np.abs(np.linalg.norm(pts - cen, axis=1) - rad)
+            d_end = np.minimum(np.linalg.norm(pts - a, axis=1), np.linalg.norm(pts - b, axis=1))
+            dist[:, c] = np.where(within, d_arc, d_end)
+        dist[[i0, i1], c] = np.inf
+    return dist.min(axis=1) if len(curves) else np.zeros(P)
+
+
+# ----------------------------------------------------------------------------------------
+# gmsh
+# ----------------------------------------------------------------------------------------
+
+_GMSH_READY = False
+
+
+def _gmsh():
+    """Import and initialise gmsh once per process."""
+    global _GMSH_READY
+    import gmsh
+    if not _GMSH_READY:
+        if not gmsh.isInitialized():
+            gmsh.initialize(interruptible=False)
+        gmsh.option.setNumber("General.Terminal", 0)
+        gmsh.option.setNumber("General.Verbosity", 0)
+        gmsh.option.setNumber("Mesh.ElementOrder", 2)
+        gmsh.option.setNumber("Mesh.SecondOrderLinear", 0)
+        gmsh.option.setNumber("Mesh.HighOrderOptimize", 0)
+        gmsh.option.setNumber("Mesh.MeshSizeFromPoints", 1)
+        gmsh.option.setNumber("Mesh.MeshSizeExtendFromBoundary", 1)
+        gmsh.option.setNumber("Mesh.MeshSizeFromCurvature", 0)
+        gmsh.option.setNumber("Mesh.Algorithm", 6)
+        # default 1e-9 makes 1D size integration dominate the run time (17 of 19 ms)
+        gmsh.option.setNumber("Mesh.LcIntegrationPrecision", 1e-3)
+        gmsh.option.setNumber("General.NumThreads", 1)
+        _GMSH_READY = True
+    return gmsh
+
+
+@dataclass(frozen=True)
+class TriMesh:
+    """Quadratic triangle mesh from gmsh: nodes (2, Np), triangle6 (6, Ne) in gmsh order,
+    no-slip boundary line3 elements (3, Nd)."""
+
+    p: np.ndarray
+    t: np.ndarray
+    noslip: np.ndarray
+
+
+def mesh_geometry(geom, h, *, lfs_factor=1.0, h_min=1e-4, curv_angle=0.6, grade=0.4):
+    """Mesh one throat with gmsh (built-in geo kernel, second-order curved triangles).
+
+    Parameters
+    ----------
+    geom : ThroatGeometry
+    h : float
+        Target element size away from narrow features (units of r̄).
+    lfs_factor : float
+        Element size at a point is ``min(h, lfs_factor * lfs)``: graded toward narrow gaps,
+        cuts and cusps.
+    h_min : float
+        Lower bound of the element size.
+    curv_angle : float
+        Element size on an arc of radius r is at most ``curv_angle * r``.
+    grade : float
+        Element size grows at most linearly with slope ``grade`` away from small sizes.
+
+    Returns
+    -------
+    TriMesh
+    """
+    gmsh = _gmsh()
+    gmsh.clear()
+    g = gmsh.model.geo
+    pts = geom.points
+    on_arc = np.full(len(pts), np.inf)
+    for kind, i0, i1, cen, rad, bc in geom.curves:
+        if kind == "arc":
+            on_arc[[i0, i1]] = np.minimum(on_arc[[i0, i1]], rad)
+    cap = np.minimum(h, curv_angle * on_arc)
+    lc = np.clip(np.minimum(cap, lfs_factor * geom.lfs), h_min, None)
+    ptag = [g.addPoint(x, y, 0.0, float(s)) for (x, y), s in zip(pts, lc)]
+    ctag, noslip, sym = [], [], []
+    for kind, i0, i1, cen, rad, bc in geom.curves:
+        a, b = pts[i0], pts[i1]
+        if kind == "line":
+            length = float(np.linalg.norm(b - a))
+            hc = h
+        else:
+            th0 = np.arctan2(a[1] - cen[1], a[0] - cen[0])
+            span = np.mod(th0 - np.arctan2(b[1] - cen[1], b[0] - cen[0]), 2 * np.pi)
+            length = rad * span
+            hc = min(h, curv_angle * rad)
+        # graded sizes: lc(s) = min(hc, lc0 + grade*s, lc1 + grade*(L - s)); gmsh interpolates
+        # linearly between points, so put points where the ramps reach the cap
+        sa = (hc - lc[i0]) / grade
+        sb = length - (hc - lc[i1]) / grade
+        if sa >= sb:
+            s_mid = 0.5 * (length + (lc[i1] - lc[i0]) / grade)
+            cuts = [(s_mid, lc[i0] + grade * s_mid)] if 0 < s_mid < length else []
+        else:
+            cuts = [(q, hc) for q in (sa, sb) if 0 < q < length]
+        cuts = [(q, sz) for q, sz in cuts if q > 0.5 * lc[i0] and length - q > 0.5 * lc[i1]]
+        chain = [ptag[i0]]
+        for q, sz in cuts:
+            f = q / length
+            if kind == "line":
+                xy = a + f * (b - a)
+            else:
+                th = th0 - f * span
+                xy = cen + rad * np.array([np.cos(th), np.sin(th)])
+            chain.append(g.addPoint(xy[0], xy[1], 0.0, float(sz)))
+        chain.append(ptag[i1])
+        if kind == "arc":
+            pc = g.addPoint(cen[0], cen[1], 0.0)
+        sub = []
+        for u, v in zip(chain[:-1], chain[1:]):
+            sub.append(g.addLine(u, v) if kind == "line" else g.addCircleArc(u, pc, v))
+        ctag.append(sub)
+        (noslip if bc == NOSLIP else sym).extend(sub)
+    surfs = []
+    for loop in geom.loops:
+        cl = g.addCurveLoop([t for c in loop for t in ctag[c]])
+        surfs.append(g.addPlaneSurface([cl]))
+    g.synchronize()
+    gmsh.model.addPhysicalGroup(1, noslip, NOSLIP)
+    if sym:
+        gmsh.model.addPhysicalGroup(1, sym, SYMMETRY)
+    gmsh.model.addPhysicalGroup(2, surfs, FLUID)
+    gmsh.model.mesh.generate(2)
+    tags, xyz, _ = gmsh.model.mesh.getNodes()
+    lookup = np.zeros(int(tags.max()) + 1, dtype=np.int64)
+    lookup[tags.astype(np.int64)] = np.arange(tags.size)
+    _, tri = gmsh.model.mesh.getElementsByType(9)
+    t = lookup[tri.astype(np.int64)].reshape(-1, 6).T
+    bnd = []
+    for c in noslip:
+        types, _, nodes = gmsh.model.mesh.getElements(1, c)
+        for ty, nd in zip(types, nodes):
+            if ty == 8:
+                bnd.append(nd)
+    noslip_el = lookup[np.concatenate(bnd).astype(np.int64)].reshape(-1, 3).T
+    p = xyz.reshape(-1, 3)[:, :2].T.copy()
+    return TriMesh(p, np.ascontiguousarray(t), noslip_el)
+
+
+def disk_geometry(radius=1.0):
+    """A full disk duct (no-slip all round), for analytic checks: Q* = π R⁴/8."""
+    th = -0.5 * np.pi * np.arange(4)
+    pts = radius * np.stack([np.cos(th), np.sin(th)], axis=1)
+    curves = [("arc", k, (k + 1) % 4, np.zeros(2), float(radius), NOSLIP) for k in range(4)]
+    return ThroatGeometry(pts, np.full(4, np.inf), curves, [[0, 1, 2, 3]],
+                          float(np.pi * radius**2))
+
+
+def polygon_geometry(vertices):
+    """A polygonal duct (no-slip on every side), for analytic checks.
+
+    ``vertices`` (P, 2) counter-clockwise; an equilateral triangle of side a has
+    Q* = √3 a⁴/320.
+    """
+    v = np.asarray(vertices, dtype=float)
+    n = v.shape[0]
+    curves = [("line", k, (k + 1) % n, None, 0.0, NOSLIP) for k in range(n)]
+    area = 0.5 * float(np.sum(v[:, 0] * np.roll(v[:, 1], -1) - np.roll(v[:, 0], -1) * v[:, 1]))
+    return ThroatGeometry(v, np.full(n, np.inf), curves, [list(range(n))], area)

@@ -1,0 +1,297 @@
+r"""Finite-element solve of the throat problem with scikit-fem on curved gmsh meshes.
+
+In units of the mean radius r̄ (thesis Eq. 3.40–3.42):
+
+.. math::
+    -\nabla^2 u^* = 1 \ \text{in}\ \Omega, \qquad u^* = 0 \ \text{on the disk arcs},\qquad
+    \partial u^*/\partial n = 0 \ \text{on the triangle-edge gaps},\qquad
+    Q^* = \int_\Omega u^*\, dA^*.
+
+Weak form: find :math:`u` with :math:`\int \nabla u\cdot\nabla v = \int v` for all
+:math:`v`; then :math:`Q^* = \int u = a(u, u)`, so the Galerkin value approaches
+:math:`Q^*` from below on the exact geometry.
+
+Discretisation: second-order (curved, isoparametric) triangles from gmsh, Lagrange elements of
+degree p = 3 and p + 1 = 4 on the same mesh (p-refinement).  The reported value is the
+degree-4 one; its error estimate is
+
+.. math::
+    \eta = \frac{|Q_4 - Q_3|}{Q_4} + 3\,\frac{|A_h - A|}{A},
+
+a discretisation part (conservative: the degree-3 error) plus a geometric part from the
+quadratic arcs (A_h the meshed area, A the exact area of the meshed region; the factor 3 is
+d ln Q / d ln A of a thin channel, Q ∝ w³).  ``rtol`` sets the first mesh size; while
+η > rtol the mesh is refined (at most twice).  A meshed area that differs from the exact
+area by more than 1 % means the mesher lost a piece or a gap: refined, then 'failed'.
+"""
+
+from __future__ import annotations
+
+import logging
+import time
+from dataclasses import dataclass
+
+import numpy as np
+
+from ._geometry import (_as_throats, canonical_form, contact_type, mean_radius, open_area,
+                        validate_throats)
+from ._mesh import DELTA_DEFAULT, TriMesh, build_geometries, mesh_geometry
+
+__all__ = ["SOLVER_VERSION", "ThroatSolution", "solve_fem"]
+
+logger = logging.getLogger(__name__)
+
+#: bump whenever results could change (the cache keys on it)
+SOLVER_VERSION = "1.0"
+
+_FORMS = {}
+
+
+def _forms():
+    """scikit-fem forms, built once (skfem imported only when solving)."""
+    if not _FORMS:
+        from skfem import BilinearForm, LinearForm
+        from skfem.helpers import dot, grad
+
+        @BilinearForm
+        def laplace(u, v, w):
+            return dot(grad(u), grad(v))
+
+        @LinearForm
+        def unit_load(v, w):
+            return v
+
+        _FORMS.update(laplace=laplace, unit_load=unit_load)
+    return _FORMS["laplace"], _FORMS["unit_load"]
+
+
+@dataclass(frozen=True)
+class ThroatSolution:
+    """Result of :func:`solve_fem`, (N,) arrays.
+
+    Attributes
+    ----------
+    qstar : float, Q* in units of r̄⁴ (NaN where status is 'invalid' or 'failed')
+    open_area : float, exact open area in units of r̄²
+    contact_type : str, 'a' | 'b' | 'c' | 'd' ('' where invalid)
+    error_estimate : float, relative error estimate of qstar
+    n_elements : int, triangles of the final mesh
+    seconds : float, wall time of this throat
+    status : str, 'ok' | 'closed' | 'invalid' | 'failed'
+    message : str, why a row is not 'ok'
+    """
+
+    qstar: np.ndarray
+    open_area: np.ndarray
+    contact_type: np.ndarray
+    error_estimate: np.ndarray
+    n_elements: np.ndarray
+    seconds: np.ndarray
+    status: np.ndarray
+    message: np.ndarray
+
+
+def _sort_t6(t):
+    """Sort the vertices of each quadratic triangle (gmsh order) ascending, carrying the
+    mid-edge nodes along.  scikit-fem orients the edge dofs of P3/P4 by vertex order, so
+    unsorted elements give a non-conforming space."""
+    o = np.argsort(t[:3], axis=0)
+    mid = np.array([[-1, 3, 5], [3, -1, 4], [5, 4, -1]])
+    cols = np.arange(t.shape[1])
+    v = t[o, cols]
+    m = np.stack([t[mid[o[0], o[1]], cols], t[mid[o[1], o[2]], cols],
+                  t[mid[o[0], o[2]], cols]])
+    return np.vstack([v, m])
+
+
+def _fe_solve(trimesh: TriMesh, orders=(3, 4)):
+    """Solve on one mesh with each Lagrange degree in ``orders``.
+
+    Returns
+    -------
+    q : list of float, Q* per degree
+    area_h : float, meshed area (∫1 with the isoparametric map)
+    """
+    from scipy.sparse.linalg import spsolve
+    from skfem import Basis, ElementTriP2, ElementTriP3, ElementTriP4, MeshTri2
+
+    laplace, unit_load = _forms()
+    t = _sort_t6(trimesh.t)
+    mesh = MeshTri2(trimesh.p, t)
+    # no-slip facets from the tagged gmsh line elements (vertex pairs, skfem numbering)
+    uniq = np.unique(t[:3])
+    nv = uniq.size
+    a = np.searchsorted(uniq, trimesh.noslip[0])
+    b = np.searchsorted(uniq, trimesh.noslip[1])
+    key = np.minimum(a, b) * nv + np.maximum(a, b)
+    fkey = mesh.facets[0].astype(np.int64) * nv + mesh.facets[1]
+    srt = np.argsort(fkey)
+    pos = np.searchsorted(fkey[srt], key)
+    if np.any(pos >= fkey.size) or np.any(fkey[srt][np.minimum(pos, fkey.size - 1)] != key):
+        raise RuntimeError("no-slip line elements do not match mesh facets")
+    facets = srt[pos]
+    elems = {2: ElementTriP2, 3: ElementTriP3, 4: ElementTriP4}
+    q, area_h = [], np.nan
+    for p in orders:
+        basis = Basis(mesh, elems[p](), intorder=2 * p)
+        A = laplace.assemble(basis)
+        f = unit_load.assemble(basis)
+        dirichlet = basis.get_dofs(facets=facets).all()
+        free = np.ones(f.size, dtype=bool)
+        free[dirichlet] = False
+        u = np.zeros(f.size)
+        u[free] = spsolve(A[free][:, free].tocsc(), f[free])
+        q.append(float(f @ u))
+        area_h = float(f.sum())
+    return q, area_h
+
+
+def _h_for_rtol(rtol):
+    """First mesh size and arc angle for a tolerance (calibrated in throats.bench)."""
+    s = (rtol / 1e-3) ** 0.25
+    return float(np.clip(0.6 * s, 0.05, 1.0)), float(np.clip(0.5 * s, 0.08, 0.8))
+
+
+def _solve_geometry(geom, rtol, *, max_refine=2):
+    """Q*, error estimate, element count, status, message for one ThroatGeometry."""
+    if not geom.loops or geom.area <= 0:
+        return 0.0, 0.0, 0, "closed", "open region closed (narrower than the closing width)"
+    h, ca = _h_for_rtol(rtol)
+    orders = (2, 3) if rtol >= 5e-3 else (3, 4)
+    msg = ""
+    for level in range(max_refine + 1):
+        try:
+            tm = mesh_geometry(geom, h, curv_angle=ca)
+            (q_lo, q_hi), area_h = _fe_solve(tm, orders)
+        except Exception as exc:  # gmsh or solver failure: refine, then report
+            msg = f"mesh/solve failed at h={h:.3g}: {exc}"
+            logger.debug(msg)
+            h, ca = 0.6 * h, 0.7 * ca
+            continue
+        geo_err = abs(area_h - geom.area) / geom.area
+        if geo_err > 1e-2:
+            msg = (f"meshed area {area_h:.6g} differs from exact {geom.area:.6g} "
+                   f"(a gap or piece was lost) at h={h:.3g}")
+            logger.debug(msg)
+            h, ca = 0.6 * h, 0.7 * ca
+            continue
+        est = abs(q_hi - q_lo) / abs(q_hi) + 3.0 * geo_err if q_hi > 0 else np.inf
+        if est <= rtol or level == max_refine:
+            return q_hi, est, tm.t.shape[1], "ok", ("" if est <= rtol else
+                                                     f"error estimate {est:.2e} > rtol")
+        h, ca = 0.6 * h, 0.7 * ca
+    return np.nan, np.nan, 0, "failed", msg
+
+
+def _solve_chunk(radii, sides, rtol, delta):
+    """Solve N valid throats in this process (geometry vectorised, one mesh per throat)."""
+    rs, ss = canonical_form(radii, sides)
+    geoms = build_geometries(rs, ss, delta=delta)
+    out = []
+    for g in geoms:
+        t0 = time.perf_counter()
+        try:
+            res = _solve_geometry(g, rtol)
+        except Exception as exc:   # never raise for one throat
+            res = (np.nan, np.nan, 0, "failed", f"{type(exc).__name__}: {exc}")
+        out.append(res + (time.perf_counter() - t0,))
+    return out
+
+
+def _worker_chunk(args):
+    return _solve_chunk(*args)
+
+
+def solve_fem(radii, sides, *, rtol=1e-3, workers=1, progress=False, delta=DELTA_DEFAULT,
+              chunk_size=16):
+    r"""Dimensionless flow Q* of N throats by finite elements.
+
+    Parameters
+    ----------
+    radii, sides : (N, 3) array_like, any consistent length unit
+        ``[r1, r2, r3]`` and ``[l12, l13, l23]``.
+    rtol : float, optional
+        Requested relative accuracy of Q*, default 1e-3; sets the mesh (as coarse as it
+        allows) and triggers refinement while the error estimate exceeds it.
+    workers : int, optional
+        Processes (gmsh is initialised once per process), default 1 (this process).
+    progress : bool, optional
+        Show a tqdm progress bar.
+    delta : float, optional
+        Closing width (units of r̄) for narrow passages, default 0.01 (see
+        :mod:`throats._mesh`; its error is below 1e-5 relative in the tests).
+    chunk_size : int, optional
+        Throats per task when ``workers > 1``.
+
+    Returns
+    -------
+    ThroatSolution
+        Rows that fail :func:`validate_throats` get status 'invalid' and NaN; throats whose
+        disks cover the triangle get status 'closed' and Q* = 0.  Never raises for one row.
+
+    Raises
+    ------
+    ValueError
+        If the arrays are not (N, 3), or ``rtol`` / ``workers`` are out of range.
+
+    Examples
+    --------
+    >>> sol = solve_fem([[1, 1, 1]], [[2, 2, 2]])   # three touching disks, type d
+    >>> sol.status[0], sol.contact_type[0], bool(sol.error_estimate[0] < 1e-3)
+    ('ok', 'd', True)
+    """
+    r, s = _as_throats(radii, sides)
+    if not (np.isfinite(rtol) and 0 < rtol < 1):
+        raise ValueError(f"rtol must be in (0, 1), got {rtol}")
+    if int(workers) < 1:
+        raise ValueError(f"workers must be >= 1, got {workers}")
+    n = r.shape[0]
+    ok, msg = validate_throats(r, s)
+    qstar = np.full(n, np.nan)
+    est = np.full(n, np.nan)
+    nel = np.zeros(n, dtype=int)
+    secs = np.zeros(n)
+    status = np.where(ok, "ok", "invalid").astype(object)
+    area = np.full(n, np.nan)
+    ctype = np.full(n, "", dtype=object)
+    idx = np.flatnonzero(ok)
+    if idx.size:
+        rbar = mean_radius(r[idx])
+        area[idx] = open_area(r[idx], s[idx]) / rbar**2
+        ctype[idx] = contact_type(r[idx], s[idx])
+        closed = area[idx] <= 1e-14
+        qstar[idx[closed]] = 0.0
+        est[idx[closed]] = 0.0
+        status[idx[closed]] = "closed"
+        msg[idx[closed]] = "disks cover the triangle (open area <= 0)"
+        idx = idx[~closed]
+    chunks = [idx[k:k + chunk_size] for k in range(0, idx.size, chunk_size)]
+    tasks = [(r[c], s[c], rtol, delta) for c in chunks]
+    bar = None
+    if progress:
+        from tqdm import tqdm
+        bar = tqdm(total=idx.size, unit="throat", desc="throats FE")
+    try:
+        if workers == 1 or len(tasks) <= 1:
+            results = (_solve_chunk(*t) for t in tasks)
+            _collect(results, chunks, qstar, est, nel, status, msg, secs, bar)
+        else:
+            import multiprocessing as mp
+            from concurrent.futures import ProcessPoolExecutor
+            ctx = mp.get_context("spawn")
+            with ProcessPoolExecutor(max_workers=int(workers), mp_context=ctx) as pool:
+                results = pool.map(_worker_chunk, tasks)
+                _collect(results, chunks, qstar, est, nel, status, msg, secs, bar)
+    finally:
+        if bar is not None:
+            bar.close()
+    return ThroatSolution(qstar, area, ctype.astype(str), est, nel, secs,
+                          status.astype(str), msg.astype(str))
+
+
+def _collect(results, chunks, qstar, est, nel, status, msg, secs, bar):
+    for c, res in zip(chunks, results):
+        for k, (q, e, ne, st, m, sec) in zip(c, res):
+            qstar[k], est[k], nel[k], status[k], msg[k], secs[k] = q, e, ne, st, m, sec
+        if bar is not None:
+            bar.update(len(c))
