@@ -237,8 +237,10 @@ def solve_fem(radii, sides, *, rtol=1e-3, workers=1, progress=False, delta=DELTA
     Examples
     --------
     >>> sol = solve_fem([[1, 1, 1]], [[2, 2, 2]])   # three touching disks, type d
-    >>> sol.status[0], sol.contact_type[0], bool(sol.error_estimate[0] < 1e-3)
+    >>> str(sol.status[0]), str(sol.contact_type[0]), bool(sol.error_estimate[0] < 1e-3)
     ('ok', 'd', True)
+    >>> round(float(sol.qstar[0]), 6)
+    0.000523
     """
     r, s = _as_throats(radii, sides)
     if not (np.isfinite(rtol) and 0 < rtol < 1):
