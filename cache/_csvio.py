@@ -1,0 +1,53 @@
+"""CSV input/output of throat shapes (columns ``r1,r2,r3,l12,l13,l23``)."""
+
+from __future__ import annotations
+
+import csv
+
+import numpy as np
+
+__all__: list[str] = []
+
+SHAPE_COLUMNS = ("r1", "r2", "r3", "l12", "l13", "l23")
+
+
+def read_throat_csv(path):
+    """Read a throat CSV: ``(header list, rows list of lists, radii (N,3), sides (N,3))``.
+
+    Cells that do not parse as numbers become NaN (the row is then reported as invalid).
+    """
+    with open(path, newline="") as fh:
+        reader = csv.reader(fh)
+        try:
+            header = [h.strip() for h in next(reader)]
+        except StopIteration:
+            raise ValueError(f"{path}: empty file, expected a header {','.join(SHAPE_COLUMNS)}") from None
+        missing = [c for c in SHAPE_COLUMNS if c not in header]
+        if missing:
+            raise ValueError(f"{path}: missing column(s) {missing}; header is {header}")
+        rows = [row for row in reader if row]
+    cols = [header.index(c) for c in SHAPE_COLUMNS]
+    vals = np.full((len(rows), 6), np.nan)
+    for j, c in enumerate(cols):
+        for i, row in enumerate(rows):
+            try:
+                vals[i, j] = float(row[c])
+            except (ValueError, IndexError):
+                pass
+    return header, rows, vals[:, :3], vals[:, 3:]
+
+
+def write_csv(path, header, rows, extra):
+    """Write ``rows`` (lists of str) with extra columns ``extra`` (dict name -> (N,) array)."""
+    names = list(extra)
+    with open(path, "w", newline="") as fh:
+        w = csv.writer(fh)
+        w.writerow(list(header) + names)
+        for i, row in enumerate(rows):
+            w.writerow(list(row) + [_fmt(extra[k][i]) for k in names])
+
+
+def _fmt(v):
+    if isinstance(v, (float, np.floating)):
+        return "" if not np.isfinite(v) else repr(float(v))
+    return str(v)

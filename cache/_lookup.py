@@ -1,0 +1,328 @@
+r"""Vectorised Q* lookup for N throats: exact hits, grid interpolation, FE on demand.
+
+Policies
+--------
+==============  ===============================================================================
+``table-only``  interpolation in the grid table for every row it covers, with its error
+                estimate; rows the grid cannot serve (outside the box, next to invalid or
+                closed nodes) take an exact hit if the store has one, else the shape-factor
+                estimate (``source='shape-factor'``).  Never runs FE.
+``table+fe``    as ``table-only``, but every row whose error estimate exceeds ``rtol`` is
+                answered by an exact hit (a stored FE solve with tolerance <= ``rtol``) or
+                else solved by FE (``throats.solve_fem``) and stored.
+``fe-only``     exact hits, FE for the rest (stored); no interpolation.
+``shape-factor`` ``throats.shape_factor_qstar`` for every row (no table).
+==============  ===============================================================================
+
+The hot path of the table policies is one multilinear evaluation per row (no canonical
+reordering, see :mod:`cache._interp`), so table lookups run at > 1e6 rows/s on one core.
+Rows with NaN/inf, a non-positive length or sides that are not a triangle are reported with
+``source='failed'`` and a message (``throats.validate_throats``), never raised.
+"""
+
+from __future__ import annotations
+
+import logging
+import os
+import time
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+
+from . import _build
+from ._build import _resolve_solver, precompute_throats
+from ._interp import GridSpec, GridTable, grid_coordinates
+from ._signature import _throats_attr, as_throats, match_keys, shape_keys, signature
+from ._store import open_store
+
+logger = logging.getLogger(__name__)
+
+__all__ = ["Lookup", "lookup_qstar", "default_db_path", "load_grid_table", "POLICIES",
+           "export_grid", "shipped_grid_path"]
+
+POLICIES = ("table-only", "table+fe", "fe-only", "shape-factor")
+_DATA = Path(__file__).resolve().parent / "data"
+
+
+@dataclass(frozen=True)
+class Lookup:
+    """Result of :func:`lookup_qstar`: (N,) arrays plus run statistics.
+
+    Attributes
+    ----------
+    qstar : (N,) float, Q* in units of r̄ (NaN where ``source == 'failed'``)
+    error_estimate : (N,) float, relative (NaN for shape-factor rows)
+    source : (N,) str, 'exact' | 'interp' | 'fe' | 'shape-factor' | 'closed' | 'failed'
+    stats : dict, counts per source, ``hit_rate`` (exact + interp over valid rows), ``n_fe``
+        (distinct shapes solved), ``seconds``
+    message : (N,) object, reason for 'failed' rows, '' elsewhere
+    """
+
+    qstar: np.ndarray
+    error_estimate: np.ndarray
+    source: np.ndarray
+    stats: dict
+    message: np.ndarray = field(default=None)
+
+
+def default_db_path():
+    """Default writable table: ``$GRAINFLOW_CACHE_DB`` or ``~/.cache/grainflow/throats.sqlite``."""
+    env = os.environ.get("GRAINFLOW_CACHE_DB")
+    if env:
+        return Path(env)
+    return Path.home() / ".cache" / "grainflow" / "throats.sqlite"
+
+
+def shipped_grid_path(name="coarse"):
+    """Path of the grid table shipped with the package (``cache/data/grid_<name>.npz``)."""
+    return _DATA / f"grid_{name}.npz"
+
+
+# cache of loaded tables: (path, grid, solver_version, mtime_ns) -> GridTable
+_TABLES: dict = {}
+
+
+def _grid_from_store(store, name, solver_version):
+    spec_d = store.grid(name)
+    if spec_d is None:
+        return None
+    spec = GridSpec.from_dict(spec_d)
+    rtol = float(spec_d.get("rtol", 1e-3))
+    nr, ns = spec.node_shapes()
+    keys = shape_keys(signature(nr, ns))
+    rows = store.load(solver_version=solver_version)
+    same = np.isclose(rows["rtol"], rtol, rtol=1e-9, atol=0)
+    idx = match_keys(keys, rows["keys"][same])
+    q = np.full(len(keys), np.nan)
+    fe = np.full(len(keys), np.nan)
+    hit = idx >= 0
+    st = rows["status"][same][idx[hit]]
+    qq = rows["qstar"][same][idx[hit]]
+    q[hit] = np.where(st == "closed", 0.0, np.where(st == "ok", qq, np.nan))
+    fe[hit] = rows["error_estimate"][same][idx[hit]]
+    logger.info("grid %r from %s: %d of %d nodes solved", name, store.path, int(np.isfinite(q).sum()),
+                len(q))
+    return GridTable(spec, q, fe)
+
+
+def export_grid(store, name, path, *, solver_version):
+    """Write grid ``name`` of ``store`` as a compact ``.npz`` (spec, node Q*, node FE errors)."""
+    import json
+
+    table = _grid_from_store(store, name, solver_version)
+    if table is None:
+        raise ValueError(f"{store.path} holds no grid named {name!r} (grids: {store.grid_names()})")
+    spec = dict(store.grid(name))
+    np.savez_compressed(path, spec=json.dumps(spec), qstar=table.qstar, fe_error=table.fe_error,
+                        solver_version=str(solver_version))
+    return Path(path)
+
+
+def load_grid_table(db=None, *, grid=None, solver_version=None):
+    """The interpolation table for ``db`` (its own grid if it has one, else the shipped one).
+
+    Returns None when neither exists for the current solver version.
+    """
+    if solver_version is None:
+        solver_version = _build.default_solver()[1]
+    path = Path(db) if db is not None else default_db_path()
+    if path.exists() and path.stat().st_size > 0:
+        key = (str(path.resolve()), grid, solver_version, path.stat().st_mtime_ns)
+        if key in _TABLES:
+            return _TABLES[key]
+        with open_store(path, create=False) as store:
+            names = store.grid_names()
+            name = grid if grid is not None else (names[-1] if names else None)
+            table = _grid_from_store(store, name, solver_version) if name in names else None
+        if table is not None:
+            _TABLES.clear()
+            _TABLES[key] = table
+            return table
+    name = grid or "coarse"
+    shipped = shipped_grid_path(name)
+    if shipped.exists():
+        key = (str(shipped), name, solver_version, shipped.stat().st_mtime_ns)
+        if key not in _TABLES:
+            import json
+
+            z = np.load(shipped, allow_pickle=False)
+            if str(z["solver_version"]) != str(solver_version):
+                logger.warning("shipped grid %s was built with solver %s, current is %s: not used",
+                               shipped, z["solver_version"], solver_version)
+                return None
+            _TABLES[key] = GridTable(GridSpec.from_dict(json.loads(str(z["spec"]))), z["qstar"],
+                                     z["fe_error"])
+        return _TABLES[key]
+    return None
+
+
+def _quick_valid(r, s):
+    """Cheap row checks of the hot path (finite, positive, strict triangle inequality)."""
+    ok = np.isfinite(r).all(1) & np.isfinite(s).all(1) & (r > 0).all(1) & (s > 0).all(1)
+    l12, l13, l23 = s[:, 0], s[:, 1], s[:, 2]
+    with np.errstate(invalid="ignore"):
+        ok &= (l12 < l13 + l23) & (l13 < l12 + l23) & (l23 < l12 + l13)
+    return ok
+
+
+def lookup_qstar(radii, sides, *, db=None, policy="table+fe", rtol=1e-3, workers=1,
+                 progress=False, grid=None, solver=None, solver_version=None, table=None):
+    r"""Q* of N throats from the cache, by the given policy (see module notes).
+
+    Parameters
+    ----------
+    radii, sides : (N, 3) array_like, any consistent length unit
+        ``[r1, r2, r3]``, ``[l12, l13, l23]``.
+    db : path, optional
+        Throat table; None means :func:`default_db_path`.  Its grid (or the shipped one)
+        serves interpolation; FE results are stored in it.
+    policy : {'table-only', 'table+fe', 'fe-only', 'shape-factor'}, keyword-only
+    rtol : float, keyword-only, default 1e-3
+        Relative tolerance: interpolated rows with a larger error estimate go to FE
+        ('table+fe'); FE solves use it as their tolerance.
+    workers : int, keyword-only, default 1
+        Processes for FE solves.
+    progress : bool, keyword-only
+        Progress bar for FE solves.
+    grid : str, optional
+        Name of the grid to interpolate in (default: the newest in ``db``, else shipped).
+    solver, solver_version : optional
+        Injected FE solver (protocol of ``throats.solve_fem``); default ``throats.solve_fem``.
+    table : GridTable, optional
+        Use this interpolation table instead of loading one (benchmarks, tests).
+
+    Returns
+    -------
+    Lookup
+        qstar (r̄ units: g = Q* r̄⁴/(μL)), error_estimate, source, stats, message.
+
+    Raises
+    ------
+    ValueError
+        Unknown policy, rtol <= 0, or arrays not both (N, 3).
+    """
+    t0 = time.perf_counter()
+    if policy not in POLICIES:
+        raise ValueError(f"unknown policy {policy!r}; expected one of {POLICIES}")
+    if not rtol > 0:
+        raise ValueError(f"rtol must be > 0, got {rtol}")
+    r, s = as_throats(radii, sides)
+    n = len(r)
+    q = np.full(n, np.nan)
+    err = np.full(n, np.nan)
+    src = np.full(n, "failed", dtype="<U12")
+    msg = np.full(n, "", dtype=object)
+    stats = {"n": n, "policy": policy, "rtol": rtol, "n_fe": 0}
+
+    ok = _quick_valid(r, s)
+    pending = np.flatnonzero(ok)
+    if policy == "shape-factor":
+        sf = _throats_attr("shape_factor_qstar")
+        q[pending] = sf(r[pending], s[pending])
+        src[pending] = "shape-factor"
+    else:
+        if solver is not None or policy != "table-only":
+            solver, solver_version = _resolve_solver(solver, solver_version)
+        elif solver_version is None:
+            solver_version = _build.default_solver()[1]
+        if policy in ("table-only", "table+fe"):
+            if table is None:
+                table = load_grid_table(db, grid=grid, solver_version=solver_version)
+            if table is None:
+                logger.warning("no grid table for solver %s: every row needs exact hits or FE",
+                               solver_version)
+            else:
+                x = grid_coordinates(r[pending], s[pending])
+                qi, ei = table(x)
+                q[pending], err[pending] = qi, ei
+                src[pending] = "interp"
+                good = (ei <= rtol) if policy == "table+fe" else np.isfinite(ei)
+                pending = pending[~good]
+        # rows the table did not settle: exact hits, then FE or shape factor
+        if len(pending):
+            _settle(r, s, pending, q, err, src, msg, stats, db=db, policy=policy, rtol=rtol,
+                    workers=workers, progress=progress, solver=solver,
+                    solver_version=solver_version)
+    bad = np.flatnonzero(~ok)
+    if len(bad):
+        _, m = _throats_attr("validate_throats")(r[bad], s[bad])
+        msg[bad] = [mm or "invalid throat" for mm in m]
+        q[bad], err[bad], src[bad] = np.nan, np.nan, "failed"
+    for name in ("exact", "interp", "fe", "shape-factor", "closed", "failed"):
+        stats[f"n_{name.replace('-', '_')}"] = int(np.sum(src == name))
+    n_valid = max(n - stats["n_failed"], 1)
+    stats["hit_rate"] = (stats["n_exact"] + stats["n_interp"]) / n_valid
+    stats["seconds"] = time.perf_counter() - t0
+    return Lookup(q, err, src.astype(str), stats, msg)
+
+
+def _settle(r, s, rows, q, err, src, msg, stats, *, db, policy, rtol, workers, progress, solver,
+            solver_version):
+    """Exact hits / FE / shape-factor for ``rows`` (in place)."""
+    ok, m = _throats_attr("validate_throats")(r[rows], s[rows])
+    bad = rows[~ok]
+    msg[bad] = m[~ok]
+    q[bad], err[bad], src[bad] = np.nan, np.nan, "failed"
+    rows = rows[ok]
+    if not len(rows):
+        return
+    keys = shape_keys(signature(r[rows], s[rows]))
+    path = Path(db) if db is not None else default_db_path()
+    need_store = policy != "table-only" or (path.exists() and path.stat().st_size > 0)
+    if not need_store:
+        _shape_factor_rows(r, s, rows, q, err, src)
+        return
+    with open_store(path, create=policy != "table-only") as store:
+        found = _exact(store, keys, rtol, solver_version)
+        hit = found["idx"] >= 0
+        _assign_exact(rows[hit], found, found["idx"][hit], q, err, src, msg, "exact")
+        miss, mkeys = rows[~hit], keys[~hit]
+        if not len(miss):
+            return
+        if policy == "table-only":
+            unserved = miss[~np.isfinite(err[miss])]
+            _shape_factor_rows(r, s, unserved, q, err, src)
+            return
+        summ = precompute_throats(store, r[miss], s[miss], rtol=rtol, solver=solver,
+                                  solver_version=solver_version, workers=workers,
+                                  progress=progress, retry_failed=True)
+        stats["n_fe"] += summ.solved + summ.failed
+        stats["fe_seconds"] = stats.get("fe_seconds", 0.0) + summ.seconds
+        found = _exact(store, mkeys, rtol, solver_version, statuses=None)
+        hit = found["idx"] >= 0
+        _assign_exact(miss[hit], found, found["idx"][hit], q, err, src, msg, "fe")
+        lost = miss[~hit]
+        q[lost], err[lost], src[lost] = np.nan, np.nan, "failed"
+        msg[lost] = "no stored result after the FE solve"
+
+
+def _exact(store, keys, rtol, solver_version, statuses=("ok", "closed")):
+    rows = store.load(solver_version=solver_version, max_rtol=rtol, statuses=statuses)
+    if len(rows["rtol"]) > 1:  # prefer the most accurate row of each shape
+        order = np.lexsort((rows["rtol"],) + tuple(rows["keys"].T[::-1]))
+        rows = {k: v[order] for k, v in rows.items()}
+    rows["idx"] = match_keys(keys, rows["keys"])
+    return rows
+
+
+def _assign_exact(dest, rows, idx, q, err, src, msg, label):
+    st = rows["status"][idx]
+    q[dest] = np.where(st == "closed", 0.0, rows["qstar"][idx])
+    err[dest] = np.where(st == "closed", 0.0, rows["error_estimate"][idx])
+    src[dest] = np.where(st == "closed", "closed", np.where(st == "ok", label, "failed"))
+    msg[dest] = np.where(st == "ok", "", rows["message"][idx])
+
+
+def _shape_factor_rows(r, s, rows, q, err, src):
+    if not len(rows):
+        return
+    try:
+        sf = _throats_attr("shape_factor_qstar")
+    except ImportError:
+        logger.warning("throats.shape_factor_qstar unavailable: %d rows keep their clamped "
+                       "interpolation with an infinite error estimate", len(rows))
+        return
+    q[rows] = sf(r[rows], s[rows])
+    err[rows] = np.nan
+    src[rows] = "shape-factor"

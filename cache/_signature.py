@@ -1,0 +1,122 @@
+r"""Shape signature of a throat: the scale- and permutation-invariant key of the cache.
+
+A throat is six numbers, ``radii = [r1, r2, r3]`` and ``sides = [l12, l13, l23]``; Q* (in
+units of the mean radius r̄) depends only on its shape, i.e. on the six numbers up to a common
+scale and a permutation of the vertices (a mirror image or rotation of the face gives the
+same six numbers).  ``throats.canonical_form`` scales by r̄ and picks the canonical vertex
+order; the signature is the five independent numbers of that canonical row,
+
+.. math:: s = (r_1^*, r_2^*, l_{12}^*, l_{13}^*, l_{23}^*), \qquad r_3^* = 3 - r_1^* - r_2^*,
+
+and the table key is ``round(s / QUANTUM)`` as five int64 (QUANTUM = 1e-9 r̄): two throats
+share a key when their shapes agree to 1e-9 r̄, far below any solver tolerance.  Solver
+settings (``SOLVER_VERSION``, ``rtol``) are stored beside the key and are part of the unique
+index, so a changed solver never serves a stale value.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+__all__ = ["signature", "shape_keys", "QUANTUM"]
+
+#: quantum of the integer key, in units of the mean radius
+QUANTUM = 1e-9
+
+
+def _throats_attr(name):
+    """``throats.<name>``, imported lazily (throats imports nothing heavy at import time)."""
+    import throats
+
+    try:
+        return getattr(throats, name)
+    except AttributeError:
+        from throats import _geometry  # fall back to the topic module while __all__ grows
+
+        try:
+            return getattr(_geometry, name)
+        except AttributeError as e:
+            raise ImportError(f"throats does not provide {name!r} (see the throats issue)") from e
+
+
+def as_throats(radii, sides):
+    """Validate the shapes at the door: two float (N, 3) arrays (a (3,) row means N = 1)."""
+    try:
+        r = np.atleast_2d(np.asarray(radii, dtype=float))
+        s = np.atleast_2d(np.asarray(sides, dtype=float))
+    except (TypeError, ValueError) as e:
+        raise TypeError(f"radii and sides must be numeric arrays: {e}") from e
+    if r.ndim != 2 or r.shape[1] != 3 or s.shape != r.shape:
+        raise ValueError(f"expected radii and sides of shape (N, 3), got {r.shape} and {s.shape}")
+    return r, s
+
+
+def signature(radii, sides):
+    r"""Scale- and permutation-invariant signature of N throats, (N, 5).
+
+    Parameters
+    ----------
+    radii, sides : (N, 3) array_like, any consistent length unit
+        ``[r1, r2, r3]`` and ``[l12, l13, l23]``.
+
+    Returns
+    -------
+    (N, 5) ndarray, dimensionless (units of r̄)
+        ``[r1*, r2*, l12*, l13*, l23*]`` of the canonical form (``throats.canonical_form``);
+        rows with NaN stay NaN.
+
+    Examples
+    --------
+    >>> a = signature([[1.0, 2.0, 3.0]], [[3.5, 4.5, 5.0]])
+    >>> b = signature([[6.0, 4.0, 2.0]], [[10.0, 9.0, 7.0]])   # permuted and scaled x2
+    >>> bool(np.allclose(a, b, rtol=0, atol=1e-12))
+    True
+    """
+    r, s = as_throats(radii, sides)
+    canonical_form = _throats_attr("canonical_form")
+    rs, ss = canonical_form(r, s)
+    return np.concatenate([rs[:, :2], ss], axis=1)
+
+
+def shape_keys(sig):
+    """Integer keys (N, 5) int64 of signatures: ``rint(sig / QUANTUM)``; NaN rows give -2**62."""
+    sig = np.asarray(sig, dtype=float)
+    with np.errstate(invalid="ignore"):
+        k = np.rint(sig / QUANTUM)
+    k[~np.isfinite(k)] = -(2.0**62)
+    return k.astype(np.int64)
+
+
+def key_hash(keys):
+    """One uint64 per key row (multiplicative mixing); equal keys give equal hashes."""
+    k = np.asarray(keys, dtype=np.int64).view(np.uint64)
+    mult = np.array([0x9E3779B97F4A7C15, 0xC2B2AE3D27D4EB4F, 0x165667B19E3779F9,
+                     0xD6E8FEB86659FD93, 0xFF51AFD7ED558CCD], dtype=np.uint64)
+    with np.errstate(over="ignore"):
+        h = np.zeros(len(k), dtype=np.uint64)
+        for c in range(5):
+            h = (h ^ (k[:, c] * mult[c])) * np.uint64(0x94D049BB133111EB)
+            h ^= h >> np.uint64(31)
+    return h
+
+
+def match_keys(query, table):
+    """Row index into ``table`` of each ``query`` key (N,), -1 where absent.
+
+    Vectorised hash join: sort the table's hashes once, ``searchsorted`` the queries, then
+    verify all five integers (a hash collision can only turn a hit into a miss).
+    """
+    query = np.asarray(query, dtype=np.int64).reshape(-1, 5)
+    table = np.asarray(table, dtype=np.int64).reshape(-1, 5)
+    out = np.full(len(query), -1, dtype=np.int64)
+    if len(table) == 0 or len(query) == 0:
+        return out
+    ht = key_hash(table)
+    order = np.argsort(ht, kind="stable")
+    hs = ht[order]
+    hq = key_hash(query)
+    pos = np.minimum(np.searchsorted(hs, hq), len(hs) - 1)
+    cand = order[pos]
+    ok = (hs[pos] == hq) & np.all(table[cand] == query, axis=1)
+    out[ok] = cand[ok]
+    return out

@@ -1,0 +1,90 @@
+"""Command line: fill a throat table by batch precomputation.
+
+Examples
+--------
+Every throat of a packing (as exported by ``python -m network.throats``)::
+
+    python -m cache.precompute --db throats.sqlite --csv THROATS.csv --workers 2
+
+The interpolation grid over the signature space (named grids: ``cache.GRIDS``)::
+
+    python -m cache.precompute --db throats.sqlite --grid coarse --workers 1
+
+Rerunning the same command resumes (solved shapes are reused); ``--retry-failed`` solves the
+recorded failures again.  A summary (solved, reused, failed, seconds) is printed as JSON.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import logging
+import sys
+
+import numpy as np
+
+from ._build import _resolve_solver, precompute_throats
+from ._csvio import read_throat_csv
+from ._interp import GRIDS
+from ._lookup import export_grid
+from ._store import CacheFileError, open_store
+
+
+def build_parser():
+    p = argparse.ArgumentParser(prog="python -m cache.precompute", description=__doc__.split("\n")[0])
+    p.add_argument("--db", required=True, help="SQLite throat table (created if missing)")
+    src = p.add_mutually_exclusive_group(required=True)
+    src.add_argument("--csv", help="throat shapes, columns r1,r2,r3,l12,l13,l23")
+    src.add_argument("--grid", choices=sorted(GRIDS), help="named interpolation grid to fill")
+    p.add_argument("--rtol", type=float, default=1e-3, help="FE tolerance (default 1e-3)")
+    p.add_argument("--workers", type=int, default=1, help="local processes (default 1)")
+    p.add_argument("--batch-size", type=int, default=16, help="solves per transaction (default 16)")
+    p.add_argument("--retry-failed", action="store_true", help="solve recorded failures again")
+    p.add_argument("--max-hours", type=float, default=None, help="stop submitting after this long")
+    p.add_argument("--export", metavar="NPZ", help="after a --grid run, write the grid as .npz")
+    p.add_argument("--quiet", action="store_true", help="no progress bar")
+    return p
+
+
+def main(argv=None) -> int:
+    args = build_parser().parse_args(argv)
+    logging.basicConfig(level=logging.INFO, format="%(levelname)s %(name)s: %(message)s")
+    try:
+        solver, version = _resolve_solver(None, None)
+    except ImportError as e:
+        print(f"error: {e}", file=sys.stderr)
+        return 2
+    try:
+        store = open_store(args.db)
+    except CacheFileError as e:
+        print(f"error: {e}", file=sys.stderr)
+        return 2
+    with store:
+        if args.csv:
+            try:
+                _, _, radii, sides = read_throat_csv(args.csv)
+            except (OSError, ValueError) as e:
+                print(f"error: {e}", file=sys.stderr)
+                return 2
+        else:
+            spec = GRIDS[args.grid]
+            radii, sides = spec.node_shapes()
+            d = spec.to_dict()
+            d.update(rtol=args.rtol, solver_version=version)
+            store.put_grid(spec.name, d)
+        summary = precompute_throats(
+            store, radii, sides, rtol=args.rtol, solver=solver, solver_version=version,
+            workers=args.workers, batch_size=args.batch_size, retry_failed=args.retry_failed,
+            progress=not args.quiet,
+            max_seconds=None if args.max_hours is None else 3600 * args.max_hours)
+        out = summary.as_dict()
+        out.update(db=str(args.db), solver_version=version, rtol=args.rtol, rows=store.count())
+        if args.grid and args.export:
+            export_grid(store, args.grid, args.export, solver_version=version)
+            out["exported"] = args.export
+    print(json.dumps(out, indent=1))
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
