@@ -104,43 +104,113 @@ def _sort_t6(t):
     return np.vstack([v, m])
 
 
-def _fe_solve(trimesh: TriMesh, orders=(3, 4)):
+_REF = {}
+
+
+def _reference(p, intorder):
+    """Reference-triangle tables, computed once per (degree, quadrature order):
+    quadrature points/weights, P2 geometry gradients (6, 2, Nq), degree-p basis values
+    (nb, Nq) and gradients (nb, 2, Nq), all from scikit-fem's elements."""
+    key = (p, intorder)
+    if key not in _REF:
+        from skfem import ElementTriP2, ElementTriP3, ElementTriP4
+        from skfem.quadrature import get_quadrature
+        from skfem.refdom import RefTri
+
+        elem = {2: ElementTriP2, 3: ElementTriP3, 4: ElementTriP4}[p]()
+        X, W = get_quadrature(RefTri, intorder)
+        geo = ElementTriP2()
+        g2 = np.array([geo.lbasis(X, i)[1] for i in range(6)])
+        phi = np.array([elem.lbasis(X, i)[0] for i in range(elem.doflocs.shape[0])])
+        dphi = np.array([elem.lbasis(X, i)[1] for i in range(elem.doflocs.shape[0])])
+        _REF[key] = (elem, W, g2, phi, dphi)
+    return _REF[key]
+
+
+def _assemble(mesh, t6, p, degree, intorder):
+    r"""Stiffness matrix and load vector of degree-``degree`` Lagrange elements on the
+    quadratic (isoparametric) triangles, vectorised over elements with ``numpy.einsum``:
+
+    .. math:: K^e_{ij} = \sum_q w_q |J_q| \nabla\phi_i \cdot \nabla\phi_j, \qquad
+              f^e_i = \sum_q w_q |J_q| \phi_i,
+
+    with :math:`J_q = \sum_k x_k \nabla_\xi N_k(\xi_q)` from the six P2 geometry nodes.
+    Same quantities as scikit-fem's ``laplace``/``unit_load`` on a ``Basis`` (checked in the
+    tests), without its per-basis-function Python loop, which dominated on ~100 elements.
+    Returns (K csr, f, element dofs (nb, Ne)).
+    """
+    from scipy.sparse import coo_matrix
+    from skfem.assembly import Dofs
+
+    elem, W, g2, phi, dphi = _reference(degree, intorder)
+    x = p[:, t6]                                         # (2, 6, Ne)
+    J = np.einsum("ake,kbq->abeq", x, g2)                # dx_a/dxi_b, (2, 2, Ne, Nq)
+    det = J[0, 0] * J[1, 1] - J[0, 1] * J[1, 0]
+    inv = np.array([[J[1, 1], -J[0, 1]], [-J[1, 0], J[0, 0]]]) / det   # dxi_a/dx_b
+    grad = np.einsum("baeq,ibq->iaeq", inv, dphi)        # physical gradients
+    wdet = np.abs(det) * W                                # (Ne, Nq)
+    K = np.einsum("iaeq,jaeq,eq->ije", grad, grad, wdet)
+    f = np.einsum("iq,eq->ie", phi, wdet)
+    edofs = Dofs(mesh, elem).element_dofs                 # (nb, Ne)
+    n = int(edofs.max()) + 1
+    nb = edofs.shape[0]
+    rows = np.broadcast_to(edofs[:, None, :], (nb, nb, edofs.shape[1])).ravel()
+    cols = np.broadcast_to(edofs[None, :, :], (nb, nb, edofs.shape[1])).ravel()
+    A = coo_matrix((K.ravel(), (rows, cols)), shape=(n, n)).tocsc()
+    b = np.bincount(edofs.ravel(), weights=f.ravel(), minlength=n)
+    return A, b, edofs
+
+
+def _noslip_facets(mesh, t6, noslip):
+    """scikit-fem facet indices of the tagged no-slip line elements (vertex pairs)."""
+    uniq = np.unique(t6[:3])
+    nv = uniq.size
+    a = np.searchsorted(uniq, noslip[0])
+    b = np.searchsorted(uniq, noslip[1])
+    key = np.minimum(a, b).astype(np.int64) * nv + np.maximum(a, b)
+    fkey = mesh.facets[0].astype(np.int64) * nv + mesh.facets[1]
+    srt = np.argsort(fkey)
+    pos = np.minimum(np.searchsorted(fkey[srt], key), fkey.size - 1)
+    if np.any(fkey[srt][pos] != key):
+        raise RuntimeError("no-slip line elements do not match mesh facets")
+    return srt[pos]
+
+
+def _fe_solve(trimesh: TriMesh, orders=(3, 4), *, use_skfem_basis=False):
     """Solve on one mesh with each Lagrange degree in ``orders``.
+
+    ``use_skfem_basis=True`` assembles with scikit-fem's ``Basis`` and forms instead of
+    :func:`_assemble` (same numbers, slower; used by the tests as the reference path).
 
     Returns
     -------
     q : list of float, Q* per degree
     area_h : float, meshed area (∫1 with the isoparametric map)
     """
-    from scipy.sparse.linalg import spsolve
-    from skfem import Basis, ElementTriP2, ElementTriP3, ElementTriP4, MeshTri2
+    from scipy.sparse.linalg import splu
+    from skfem import MeshTri2
 
-    laplace, unit_load = _forms()
-    t = _sort_t6(trimesh.t)
-    mesh = MeshTri2(trimesh.p, t)
-    # no-slip facets from the tagged gmsh line elements (vertex pairs, skfem numbering)
-    uniq = np.unique(t[:3])
-    nv = uniq.size
-    a = np.searchsorted(uniq, trimesh.noslip[0])
-    b = np.searchsorted(uniq, trimesh.noslip[1])
-    key = np.minimum(a, b) * nv + np.maximum(a, b)
-    fkey = mesh.facets[0].astype(np.int64) * nv + mesh.facets[1]
-    srt = np.argsort(fkey)
-    pos = np.searchsorted(fkey[srt], key)
-    if np.any(pos >= fkey.size) or np.any(fkey[srt][np.minimum(pos, fkey.size - 1)] != key):
-        raise RuntimeError("no-slip line elements do not match mesh facets")
-    facets = srt[pos]
-    elems = {2: ElementTriP2, 3: ElementTriP3, 4: ElementTriP4}
+    t6 = _sort_t6(trimesh.t)
+    mesh = MeshTri2(trimesh.p, t6)
+    facets = _noslip_facets(mesh, t6, trimesh.noslip)
     q, area_h = [], np.nan
-    for p in orders:
-        basis = Basis(mesh, elems[p](), intorder=2 * p)
-        A = laplace.assemble(basis)
-        f = unit_load.assemble(basis)
-        dirichlet = basis.get_dofs(facets=facets).all()
+    for deg in orders:
+        if use_skfem_basis:
+            from skfem import Basis, ElementTriP2, ElementTriP3, ElementTriP4
+            laplace, unit_load = _forms()
+            basis = Basis(mesh, {2: ElementTriP2, 3: ElementTriP3, 4: ElementTriP4}[deg](),
+                          intorder=2 * deg)
+            A = laplace.assemble(basis).tocsc()
+            f = unit_load.assemble(basis)
+            dirichlet = basis.get_dofs(facets=facets).all()
+        else:
+            A, f, _ = _assemble(mesh, t6, trimesh.p, deg, 2 * deg)
+            from skfem.assembly import Dofs
+            dirichlet = Dofs(mesh, _reference(deg, 2 * deg)[0]).get_facet_dofs(facets).all()
         free = np.ones(f.size, dtype=bool)
         free[dirichlet] = False
         u = np.zeros(f.size)
-        u[free] = spsolve(A[free][:, free].tocsc(), f[free])
+        u[free] = splu(A[free][:, free].tocsc()).solve(f[free])
         q.append(float(f @ u))
         area_h = float(f.sum())
     return q, area_h
