@@ -14,9 +14,14 @@ from pathlib import Path
 
 import numpy as np
 
-__all__ = ["Packing", "read_packing", "write_packing_csv", "MIN_SPHERES"]
+__all__ = ["Packing", "read_packing", "write_packing_csv", "MIN_SPHERES", "default_packing_path"]
 
 log = logging.getLogger(__name__)
+
+def default_packing_path() -> Path:
+    """The bundled soybean-like scene, ``network/data/soybean_default.csv`` (see its README)."""
+    return Path(__file__).resolve().parent / "data" / "soybean_default.csv"
+
 
 #: Fewest spheres that make a three-dimensional Delaunay tessellation with an interior.
 MIN_SPHERES = 5
