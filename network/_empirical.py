@@ -48,7 +48,7 @@ def ergun_gradient(velocity_m_s, *, porosity, diameter_m, viscosity_pa_s=MU_AIR_
                    density_kg_m3=RHO_AIR_KG_M3):
     """Ergun pressure gradient, Pa/m (see module docstring).
 
-    >>> round(0.25 * ergun_gradient(0.013, porosity=0.408, diameter_m=6.5e-3), 2)
+    >>> round(float(0.25 * ergun_gradient(0.013, porosity=0.408, diameter_m=6.5e-3)), 2)
     1.27
     """
     _check(porosity, diameter_m, velocity_m_s)
@@ -67,7 +67,7 @@ def kozeny_carman_gradient(velocity_m_s, *, porosity, diameter_m, viscosity_pa_s
 def asabe_d272_gradient(velocity_m_s, *, a=ASABE_SOYBEAN_A, b=ASABE_SOYBEAN_B):
     """ASABE D272 (Hukill–Ives) pressure gradient, Pa/m; defaults are soybeans.
 
-    >>> round(0.25 * asabe_d272_gradient(0.013), 2)
+    >>> round(float(0.25 * asabe_d272_gradient(0.013)), 2)
     2.28
     """
     if not velocity_m_s > 0:
