@@ -1,0 +1,188 @@
+"""Airflow paths, tortuosity, widths and the branched-path model of a packing (thesis 3.4, 3.5.1).
+
+Usage::
+
+    python -m network.paths PACKING [--entry X Y | --entries N] [--kind widest|narrowest|
+        maximin|shortest|all] [--axis z] [--method build|delaunay] [--seed S]
+        [--velocity U ...] [--json OUT.json] [--plot OUT.png]
+
+``widest``/``narrowest`` are the thesis's step-increment paths (``--method build``: tetrahedra
+built sphere by sphere as in Appendices D-E; ``--method delaunay``: the same rule walked on the
+Delaunay tessellation); ``maximin`` is the optimal widest (maximin-bottleneck) path and
+``shortest`` the shortest path on the tessellation. Entry points are (X, Y) in metres in the
+plane normal to ``--axis`` (the other two axes in x, y, z order); ``--entries N`` draws N at
+random (``--seed``) away from the walls. The branched-path model (Table 4.4 layout) is evaluated
+on every widest/narrowest path at each ``--velocity``.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import os
+import platform
+import sys
+import time
+
+import numpy as np
+
+from ._paths import (
+    _relaxed_packing,
+    bed_depth,
+    branched_table,
+    face_graph,
+    random_entry_points,
+    trace_paths,
+)
+
+_ALL = ("widest", "narrowest", "maximin", "shortest")
+#: Thesis values (Tables 4.1-4.5) printed beside ours.
+THESIS = {
+    "tortuosity": {"widest": 1.39, "narrowest": 1.40},
+    "mean_width_mm": {"widest": (2.73, 2.91), "narrowest": (1.85, 2.00)},
+    "tetrahedra": {"widest": (152, 162), "narrowest": (142, 154)},
+    "branched_mfx3_average_pa": {"0.013": 2.74, "0.027": 5.65},
+    "measured_pa": {"0.013": 2.44, "0.027": 6.80},
+}
+
+
+def _parser():
+    p = argparse.ArgumentParser(prog="python -m network.paths", description=__doc__.split("\n")[0])
+    p.add_argument("packing", nargs="?", help="CSV x,y,z,r (m), .npz or LAMMPS dump")
+    g = p.add_mutually_exclusive_group()
+    g.add_argument("--entry", nargs=2, type=float, action="append", metavar=("X", "Y"),
+                   help="entry point (m); repeat for several")
+    g.add_argument("--entries", type=int, default=None, metavar="N",
+                   help="N random entry points (default 3)")
+    p.add_argument("--kind", default="all", choices=_ALL + ("all",))
+    p.add_argument("--axis", default="z", choices=("x", "y", "z"))
+    p.add_argument("--method", default="build", choices=("build", "delaunay"),
+                   help="how widest/narrowest paths are made (default build, as the thesis)")
+    p.add_argument("--seed", type=int, default=0)
+    p.add_argument("--velocity", type=float, nargs="+", default=[0.013, 0.027],
+                   help="superficial velocities for the branched model (m/s)")
+    p.add_argument("--branches", default="all", choices=("all", "path"),
+                   help="daughter losses summed: all three (Appendix F) or the path's (Eq. 3.28)")
+    p.add_argument("--no-branched", action="store_true", help="skip the branched model")
+    p.add_argument("--json", metavar="OUT.json")
+    p.add_argument("--plot", metavar="OUT.png")
+    p.add_argument("--standin", nargs=3, type=float, metavar=("LX", "LY", "LZ"),
+                   help="instead of PACKING, a geometric stand-in packing in this box (m): "
+                        "diameters 5.5-7.5 mm, porosity 0.408, by overlap relaxation (--seed)")
+    return p
+
+
+def main(argv=None) -> int:
+    args = _parser().parse_args(argv)
+    t0 = time.perf_counter()
+    if args.standin:
+        x, r = _relaxed_packing(args.standin, rng=args.seed)
+        source = f"stand-in {args.standin} seed {args.seed}"
+    elif args.packing:
+        from ._io import read_packing
+
+        pk = read_packing(args.packing)
+        x, r = np.asarray(pk.centers), np.asarray(pk.radii)
+        source = str(args.packing)
+    else:
+        print("error: give PACKING or --standin LX LY LZ", file=sys.stderr)
+        return 2
+    t_read = time.perf_counter() - t0
+    if args.entry:
+        xy = np.array(args.entry, dtype=float)
+    else:
+        xy = random_entry_points(x, r, args.entries or 3, axis=args.axis, rng=args.seed)
+    kinds = _ALL if args.kind == "all" else (args.kind,)
+    need_graph = any(k in ("maximin", "shortest") for k in kinds) or args.method == "delaunay"
+    graph = None
+    t1 = time.perf_counter()
+    if need_graph:
+        from ._io import Packing
+        from ._tessellation import tessellate
+
+        graph = face_graph(tessellate(Packing(x, r, source)))
+    t_graph = time.perf_counter() - t1
+    paths, t_kind = [], {}
+    for kind in kinds:
+        tk = time.perf_counter()
+        paths += trace_paths(x, r, xy, kind=kind, method=args.method, graph=graph,
+                             axis=args.axis)
+        t_kind[kind] = time.perf_counter() - tk
+    depth = bed_depth(x, r, args.axis)
+
+    print(f"{source}: {len(r)} spheres, depth {depth:.4f} m along {args.axis}, "
+          f"{len(xy)} entries; read {t_read:.2f} s, tessellation+open areas {t_graph:.2f} s, "
+          + ", ".join(f"{k} {v:.2f} s" for k, v in t_kind.items()))
+    print(f"{'kind':10s} {'entry (m)':>18s} {'status':>9s} {'tetra':>6s} {'L (m)':>7s} "
+          f"{'T raw':>6s} {'T':>6s} {'T span':>6s} {'W (mm)':>7s} {'<30deg':>7s}")
+    for p in paths:
+        s = p.summary()
+        print(f"{p.kind:10s} ({p.entry_xy[0]:7.4f},{p.entry_xy[1]:7.4f}) {p.status:>9s} "
+              f"{p.n_tetrahedra:6d} {p.length_m:7.3f} {p.tortuosity_raw:6.3f} {p.tortuosity:6.3f} "
+              f"{p.tortuosity_span:6.3f} "
+              f"{p.mean_width_m * 1e3:7.2f} {s['turning_below_30deg']:7.2f}")
+    for kind in kinds:
+        ok = [p for p in paths if p.kind == kind and p.status == "ok"]
+        if not ok:
+            continue
+        ref = THESIS["tortuosity"].get(kind)
+        refw = THESIS["mean_width_mm"].get(kind)
+        print(f"mean {kind}: tetrahedra {np.mean([p.n_tetrahedra for p in ok]):.0f}, "
+              f"tortuosity {np.mean([p.tortuosity for p in ok]):.3f}"
+              + (f" (thesis {ref})" if ref else "")
+              + f", width {np.mean([p.mean_width_m for p in ok]) * 1e3:.2f} mm"
+              + (f" (thesis {refw[0]}-{refw[1]})" if refw else "")
+              + f", turns < 30 deg {np.mean(np.concatenate([p.turning_angles_deg for p in ok]) < 30):.2f}"
+              + (" (thesis > 0.5)" if ref else ""))
+
+    branched = []
+    if not args.no_branched:
+        t2 = time.perf_counter()
+        for i, p in enumerate(paths):
+            if p.kind in ("widest", "narrowest") and p.status == "ok":
+                tab = branched_table(x, r, p, velocities_m_s=args.velocity,
+                                     branches=args.branches)
+                branched.append({"path": i, "kind": p.kind, "entry_xy_m": p.entry_xy.tolist(),
+                                 **tab})
+        if branched:
+            print(f"branched model (Pa; branches={args.branches}, Q0 = U x mean face area; "
+                  f"{time.perf_counter() - t2:.2f} s)")
+            us = [f"{u:g}" for u in args.velocity]
+            print(f"{'kind':10s} {'LFPW':8s} " + " ".join(f"MFx3@{u:<7s}" for u in us) + " "
+                  + " ".join(f"MFx2@{u:<7s}" for u in us))
+            for b in branched:
+                for w in ("max", "min", "average"):
+                    print(f"{b['kind']:10s} {w:8s} "
+                          + " ".join(f"{b[w]['MFx3'][u]:12.3g}" for u in us) + " "
+                          + " ".join(f"{b[w]['MFx2'][u]:12.3g}" for u in us))
+            for u in us:
+                avg = np.mean([b["average"]["MFx3"][u] for b in branched])
+                ref = THESIS["branched_mfx3_average_pa"].get(u)
+                meas = THESIS["measured_pa"].get(u)
+                print(f"mean MFx3 average-width at {u} m/s: {avg:.3g} Pa"
+                      + (f" (thesis {ref} Pa, measured {meas} Pa)" if ref else ""))
+
+    if args.json:
+        out = {
+            "source": source, "n_spheres": int(len(r)), "axis": args.axis, "depth_m": depth,
+            "method": args.method, "entries_xy_m": xy.tolist(),
+            "seconds": {"read": t_read, "tessellation": t_graph, **t_kind},
+            "paths": [{**p.summary(), "points_m": p.points.tolist(),
+                       "widths_m": p.widths_m.tolist(),
+                       "turning_angles_deg": p.turning_angles_deg.tolist()} for p in paths],
+            "branched": branched, "thesis": THESIS,
+            "platform": platform.platform(), "cpu_count": os.cpu_count(),
+            "loadavg": os.getloadavg(), "timestamp": time.strftime("%Y-%m-%dT%H:%M:%SZ",
+                                                                   time.gmtime()),
+        }
+        with open(args.json, "w") as f:
+            json.dump(out, f, indent=1)
+    if args.plot:
+        from ._plots import plot_paths
+
+        plot_paths(x, paths, args.plot, axis=args.axis, title=source)
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
