@@ -166,3 +166,12 @@ def test_tiny_gap_is_solved_continuously():
     step = np.diff(sol.qstar)
     assert step[0] == pytest.approx(step[1], rel=2e-2)
     assert abs(step[0]) / sol.qstar[1] < 3e-4
+
+
+def test_workers_give_the_same_answers():
+    r = np.array([[1, 1, 1], [0.9, 1.1, 1.0], [1.0, 0.8, 1.2], [1, 1, 1]] * 2, dtype=float)
+    s = np.array([[2.2, 2.2, 2.2], [2.3, 2.0, 2.5], [1.7, 2.4, 2.1], [2, 2, 2]] * 2)
+    one = solve_fem(r, s)
+    two = solve_fem(r, s, workers=2, chunk_size=3)
+    np.testing.assert_array_equal(one.qstar, two.qstar)
+    assert two.status.tolist() == ["ok"] * 8

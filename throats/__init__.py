@@ -19,6 +19,9 @@ validate_throats
     Row checks: ``(ok_mask, messages)``.
 triangle_vertices
     Planar vertex coordinates of the triangles.
+shape_factor_qstar
+    Fast Q* estimate in the Patzek & Silin (2001) form c_t A² G, fitted per contact type
+    (median error 21 %, 95th percentile 54 % against FE; over 1e6 throats/s).
 solve_fem
     Q* by finite elements (gmsh + scikit-fem), batch, ``rtol``-driven, with an error
     estimate; returns a ``ThroatSolution``.
@@ -28,7 +31,8 @@ SOLVER_VERSION
 
 from ._geometry import (canonical_form, contact_type, open_area, triangle_vertices,
                         validate_throats)
+from ._shape_factor import shape_factor_qstar
 from ._solve import SOLVER_VERSION, ThroatSolution, solve_fem
 
 __all__ = ["SOLVER_VERSION", "ThroatSolution", "canonical_form", "contact_type", "open_area",
-           "solve_fem", "triangle_vertices", "validate_throats"]
+           "shape_factor_qstar", "solve_fem", "triangle_vertices", "validate_throats"]
