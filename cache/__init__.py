@@ -14,6 +14,8 @@ lookup_qstar(radii, sides, *, db=None, policy='table+fe', rtol=1e-3, workers=1, 
     Policies: ``'table-only'``, ``'table+fe'``, ``'fe-only'``, ``'shape-factor'``.
 precompute_throats(store, radii, sides, *, rtol, workers, retry_failed, ...)
     Solve and store what a table lacks, one transaction per batch.
+precompute_grid(store, spec, *, rtol, ...)
+    Register an interpolation grid (``GRIDS[name]``) and solve its nodes.
 open_store(path) / ThroatStore
     The SQLite file (WAL, format-checked; :class:`CacheFileError` on corrupt/foreign files).
 default_db_path()
@@ -26,7 +28,7 @@ Command lines: ``python -m cache.precompute``, ``python -m cache.lookup``, ``pyt
 meshes or solves itself: it calls ``throats``.
 """
 
-from ._build import PrecomputeSummary, precompute_throats
+from ._build import PrecomputeSummary, precompute_grid, precompute_throats
 from ._interp import GRIDS, GridSpec, GridTable, grid_coordinates
 from ._lookup import (POLICIES, Lookup, default_db_path, export_grid, load_grid_table,
                       lookup_qstar, shipped_grid_path)
@@ -34,6 +36,6 @@ from ._signature import QUANTUM, shape_keys, signature
 from ._store import CacheFileError, ThroatStore, open_store
 
 __all__ = ["signature", "shape_keys", "QUANTUM", "lookup_qstar", "Lookup", "POLICIES",
-           "default_db_path", "precompute_throats", "PrecomputeSummary", "open_store",
+           "default_db_path", "precompute_throats", "precompute_grid", "PrecomputeSummary", "open_store",
            "ThroatStore", "CacheFileError", "GridSpec", "GridTable", "GRIDS",
            "grid_coordinates", "load_grid_table", "export_grid", "shipped_grid_path"]

@@ -26,7 +26,7 @@ from ._signature import _throats_attr, as_throats, match_keys, shape_keys, signa
 
 logger = logging.getLogger(__name__)
 
-__all__ = ["precompute_throats", "PrecomputeSummary", "default_solver"]
+__all__ = ["precompute_throats", "precompute_grid", "PrecomputeSummary", "default_solver"]
 
 
 @dataclass
@@ -81,7 +81,12 @@ def _solve_chunk(solver, radii, sides, rtol):
             if v.shape != (n,):
                 raise ValueError(f"solver returned {k} of shape {v.shape}, expected ({n},)")
     except Exception as e:  # noqa: BLE001 - recorded per row, never dropped
-        logger.warning("solver raised on a chunk of %d throats: %s: %s", n, type(e).__name__, e)
+        if n > 1:  # isolate the row(s) that make the solver raise: solve one by one
+            logger.warning("solver raised on a chunk of %d throats (%s: %s); retrying row by row",
+                           n, type(e).__name__, e)
+            parts = [_solve_chunk(solver, radii[i:i + 1], sides[i:i + 1], rtol) for i in range(n)]
+            return {k: np.concatenate([p[k] for p in parts]) for k in parts[0]}
+        logger.warning("solver raised on a throat: %s: %s", type(e).__name__, e)
         dt = (time.perf_counter() - t0) / max(n, 1)
         out = {"qstar": np.full(n, np.nan), "open_area": np.full(n, np.nan),
                "contact_type": np.full(n, "", dtype=object),
@@ -233,3 +238,17 @@ def precompute_throats(store, radii, sides, *, rtol=1e-3, solver=None, solver_ve
     summary.seconds = time.perf_counter() - t0
     summary.extra["remaining"] = int(len(todo) - processed[0])
     return summary
+
+
+def precompute_grid(store, spec, *, rtol=1e-3, solver=None, solver_version=None, **kwargs):
+    """Register grid ``spec`` (a :class:`cache.GridSpec`) in ``store`` and solve its nodes.
+
+    Keyword arguments go to :func:`precompute_throats`; returns its summary.
+    """
+    solver, solver_version = _resolve_solver(solver, solver_version)
+    d = spec.to_dict()
+    d.update(rtol=float(rtol), solver_version=str(solver_version))
+    store.put_grid(spec.name, d)
+    r, s = spec.node_shapes()
+    return precompute_throats(store, r, s, rtol=rtol, solver=solver, solver_version=solver_version,
+                              **kwargs)

@@ -23,7 +23,7 @@ import sys
 
 import numpy as np
 
-from ._build import _resolve_solver, precompute_throats
+from ._build import _resolve_solver, precompute_grid, precompute_throats
 from ._csvio import read_throat_csv
 from ._interp import GRIDS
 from ._lookup import export_grid
@@ -66,17 +66,14 @@ def main(argv=None) -> int:
             except (OSError, ValueError) as e:
                 print(f"error: {e}", file=sys.stderr)
                 return 2
+        kw = dict(rtol=args.rtol, solver=solver, solver_version=version, workers=args.workers,
+                  batch_size=args.batch_size, retry_failed=args.retry_failed,
+                  progress=not args.quiet,
+                  max_seconds=None if args.max_hours is None else 3600 * args.max_hours)
+        if args.csv:
+            summary = precompute_throats(store, radii, sides, **kw)
         else:
-            spec = GRIDS[args.grid]
-            radii, sides = spec.node_shapes()
-            d = spec.to_dict()
-            d.update(rtol=args.rtol, solver_version=version)
-            store.put_grid(spec.name, d)
-        summary = precompute_throats(
-            store, radii, sides, rtol=args.rtol, solver=solver, solver_version=version,
-            workers=args.workers, batch_size=args.batch_size, retry_failed=args.retry_failed,
-            progress=not args.quiet,
-            max_seconds=None if args.max_hours is None else 3600 * args.max_hours)
+            summary = precompute_grid(store, GRIDS[args.grid], **kw)
         out = summary.as_dict()
         out.update(db=str(args.db), solver_version=version, rtol=args.rtol, rows=store.count())
         if args.grid and args.export:
