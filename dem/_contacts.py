@@ -1,0 +1,143 @@
+r"""Linear spring–dashpot contact law with Coulomb friction (PFC3D linear model).
+
+The contact law is a pure function of the contact kinematics: it knows nothing of
+neighbour lists, containers or the integrator (STYLE.md item 11).
+
+Conventions (one row per contact): ``normal`` is the unit vector from particle *i*
+towards its partner *j* (or towards the wall), ``overlap`` δ = r_i + r_j − |x_j − x_i| > 0,
+``v_rel`` is the velocity of the contact point on *i* relative to the one on *j*. The
+returned force acts on *i*; *j* receives its negative.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+__all__ = [
+    "series_stiffness",
+    "damping_coefficient",
+    "restitution_coefficient",
+    "linear_contact_forces",
+]
+
+
+def series_stiffness(k_a, k_b):
+    r"""Contact stiffness of two springs in series, N/m (PFC3D linear contact model).
+
+    .. math:: k = \frac{k_a k_b}{k_a + k_b}
+
+    Two soybeans with k_pn = 4.0e6 N/m touch with k = 2.0e6 N/m; a soybean on a
+    Plexiglas wall (1.8e7 N/m) with 3.27e6 N/m.
+
+    >>> float(series_stiffness(4.0e6, 4.0e6))
+    2000000.0
+    """
+    k_a = np.asarray(k_a, dtype=float)
+    k_b = np.asarray(k_b, dtype=float)
+    return k_a * k_b / (k_a + k_b)
+
+
+def damping_coefficient(beta, mass_eff_kg, stiffness_n_m):
+    r"""Viscous dashpot coefficient for a critical-damping ratio β, N·s/m.
+
+    .. math:: c = 2 \beta \sqrt{m^* k}
+
+    PFC3D "viscous damping" (the thesis sets β = 0.1 in the normal and shear directions,
+    Appendix A); m* is the effective mass m_i m_j / (m_i + m_j) (m_i for a wall).
+    """
+    return 2.0 * np.asarray(beta, dtype=float) * np.sqrt(
+        np.asarray(mass_eff_kg, dtype=float) * np.asarray(stiffness_n_m, dtype=float)
+    )
+
+
+def restitution_coefficient(beta):
+    r"""Normal coefficient of restitution of a linear spring–dashpot contact.
+
+    .. math:: e = \exp\!\left(-\frac{\pi \beta}{\sqrt{1 - \beta^2}}\right)
+
+    (damped harmonic oscillator, contact ends when the spring force returns to zero;
+    exact for the tension-free dashpot only in the limit of small β).
+    For β = 0.1, e = 0.7292.
+
+    >>> round(float(restitution_coefficient(0.1)), 4)
+    0.7292
+    """
+    beta = np.asarray(beta, dtype=float)
+    if np.any((beta < 0) | (beta >= 1)):
+        raise ValueError(f"damping ratio must be in [0, 1), got {beta}")
+    return np.exp(-np.pi * beta / np.sqrt(1.0 - beta**2))
+
+
+def _dot(a, b):
+    return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
+
+
+def linear_contact_forces(overlap, normal, v_rel, shear_disp, *, kn, ks, cn, ct, mu, dt):
+    r"""Forces of Nc linear spring–dashpot contacts with a Coulomb-limited shear spring.
+
+    .. math::
+
+        F_n &= \max(0,\; k_n \delta + c_n v_n), \qquad v_n = \mathbf v_{rel}\cdot\mathbf n \\
+        \boldsymbol\xi &\leftarrow \boldsymbol\xi - (\boldsymbol\xi\cdot\mathbf n)\mathbf n
+                          + \mathbf v_t\,\Delta t, \qquad
+        \mathbf F_t = -k_s \boldsymbol\xi - c_t \mathbf v_t, \quad
+        |\mathbf F_t| \le \mu F_n
+
+    When the Coulomb limit is exceeded the shear force is scaled back onto the cone
+    and the spring is reset to the sliding value
+    :math:`\boldsymbol\xi = -(\mathbf F_t + c_t\mathbf v_t)/k_s` (as in LAMMPS
+    ``granular hooke/history``). The normal dashpot cannot pull (PFC "notens").
+
+    Vectors are passed component-first, shape (3, Nc) (each component contiguous, which
+    is what makes the numpy arithmetic fast); transpose (Nc, 3) data with ``.T``.
+
+    Parameters
+    ----------
+    overlap : (Nc,) array, m
+        δ > 0 for touching pairs.
+    normal : (3, Nc) array
+        Unit vector from *i* to its partner.
+    v_rel : (3, Nc) array, m/s
+        Velocity of *i*'s contact point relative to the partner's.
+    shear_disp : (3, Nc) array, m
+        Accumulated tangential spring displacement ξ (contact history).
+    kn, ks : float, N/m
+        Contact normal and shear stiffness.
+    cn, ct : float or (Nc,) array, N·s/m
+        Normal and shear dashpot coefficients.
+    mu : float
+        Coulomb friction coefficient.
+    dt : float, s
+        Time step.
+
+    Returns
+    -------
+    force : (3, Nc) array, N
+        Total contact force on *i* (normal + tangential).
+    fn : (Nc,) array, N
+        Normal force magnitude (≥ 0).
+    ft : (3, Nc) array, N
+        Tangential force on *i*.
+    shear_disp : (3, Nc) array, m
+        Updated spring displacement (a new array).
+    """
+    vn = _dot(v_rel, normal)
+    fn = kn * overlap
+    fn += cn * vn
+    np.maximum(fn, 0.0, out=fn)
+    vt = v_rel - vn * normal
+    xi = shear_disp - _dot(shear_disp, normal) * normal
+    xi += vt * dt
+    ft = xi * (-ks)
+    ft -= ct * vt
+    ft_mag = np.sqrt(_dot(ft, ft))
+    limit = mu * fn
+    slide = np.flatnonzero(ft_mag > limit)
+    if len(slide):
+        scale = limit[slide] / ft_mag[slide]
+        fts = ft[:, slide] * scale
+        ft[:, slide] = fts
+        ct_s = ct[slide] if np.ndim(ct) else ct
+        xi[:, slide] = (fts + ct_s * vt[:, slide]) * (-1.0 / ks)
+    force = ft - fn * normal
+    return force, fn, ft, xi

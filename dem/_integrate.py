@@ -1,0 +1,442 @@
+r"""Soft-sphere DEM state and time integration (the four-step loop of STYLE.md item 11).
+
+Each step: (1) candidate pairs from the Verlet list (rebuilt when a particle moved more
+than skin/2); (2) the linear contact law of :mod:`dem._contacts` for particle–particle and
+particle–wall contacts; (3) forces and torques accumulated with :func:`numpy.bincount`;
+(4) semi-implicit (symplectic) Euler update of velocities, spins and positions:
+
+.. math::
+
+    \mathbf v^{n+1/2} = \mathbf v^{n-1/2} + \frac{\mathbf F^n}{m}\Delta t, \quad
+    \mathbf x^{n+1} = \mathbf x^n + \mathbf v^{n+1/2}\Delta t, \quad
+    \boldsymbol\omega^{n+1/2} = \boldsymbol\omega^{n-1/2} + \frac{\mathbf T^n}{I}\Delta t,
+    \quad I = \tfrac25 m r^2 .
+
+Time step: :math:`\Delta t = s\,\sqrt{m_{min}/k_{n}}` with the particle normal stiffness
+k_n (≥ the contact stiffness) and a safety factor s (default 0.25).
+
+Quasi-static acceleration (density scaling): ``mass_scale`` S multiplies every mass and
+moment of inertia while gravity stays g. Motion under gravity is unchanged, but contact
+oscillations are √S slower, so Δt grows by √S; it is equivalent to dividing all
+stiffnesses by S (overlaps under load grow S-fold). Used only where the path to a
+static state does not matter (radius expansion, settling); its effect is measured in
+``dem.bench``.
+"""
+
+from __future__ import annotations
+
+import logging
+import time
+from dataclasses import dataclass
+
+import numpy as np
+
+from ._contacts import damping_coefficient, linear_contact_forces, series_stiffness
+from ._neighbors import VerletList, remap_history
+from ._walls import wall_contacts
+
+__all__ = ["Material", "Simulation", "DemInstabilityError", "SOYBEAN"]
+
+log = logging.getLogger(__name__)
+
+
+class DemInstabilityError(RuntimeError):
+    """The simulation blew up (energy growth, NaN, particles through walls)."""
+
+
+@dataclass(frozen=True)
+class Material:
+    """Grain and wall properties (defaults: soybean in Plexiglas, thesis Table 3.1).
+
+    Stiffnesses are per-entity values as in PFC3D; a contact uses the series
+    combination (:func:`dem._contacts.series_stiffness`).
+    """
+
+    density_kg_m3: float = 1285.0
+    kn_n_m: float = 4.0e6
+    ks_n_m: float = 2.0e6
+    friction: float = 0.47
+    wall_kn_n_m: float = 1.8e7
+    wall_ks_n_m: float = 0.9e7
+    wall_friction: float = 0.3
+    damping_ratio: float = 0.1
+    radius_min_m: float = 0.00275
+    radius_max_m: float = 0.00375
+
+    def __post_init__(self):
+        for name in ("density_kg_m3", "kn_n_m", "ks_n_m", "wall_kn_n_m", "wall_ks_n_m"):
+            v = getattr(self, name)
+            if not (np.isfinite(v) and v > 0):
+                raise ValueError(f"{name} must be positive and finite, got {v}")
+        for name in ("friction", "wall_friction"):
+            v = getattr(self, name)
+            if not (np.isfinite(v) and v >= 0):
+                raise ValueError(f"{name} must be >= 0, got {v}")
+        if not 0 <= self.damping_ratio < 1:
+            raise ValueError(f"damping_ratio must be in [0, 1), got {self.damping_ratio}")
+        if not 0 < self.radius_min_m <= self.radius_max_m:
+            raise ValueError(
+                f"need 0 < radius_min_m <= radius_max_m, got {self.radius_min_m}, {self.radius_max_m}"
+            )
+
+    @property
+    def kn_pp(self):
+        """Particle–particle contact normal stiffness, N/m."""
+        return float(series_stiffness(self.kn_n_m, self.kn_n_m))
+
+    @property
+    def ks_pp(self):
+        return float(series_stiffness(self.ks_n_m, self.ks_n_m))
+
+    @property
+    def kn_pw(self):
+        """Particle–wall contact normal stiffness, N/m."""
+        return float(series_stiffness(self.kn_n_m, self.wall_kn_n_m))
+
+    @property
+    def ks_pw(self):
+        return float(series_stiffness(self.ks_n_m, self.wall_ks_n_m))
+
+
+SOYBEAN = Material()
+
+
+def _cross(a, b):
+    """Cross product of two component-first (3, Nc) arrays."""
+    return np.stack([
+        a[1] * b[2] - a[2] * b[1],
+        a[2] * b[0] - a[0] * b[2],
+        a[0] * b[1] - a[1] * b[0],
+    ])
+
+
+def _dot(a, b):
+    return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
+
+
+class Simulation:
+    """State of N spheres in a set of walls, advanced by :meth:`step` / :meth:`run`.
+
+    Internally vectors are stored component-first, (3, N); the attributes ``centers``,
+    ``velocities`` and ``spins`` are (N, 3) views of them (writable).
+
+    Parameters
+    ----------
+    centers : (N, 3) array, m
+    radii : (N,) array, m
+    walls : list of PlaneWall | CylinderWall
+    material : Material
+    gravity_m_s2 : float
+        Magnitude of gravity along −z (9.81; 0 disables).
+    mass_scale : float
+        Density scaling factor S ≥ 1 (see module notes).
+    dt_safety : float
+        Safety factor s of the time step.
+    skin_m : float | None
+        Verlet skin; default 0.1 · r_max.
+    bounds_m : (2, 3) array | None
+        Box that every centre must stay in; leaving it raises DemInstabilityError.
+    """
+
+    def __init__(self, centers, radii, walls, material=SOYBEAN, *, gravity_m_s2=9.81, mass_scale=1.0,
+                 dt_safety=0.25, skin_m=None, bounds_m=None):
+        centers = np.array(centers, dtype=float)
+        radii = np.array(radii, dtype=float)
+        n = len(radii)
+        if radii.ndim != 1 or centers.shape != (n, 3):
+            raise ValueError(f"centers must be (N, 3) with N = len(radii) = {n}, got {centers.shape}")
+        if not np.all(np.isfinite(centers)) or not np.all(radii > 0):
+            raise ValueError("centers must be finite and radii positive")
+        if not isinstance(material, Material):
+            raise TypeError(f"material must be a Material, got {type(material).__name__}")
+        if not mass_scale >= 1.0:
+            raise ValueError(f"mass_scale must be >= 1, got {mass_scale}")
+        if not 0 < dt_safety <= 1:
+            raise ValueError(f"dt_safety must be in (0, 1], got {dt_safety}")
+        self.walls = list(walls)
+        self.material = material
+        self.gravity_m_s2 = float(gravity_m_s2)
+        self.mass_scale = float(mass_scale)
+        self.dt_safety = float(dt_safety)
+        self.bounds_m = None if bounds_m is None else np.array(bounds_m, dtype=float)
+        self.time_s = 0.0
+        self.steps = 0
+        self.z_offset_m = 0.0
+        self.wall_vz_m_s = 0.0
+        self.stats = {"rebuilds": 0}
+        self._x = np.ascontiguousarray(centers.T)
+        self._v = np.zeros((3, n))
+        self._w = np.zeros((3, n))
+        skin = skin_m if skin_m is not None else 0.1 * float(radii.max())
+        self.verlet = VerletList(skin)
+        self.shear = np.zeros((3, 0))
+        self._pi = self._pj = np.empty(0, dtype=np.int64)
+        self.wall_shear = np.zeros((len(self.walls), 3, n))
+        self._wall_prev = None
+        self._set_radii(radii)
+        self._contact_index = np.empty(0, dtype=np.int64)
+        self.contact_fn = np.empty(0)
+        self.last_wall_fn = np.empty(0)
+
+    # ------------------------------------------------------------------ state
+    centers = property(lambda self: self._x.T, lambda self, v: self._x.__setitem__(slice(None), np.asarray(v).T))
+    velocities = property(lambda self: self._v.T, lambda self, v: self._v.__setitem__(slice(None), np.asarray(v).T))
+    spins = property(lambda self: self._w.T, lambda self, v: self._w.__setitem__(slice(None), np.asarray(v).T))
+
+    def _set_radii(self, radii):
+        self.radii = np.asarray(radii, dtype=float)
+        m = self.material
+        self.mass = m.density_kg_m3 * 4.0 / 3.0 * np.pi * self.radii**3
+        self.inertia = 0.4 * self.mass * self.radii**2
+        self._coef_valid = False
+        self._dt = self.dt_safety * float(
+            np.sqrt(self.mass_scale * self.mass.min() / max(self.material.kn_n_m, self.material.ks_n_m))
+        )
+
+    def set_radii(self, radii):
+        """Change radii (radius expansion); masses follow at fixed density."""
+        self._set_radii(radii)
+
+    def set_walls(self, walls):
+        """Replace the walls (e.g. remove the lid); wall contact history is dropped."""
+        self.walls = list(walls)
+        self.wall_shear = np.zeros((len(self.walls), 3, self.n))
+        self._wall_prev = None
+
+    def set_material(self, material):
+        """Replace the material (e.g. restore friction after packing)."""
+        self.material = material
+        self._set_radii(self.radii)
+
+    @property
+    def dt(self):
+        """Time step, s: s·sqrt(S m_min / max(k_n, k_s))."""
+        return self._dt
+
+    @property
+    def n(self):
+        return len(self.radii)
+
+    def kinetic_energy(self):
+        """Translational + rotational kinetic energy with physical (unscaled) masses, J."""
+        return float(0.5 * np.sum(self.mass * _dot(self._v, self._v)) + 0.5 * np.sum(self.inertia * _dot(self._w, self._w)))
+
+    # ------------------------------------------------------------------ forces
+    def _rebuild(self):
+        old_keys = self.verlet.build(self.centers, self.radii)
+        self.shear = remap_history(old_keys, self.shear.T, self.verlet.keys).T.copy()
+        p = self.verlet.pairs
+        self._pi, self._pj = p[:, 0].copy(), p[:, 1].copy()
+        self._coef_valid = False
+        self.stats["rebuilds"] += 1
+
+    def _pair_coefficients(self):
+        mat = self.material
+        ms = self.mass * self.mass_scale
+        mi, mj = ms[self._pi], ms[self._pj]
+        meff = mi * mj / (mi + mj)
+        self._cn = damping_coefficient(mat.damping_ratio, meff, mat.kn_pp)
+        self._ct = damping_coefficient(mat.damping_ratio, meff, mat.ks_pp)
+        self._rsum = self.radii[self._pi] + self.radii[self._pj]
+        self._coef_valid = True
+
+    def forces(self):
+        """Net force and torque on every particle, both (3, N) component-first (scaled masses)."""
+        if self.verlet.needs_rebuild(self.centers, self.radii):
+            self._rebuild()
+        if not self._coef_valid:
+            self._pair_coefficients()
+        mat = self.material
+        n = self.n
+        X, V, W, r = self._x, self._v, self._w, self.radii
+        dt = self._dt
+        pi, pj = self._pi, self._pj
+
+        # 1. candidate pairs -> touching pairs
+        d = X.take(pj, axis=1)
+        d -= X.take(pi, axis=1)
+        dist2 = _dot(d, d)
+        rsum = self._rsum
+        c = np.flatnonzero(dist2 < rsum * rsum)
+        ci, cj = pi[c], pj[c]
+        dist = np.sqrt(dist2[c])
+        nrm = d[:, c] / dist
+        RW = W * r
+        v_rel = V.take(ci, axis=1)
+        v_rel -= V.take(cj, axis=1)
+        v_rel += _cross(RW.take(ci, axis=1) + RW.take(cj, axis=1), nrm)
+        # 2. contact law
+        f, fn, ft, xi = linear_contact_forces(
+            rsum[c] - dist, nrm, v_rel, self.shear[:, c],
+            kn=mat.kn_pp, ks=mat.ks_pp, cn=self._cn[c], ct=self._ct[c], mu=mat.friction, dt=dt,
+        )
+        shear = np.zeros_like(self.shear)
+        shear[:, c] = xi
+        self.shear = shear
+        self._contact_index = c
+        self.contact_fn = fn
+        # 3. accumulate: +f on i, -f on j; torque r_i n x ft on i, r_j n x ft on j
+        nxft = _cross(nrm, ft)
+        idx = np.concatenate([ci, cj])
+        rr = r[idx]
+        force = np.empty((3, n))
+        torque = np.empty((3, n))
+        for k in range(3):
+            force[k] = np.bincount(idx, np.concatenate([f[k], -f[k]]), minlength=n)
+            torque[k] = np.bincount(idx, np.concatenate([nxft[k], nxft[k]]) * rr, minlength=n)
+
+        # walls (same contact law)
+        if self.walls:
+            widx, p, ov, wn, moves = wall_contacts(self.walls, X, r, self.z_offset_m)
+            self._clear_wall_history()
+            if len(p):
+                wall_v = np.zeros((3, len(p)))
+                wall_v[2, moves] = self.wall_vz_m_s
+                v_rel_w = V[:, p] - wall_v + _cross(RW[:, p], wn)
+                ms = self.mass[p] * self.mass_scale
+                fw, fnw, ftw, xiw = linear_contact_forces(
+                    ov, wn, v_rel_w, self.wall_shear[widx, :, p].T,
+                    kn=mat.kn_pw, ks=mat.ks_pw,
+                    cn=damping_coefficient(mat.damping_ratio, ms, mat.kn_pw),
+                    ct=damping_coefficient(mat.damping_ratio, ms, mat.ks_pw),
+                    mu=mat.wall_friction, dt=dt,
+                )
+                self.wall_shear[widx, :, p] = xiw.T
+                self._wall_prev = (widx, p)
+                rnxf = _cross(wn, ftw) * r[p]
+                for k in range(3):
+                    force[k] += np.bincount(p, fw[k], minlength=n)
+                    torque[k] += np.bincount(p, rnxf[k], minlength=n)
+                self.last_wall_fn = fnw
+            else:
+                self.last_wall_fn = np.empty(0)
+        if self.gravity_m_s2:
+            force[2] -= self.mass * (self.mass_scale * self.gravity_m_s2)
+        return force, torque
+
+    def _clear_wall_history(self):
+        prev = self._wall_prev
+        if prev is not None:
+            self.wall_shear[prev[0], :, prev[1]] = 0.0
+            self._wall_prev = None
+
+    @property
+    def touching_pairs(self):
+        """(Nc, 2) pairs in contact at the last force evaluation."""
+        return self.verlet.pairs[self._contact_index]
+
+    # ------------------------------------------------------------------ stepping
+    def step(self):
+        """Advance one time step; returns the net force, (3, N) component-first, N."""
+        force, torque = self.forces()
+        dt = self._dt
+        self._v += force * (dt / (self.mass * self.mass_scale))
+        self._w += torque * (dt / (self.inertia * self.mass_scale))
+        self._x += self._v * dt
+        self.time_s += dt
+        self.steps += 1
+        return force
+
+    def unbalanced_force_ratio(self, force):
+        r"""Mean unbalanced-force ratio :math:`\overline{|F_{net}|} / \overline{F_n}`.
+
+        Mean magnitude of the net force on the particles over the mean normal contact
+        force (particle and wall contacts); 0 means exact static equilibrium.
+        """
+        fn = np.concatenate([self.contact_fn, self.last_wall_fn])
+        if len(fn) == 0 or fn.mean() == 0:
+            return float("inf")
+        return float(np.mean(np.sqrt(_dot(force, force))) / fn.mean())
+
+    def check_stability(self, *, max_speed_m_s=20.0, max_overlap_fraction=0.5):
+        """Raise DemInstabilityError on NaN, runaway speeds, deep overlaps or escapes."""
+        if not np.all(np.isfinite(self.centers)) or not np.all(np.isfinite(self.velocities)):
+            raise DemInstabilityError(
+                f"non-finite positions/velocities at t = {self.time_s:.4g} s (step {self.steps}); "
+                "reduce dt_safety or mass_scale"
+            )
+        vmax = float(np.sqrt(np.max(_dot(self._v, self._v))))
+        if vmax > max_speed_m_s:
+            raise DemInstabilityError(
+                f"particle speed {vmax:.3g} m/s exceeds {max_speed_m_s} m/s at t = {self.time_s:.4g} s "
+                f"(step {self.steps}): energy blow-up; reduce dt_safety or mass_scale"
+            )
+        pairs = self.touching_pairs
+        if len(pairs):
+            i, j = pairs[:, 0], pairs[:, 1]
+            d = np.linalg.norm(self.centers[j] - self.centers[i], axis=1)
+            frac = (self.radii[i] + self.radii[j] - d) / np.minimum(self.radii[i], self.radii[j])
+            if frac.max() > max_overlap_fraction:
+                raise DemInstabilityError(
+                    f"overlap {frac.max():.2f} of a radius at t = {self.time_s:.4g} s: particles "
+                    "pass through each other (stiffness too low for the load or dt too large)"
+                )
+        if self.bounds_m is not None:
+            lo, hi = self.bounds_m
+            out = np.any((self.centers < lo) | (self.centers > hi), axis=1)
+            if np.any(out):
+                k = int(np.flatnonzero(out)[0])
+                raise DemInstabilityError(
+                    f"{int(out.sum())} particle(s) left the container (e.g. #{k} at "
+                    f"{self.centers[k].round(4).tolist()} m) at t = {self.time_s:.4g} s"
+                )
+
+    def run(self, *, duration_s=None, max_steps=None, tol=None, min_steps=0, check_every=200,
+            callback=None, grow_from=None, grow_to=None):
+        """Advance until ``duration_s`` / ``max_steps`` or until equilibrium.
+
+        Parameters
+        ----------
+        duration_s : float, optional
+            Simulated time to advance, s.
+        max_steps : int, optional
+        tol : float, optional
+            Stop when the mean unbalanced-force ratio is below ``tol`` (checked every
+            ``check_every`` steps, after ``min_steps``).
+        callback : callable(sim, force) -> None, optional
+            Called every ``check_every`` steps (progress output, histories).
+        grow_from, grow_to : (N,) arrays, optional
+            Radii interpolated linearly from ``grow_from`` to ``grow_to`` over the run
+            (needs ``max_steps``): radius expansion.
+
+        Returns
+        -------
+        dict with ``steps``, ``time_s``, ``ratio``, ``converged``, ``wall_s``.
+        """
+        if duration_s is None and max_steps is None:
+            raise ValueError("give duration_s or max_steps")
+        if (grow_from is None) != (grow_to is None):
+            raise ValueError("grow_from and grow_to go together")
+        if grow_from is not None and max_steps is None:
+            raise ValueError("radius growth needs max_steps")
+        t0 = time.perf_counter()
+        t_end = None if duration_s is None else self.time_s + duration_s
+        k = 0
+        ratio = float("inf")
+        converged = False
+        while True:
+            if max_steps is not None and k >= max_steps:
+                break
+            if t_end is not None and self.time_s >= t_end - 1e-15:
+                break
+            if grow_from is not None:
+                s = (k + 1) / max_steps
+                self._set_radii(grow_from + s * (grow_to - grow_from))
+            force = self.step()
+            k += 1
+            if k % check_every == 0:
+                self.check_stability()
+                ratio = self.unbalanced_force_ratio(force)
+                if callback is not None:
+                    callback(self, force)
+                if tol is not None and k >= min_steps and ratio < tol:
+                    converged = True
+                    break
+        self.check_stability()
+        return {
+            "steps": k,
+            "time_s": self.time_s,
+            "ratio": ratio,
+            "converged": converged,
+            "wall_s": time.perf_counter() - t0,
+        }

@@ -1,0 +1,187 @@
+r"""Porosity and coordination measurements on sphere packings.
+
+* Local porosity in measurement spheres (thesis B1–B5, PFC3D ``measure``): exact
+  sphere–sphere lens volumes.
+* Porosity of a box or cylinder region: spheres wholly inside count fully; spheres cut
+  by the region boundary are integrated with a fixed 1 791-point quadrature inside the
+  unit sphere (error of the cut volume ~ 1e-3 of a sphere volume each, averaging out).
+* Coordination numbers: neighbours within a cutoff distance (thesis: 1.05 d_max) and
+  true contacts (overlap > −tol).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+from scipy.spatial import cKDTree
+
+__all__ = [
+    "Region",
+    "lens_volume",
+    "porosity_in_spheres",
+    "porosity_in_region",
+    "coordination_numbers",
+    "sphere_volume",
+]
+
+
+def sphere_volume(radii):
+    """Volume 4/3 π r³ of each sphere, m³."""
+    return 4.0 / 3.0 * np.pi * np.asarray(radii, dtype=float) ** 3
+
+
+def lens_volume(big_r, small_r, dist):
+    r"""Intersection volume of spheres of radii R and r whose centres are ``dist`` apart, m³.
+
+    .. math:: V = \frac{\pi (R + r - d)^2 (d^2 + 2dr - 3r^2 + 2dR + 6rR - 3R^2)}{12 d}
+
+    for |R − r| < d < R + r; the smaller sphere's volume when one contains the other;
+    0 when they are apart.
+
+    >>> round(float(lens_volume(1.0, 1.0, 1.0) / (5 * np.pi / 12)), 12)
+    1.0
+    """
+    R = np.asarray(big_r, dtype=float)
+    r = np.asarray(small_r, dtype=float)
+    d = np.asarray(dist, dtype=float)
+    R, r, d = np.broadcast_arrays(R, r, d)
+    out = np.zeros(d.shape)
+    inside = d <= np.abs(R - r)
+    out[inside] = sphere_volume(np.minimum(R, r)[inside])
+    part = (~inside) & (d < R + r)
+    Rp, rp, dp = R[part], r[part], d[part]
+    out[part] = (
+        np.pi * (Rp + rp - dp) ** 2
+        * (dp**2 + 2 * dp * rp - 3 * rp**2 + 2 * dp * Rp + 6 * rp * Rp - 3 * Rp**2)
+        / (12 * dp)
+    )
+    return out
+
+
+def porosity_in_spheres(centers, radii, sphere_centers, sphere_radius):
+    """Porosity inside each measurement sphere (thesis B1–B5 style), shape (M,).
+
+    Parameters
+    ----------
+    centers : (N, 3) array, m
+    radii : (N,) array, m
+    sphere_centers : (M, 3) array, m
+    sphere_radius : float or (M,) array, m
+    """
+    centers = np.asarray(centers, dtype=float)
+    radii = np.asarray(radii, dtype=float)
+    sc = np.atleast_2d(np.asarray(sphere_centers, dtype=float))
+    sr = np.broadcast_to(np.asarray(sphere_radius, dtype=float), (len(sc),))
+    tree = cKDTree(centers)
+    out = np.empty(len(sc))
+    for k in range(len(sc)):  # a handful of measurement spheres
+        idx = np.asarray(tree.query_ball_point(sc[k], sr[k] + radii.max()), dtype=np.int64)
+        if len(idx) == 0:
+            out[k] = 1.0
+            continue
+        d = np.linalg.norm(centers[idx] - sc[k], axis=1)
+        solid = lens_volume(sr[k], radii[idx], d).sum()
+        out[k] = 1.0 - solid / sphere_volume(sr[k])
+    return out
+
+
+@dataclass(frozen=True)
+class Region:
+    """Box ``lo``–``hi`` or vertical cylinder (``radius`` about ``center_xy``, z in lo[2]–hi[2])."""
+
+    kind: str
+    lo: tuple
+    hi: tuple
+    radius: float = 0.0
+    center_xy: tuple = (0.0, 0.0)
+
+    def __post_init__(self):
+        if self.kind not in ("box", "cylinder"):
+            raise ValueError(f"region kind must be 'box' or 'cylinder', got {self.kind!r}")
+        if not np.all(np.asarray(self.hi, float)[2:] > np.asarray(self.lo, float)[2:]):
+            raise ValueError(f"empty region {self.lo}–{self.hi}")
+
+    @property
+    def volume(self):
+        lo, hi = np.asarray(self.lo, float), np.asarray(self.hi, float)
+        if self.kind == "box":
+            return float(np.prod(hi - lo))
+        return float(np.pi * self.radius**2 * (hi[2] - lo[2]))
+
+    def signed_distance(self, p):
+        """Distance from points (…, 3) to the region boundary, positive inside."""
+        lo, hi = np.asarray(self.lo, float), np.asarray(self.hi, float)
+        dz = np.minimum(p[..., 2] - lo[2], hi[2] - p[..., 2])
+        if self.kind == "box":
+            dxy = np.minimum(
+                np.minimum(p[..., 0] - lo[0], hi[0] - p[..., 0]),
+                np.minimum(p[..., 1] - lo[1], hi[1] - p[..., 1]),
+            )
+        else:
+            rho = np.hypot(p[..., 0] - self.center_xy[0], p[..., 1] - self.center_xy[1])
+            dxy = self.radius - rho
+        return np.minimum(dxy, dz)
+
+    def to_dict(self):
+        return {"kind": self.kind, "lo": list(map(float, self.lo)), "hi": list(map(float, self.hi)),
+                "radius": float(self.radius), "center_xy": list(map(float, self.center_xy))}
+
+
+def _unit_ball_points(spacing=0.13):
+    g = np.arange(-1 + spacing / 2, 1, spacing)
+    p = np.stack(np.meshgrid(g, g, g, indexing="ij"), axis=-1).reshape(-1, 3)
+    return p[np.einsum("ij,ij->i", p, p) <= 1.0]
+
+
+_BALL = _unit_ball_points()
+
+
+def porosity_in_region(centers, radii, region, *, chunk=256):
+    """Porosity of a Region, 1 − (solid volume inside)/(region volume).
+
+    Spheres wholly inside count fully; spheres cut by the boundary use a fixed point
+    quadrature (``len(_BALL)`` points) scaled to each sphere.
+    """
+    centers = np.asarray(centers, dtype=float)
+    radii = np.asarray(radii, dtype=float)
+    sd = region.signed_distance(centers)
+    full = sd >= radii
+    cut = np.flatnonzero((sd > -radii) & ~full)
+    solid = float(sphere_volume(radii[full]).sum())
+    for s in range(0, len(cut), chunk):
+        k = cut[s : s + chunk]
+        pts = centers[k, None, :] + radii[k, None, None] * _BALL[None, :, :]
+        frac = (region.signed_distance(pts) >= 0).mean(axis=1)
+        solid += float(np.sum(frac * sphere_volume(radii[k])))
+    return 1.0 - solid / region.volume
+
+
+def coordination_numbers(centers, radii, *, cutoff_m=None, contact_tol_m=0.0, select=None):
+    """Coordination number of each selected particle.
+
+    Parameters
+    ----------
+    centers : (N, 3) array, m
+    radii : (N,) array, m
+    cutoff_m : float, optional
+        Count neighbours whose centre distance is below this (thesis: 1.05 d_max).
+        If None, count true contacts: distance < r_i + r_j + contact_tol_m.
+    select : (N,) bool array, optional
+        Particles whose coordination is returned (neighbours are counted among all).
+
+    Returns
+    -------
+    (n_selected,) int array
+    """
+    centers = np.asarray(centers, dtype=float)
+    radii = np.asarray(radii, dtype=float)
+    n = len(radii)
+    reach = cutoff_m if cutoff_m is not None else 2 * radii.max() + contact_tol_m
+    pairs = cKDTree(centers).query_pairs(reach, output_type="ndarray")
+    if cutoff_m is None and len(pairs):
+        i, j = pairs[:, 0], pairs[:, 1]
+        d = np.linalg.norm(centers[j] - centers[i], axis=1)
+        pairs = pairs[d < radii[i] + radii[j] + contact_tol_m]
+    z = np.bincount(pairs.ravel(), minlength=n)
+    return z if select is None else z[select]

@@ -1,0 +1,451 @@
+r"""Containers, the thesis's bins, sphere generation and the packing procedure.
+
+Procedure (thesis 3.1 and Appendix A, PFC3D ``generate`` / ``ini rad mul`` / ``solve``):
+
+1. Number of spheres from the target porosity φ and the mean radius
+   r̄ = (r_lo + r_hi)/2 (thesis Eq. 3.10): :math:`N = \lfloor (1-φ) V / (\tfrac43 π r̄^3) \rfloor`.
+2. Generate N non-overlapping spheres at radii uniform in [r_lo, r_hi] / m₀ (m₀ = 1.4)
+   inside the container closed by a lid at the fill height (random sequential addition).
+3. Expand the radii by the multiplier of Eqs. 3.5–3.7,
+   :math:`m^3 = (1-φ)/(1-φ_0)`, so that the spheres fill exactly (1 − φ) of the closed
+   volume; growth is spread over ``grow_steps`` steps under gravity.
+4. Cycle to equilibrium in the closed box, remove the lid, cycle to equilibrium again.
+
+Equilibrium criterion: mean unbalanced-force ratio (:meth:`Simulation.unbalanced_force_ratio`)
+below ``tol``. Stages 3–4 use density scaling S (``mass_scale``; see
+:mod:`dem._integrate`); the physical parameters are otherwise those of Table 3.1.
+"""
+
+from __future__ import annotations
+
+import logging
+import time
+from dataclasses import dataclass, field, replace
+
+import numpy as np
+from scipy.spatial import cKDTree
+
+from ._integrate import SOYBEAN, Material, Simulation
+from ._measure import Region, coordination_numbers, porosity_in_region, porosity_in_spheres, sphere_volume
+from ._walls import CylinderWall, PlaneWall
+
+__all__ = [
+    "Container",
+    "SCENES",
+    "scene_container",
+    "default_measure_spheres",
+    "thesis_particle_count",
+    "generate_spheres",
+    "make_simulation",
+    "pack",
+    "PackResult",
+    "summarize",
+]
+
+log = logging.getLogger(__name__)
+
+#: Densest packing of equal spheres (Kepler), porosity 1 − π/√18.
+KEPLER_POROSITY = 1.0 - np.pi / np.sqrt(18.0)
+
+
+@dataclass(frozen=True)
+class Container:
+    """A bin with its floor at z = 0, centred on the z axis.
+
+    ``kind`` 'box': ``size_m`` = (length_x, width_y); 'cylinder': ``size_m`` = (diameter,).
+    ``fill_height_m`` is the height the bed is filled to (lid height during expansion).
+    """
+
+    kind: str
+    size_m: tuple
+    fill_height_m: float
+
+    def __post_init__(self):
+        if self.kind not in ("box", "cylinder"):
+            raise ValueError(f"container kind must be 'box' or 'cylinder', got {self.kind!r}")
+        need = 2 if self.kind == "box" else 1
+        if len(self.size_m) != need:
+            raise ValueError(f"{self.kind} needs {need} size value(s), got {self.size_m}")
+        if not all(s > 0 for s in self.size_m) or not self.fill_height_m > 0:
+            raise ValueError(f"container dimensions must be positive, got {self.size_m}, {self.fill_height_m}")
+
+    @property
+    def area_m2(self):
+        if self.kind == "box":
+            return float(self.size_m[0] * self.size_m[1])
+        return float(np.pi * self.size_m[0] ** 2 / 4)
+
+    @property
+    def volume_m3(self):
+        return self.area_m2 * self.fill_height_m
+
+    @property
+    def min_dimension_m(self):
+        return float(min(min(self.size_m), self.fill_height_m))
+
+    def walls(self, *, lid=True, lid_height_m=None):
+        """Wall list: side walls and floor move with the container; the lid (at the fill
+        height unless ``lid_height_m`` is given) is fixed."""
+        h = self.fill_height_m if lid_height_m is None else float(lid_height_m)
+        if self.kind == "box":
+            lx, ly = self.size_m
+            walls = [
+                PlaneWall((-lx / 2, 0, 0), (1, 0, 0), "x-"),
+                PlaneWall((lx / 2, 0, 0), (-1, 0, 0), "x+"),
+                PlaneWall((0, -ly / 2, 0), (0, 1, 0), "y-"),
+                PlaneWall((0, ly / 2, 0), (0, -1, 0), "y+"),
+            ]
+        else:
+            walls = [CylinderWall(self.size_m[0] / 2, (0.0, 0.0), "cylinder")]
+        walls.append(PlaneWall((0, 0, 0), (0, 0, 1), "floor"))
+        if lid:
+            walls.append(PlaneWall((0, 0, h), (0, 0, -1), "lid", moves=False))
+        return walls
+
+    def bounds(self, r_max, *, headroom=1.0):
+        """Box every centre must stay in (escape detection)."""
+        h = self.fill_height_m
+        if self.kind == "box":
+            lx, ly = self.size_m
+            half = np.array([lx / 2, ly / 2])
+        else:
+            half = np.array([self.size_m[0] / 2] * 2)
+        lo = np.array([-half[0] - r_max, -half[1] - r_max, -r_max - 0.02])
+        hi = np.array([half[0] + r_max, half[1] + r_max, h * (1 + headroom) + 0.05])
+        return np.array([lo, hi])
+
+    def interior(self, margin_m, top_m):
+        """Region at least ``margin_m`` from the side walls (x only for a box thinner than
+        4 margins in y), the floor and the bed top ``top_m``."""
+        z = (margin_m, top_m - margin_m)
+        if self.kind == "box":
+            lx, ly = self.size_m
+            my = margin_m if ly > 4 * margin_m else 0.0
+            return Region("box", (-lx / 2 + margin_m, -ly / 2 + my, z[0]), (lx / 2 - margin_m, ly / 2 - my, z[1]))
+        return Region("cylinder", (0, 0, z[0]), (0, 0, z[1]), radius=self.size_m[0] / 2 - margin_m)
+
+    def sample_centers(self, radii, rng):
+        """Uniform random centres such that each sphere lies inside the closed container."""
+        h = self.fill_height_m
+        z = rng.uniform(radii, h - radii)
+        if self.kind == "box":
+            lx, ly = self.size_m
+            x = rng.uniform(-lx / 2 + radii, lx / 2 - radii)
+            y = rng.uniform(-ly / 2 + radii, ly / 2 - radii)
+        else:
+            rad = self.size_m[0] / 2 - radii
+            rho = rad * np.sqrt(rng.uniform(0, 1, len(radii)))
+            phi = rng.uniform(0, 2 * np.pi, len(radii))
+            x, y = rho * np.cos(phi), rho * np.sin(phi)
+        return np.column_stack([x, y, z])
+
+    def to_dict(self):
+        return {"kind": self.kind, "size_m": list(map(float, self.size_m)), "fill_height_m": float(self.fill_height_m)}
+
+    @classmethod
+    def from_dict(cls, d):
+        return cls(d["kind"], tuple(d["size_m"]), d["fill_height_m"])
+
+
+#: The thesis's bins: Appendix A (rectangular, 0.25 × 0.02 m, filled to 0.25 m) and
+#: Appendices B–C (cylinder 0.15 m in diameter, filled to 0.25 m).
+SCENES = {
+    "rect-bin": Container("box", (0.25, 0.02), 0.25),
+    "cyl-bin": Container("cylinder", (0.15,), 0.25),
+}
+
+
+def scene_container(name):
+    """Container of a named scene ('rect-bin' | 'cyl-bin')."""
+    try:
+        return SCENES[name]
+    except KeyError:
+        raise ValueError(f"unknown scene {name!r}; choose from {sorted(SCENES)} or 'box'/'cylinder'") from None
+
+
+def default_measure_spheres(container):
+    """Thesis B1–B5 measurement spheres (Appendix C: x = 3/7·width, radius width/14).
+
+    For a box the sphere radius is capped at 0.99 × half the thinner side so it stays inside.
+    """
+    zs = np.array([0.119, 0.129, 0.130, 0.136, 0.146]) * container.fill_height_m / 0.25
+    if container.kind == "cylinder":
+        w = container.size_m[0]
+        r = w / 14.0
+        x = 3.0 / 7.0 * w
+        x = min(x, w / 2 - r)
+    else:
+        r = min(0.15 / 14.0, 0.99 * min(container.size_m) / 2)
+        x = min(0.0643, container.size_m[0] / 2 - r)
+    centers = np.column_stack([np.full(5, x), np.zeros(5), zs])
+    return centers, r
+
+
+def thesis_particle_count(container, porosity, material=SOYBEAN):
+    r"""Sphere count of thesis Eq. 3.10 with r̄ = (r_lo + r_hi)/2:
+    :math:`N = \lfloor (1-φ)V / (\tfrac43 π r̄^3) \rfloor` (rect-bin: 5146; cyl-bin: 18188)."""
+    rbar = 0.5 * (material.radius_min_m + material.radius_max_m)
+    return int((1.0 - porosity) * container.volume_m3 / (4.0 / 3.0 * np.pi * rbar**3))
+
+
+def _validate(container, porosity, material):
+    if not 0.0 < porosity < 1.0:
+        raise ValueError(f"porosity must be in (0, 1), got {porosity}")
+    if porosity <= KEPLER_POROSITY:
+        raise ValueError(
+            f"porosity {porosity} is unreachable: no sphere packing is denser than "
+            f"{KEPLER_POROSITY:.4f} (face-centred cubic)"
+        )
+    if porosity < 0.35:
+        raise ValueError(
+            f"porosity {porosity} is unreachable by a random packing of near-equal spheres "
+            "(random close packing is about 0.36)"
+        )
+    d = 2 * material.radius_max_m
+    if container.min_dimension_m < d:
+        raise ValueError(
+            f"container ({container.size_m}, height {container.fill_height_m}) m is smaller than a "
+            f"grain of diameter {d} m"
+        )
+
+
+def generate_spheres(container, n, r_lo, r_hi, rng, *, tries=200000):
+    """N non-overlapping spheres, radii uniform in [r_lo, r_hi], random sequential addition.
+
+    Candidates are drawn in batches and rejected against the accepted spheres (KD-tree)
+    and against each other; raises ValueError after ``tries`` rejected candidates
+    (PFC3D ``generate ... tries``).
+    """
+    radii_all = np.empty(0)
+    centers_all = np.empty((0, 3))
+    rejected = 0
+    while len(radii_all) < n:
+        need = n - len(radii_all)
+        m = max(2 * need, 64)
+        r = rng.uniform(r_lo, r_hi, m)
+        x = container.sample_centers(r, rng)
+        ok = np.ones(m, dtype=bool)
+        if len(radii_all):
+            tree = cKDTree(centers_all)
+            k = min(16, len(radii_all))
+            dist, idx = tree.query(x, k=k, distance_upper_bound=r_hi + r.max())
+            dist = dist.reshape(m, k)
+            idx = idx.reshape(m, k)
+            valid = idx < len(radii_all)
+            rr = np.where(valid, radii_all[np.minimum(idx, len(radii_all) - 1)], 0.0)
+            ok &= ~np.any(valid & (dist < r[:, None] + rr), axis=1)
+        pairs = cKDTree(x).query_pairs(2 * r_hi, output_type="ndarray")
+        if len(pairs):
+            i, j = pairs[:, 0], pairs[:, 1]
+            clash = np.linalg.norm(x[i] - x[j], axis=1) < r[i] + r[j]
+            ok[np.maximum(i, j)[clash]] = False
+        acc = np.flatnonzero(ok)[:need]
+        rejected += m - len(acc)
+        radii_all = np.concatenate([radii_all, r[acc]])
+        centers_all = np.concatenate([centers_all, x[acc]])
+        if rejected > tries and len(radii_all) < n:
+            raise ValueError(
+                f"could only place {len(radii_all)} of {n} spheres after {rejected} tries: "
+                "container too small or porosity too low for the initial radii"
+            )
+    return centers_all, radii_all
+
+
+def make_simulation(container, centers, radii, *, material=SOYBEAN, lid=True, lid_height_m=None, **kw):
+    """Simulation of spheres in a container's walls (lid optional), with escape bounds."""
+    return Simulation(
+        centers, radii, container.walls(lid=lid, lid_height_m=lid_height_m), material,
+        bounds_m=container.bounds(material.radius_max_m * 1.2), **kw,
+    )
+
+
+@dataclass
+class PackResult:
+    """A finished packing and how it was made."""
+
+    centers: np.ndarray
+    radii: np.ndarray
+    container: Container
+    summary: dict = field(default_factory=dict)
+
+
+def summarize(centers, radii, container, *, material=SOYBEAN, measure_spheres=None, interior_margin_m=None,
+              coordination_box=None):
+    """JSON-ready measurements of a packing (porosities, coordination distributions)."""
+    centers = np.asarray(centers, float)
+    radii = np.asarray(radii, float)
+    vp = float(sphere_volume(radii).sum())
+    top = float(np.max(centers[:, 2] + radii))
+    rbar = 0.5 * (material.radius_min_m + material.radius_max_m)
+    bhtf = float(np.max(centers[:, 2]) + rbar)
+    dmean = float(2 * radii.mean())
+    margin = interior_margin_m if interior_margin_m is not None else 2 * dmean
+    # bed surface: mean top of the highest sphere in each column of the cross-section
+    surface = _surface_height(centers, radii, container)
+    region = container.interior(margin, surface)
+    if measure_spheres is None:
+        measure_spheres = default_measure_spheres(container)
+    mc, mr = measure_spheres
+    local = porosity_in_spheres(centers, radii, mc, mr)
+    dmax = float(2 * radii.max())
+    if coordination_box is None:
+        if container.kind == "box":
+            lx, ly = container.size_m
+            coordination_box = ((-min(0.05, lx / 2), -ly / 2, 0.02), (min(0.05, lx / 2), ly / 2, surface - 0.02))
+        else:
+            coordination_box = ((-0.05, -0.05, 0.02), (0.05, 0.05, surface - 0.02))
+    lo, hi = map(np.asarray, coordination_box)
+    sel = np.all((centers >= lo) & (centers <= hi), axis=1)
+    z_cut = coordination_numbers(centers, radii, cutoff_m=1.05 * dmax, select=sel)
+    z_true = coordination_numbers(centers, radii, contact_tol_m=0.0, select=sel)
+    d_all = 2 * radii
+    return {
+        "n_spheres": int(len(radii)),
+        "container": container.to_dict(),
+        "solid_volume_m3": vp,
+        "porosity_closed_volume": 1.0 - vp / container.volume_m3,
+        "bed_height_max_m": top,
+        "bed_height_surface_m": surface,
+        "porosity_global_surface": 1.0 - vp / (container.area_m2 * surface),
+        "porosity_global_thesis": 1.0 - vp / (container.area_m2 * bhtf),
+        "porosity_interior": porosity_in_region(centers, radii, region),
+        "interior_region": region.to_dict(),
+        "measure_spheres": {"centers_m": mc.tolist(), "radius_m": float(mr), "porosity": local.tolist(),
+                            "mean": float(local.mean())},
+        "coordination": {
+            "box_m": [lo.tolist(), hi.tolist()],
+            "n_particles": int(sel.sum()),
+            "cutoff_m": 1.05 * dmax,
+            "cutoff_mean": float(z_cut.mean()) if len(z_cut) else None,
+            "cutoff_hist": np.bincount(z_cut).tolist() if len(z_cut) else [],
+            "contact_mean": float(z_true.mean()) if len(z_true) else None,
+            "contact_hist": np.bincount(z_true).tolist() if len(z_true) else [],
+        },
+        "diameter_m": {"min": float(d_all.min()), "max": float(d_all.max()), "mean": float(d_all.mean()),
+                       "fraction_outside_nominal": float(np.mean((d_all < 2 * material.radius_min_m * (1 - 1e-9))
+                                                                 | (d_all > 2 * material.radius_max_m * (1 + 1e-9))))},
+    }
+
+
+def _surface_height(centers, radii, container, cell=None):
+    """Bed surface height, m: median over a grid of columns of the highest sphere top."""
+    cell = cell or 2 * float(radii.mean())
+    top = centers[:, 2] + radii
+    ix = np.floor(centers[:, 0] / cell).astype(np.int64)
+    iy = np.floor(centers[:, 1] / cell).astype(np.int64)
+    key = (ix - ix.min()) * (iy.max() - iy.min() + 1) + (iy - iy.min())
+    order = np.lexsort((top, key))
+    last = np.r_[np.flatnonzero(np.diff(key[order])), len(order) - 1]
+    return float(np.median(top[order][last]))
+
+
+def pack(container, *, material=SOYBEAN, porosity=0.408, n_particles=None, rng=None, initial_multiplier=1.4,
+         mass_scale=100.0, dt_safety=0.25, grow_steps=3000, tol=1e-3, max_steps=200000, check_every=200,
+         open_top=True, packing_friction=None, lid_headroom=0.2, measure_spheres=None, progress=None):
+    """Make a settled packing in ``container`` by the thesis procedure (module notes).
+
+    Parameters
+    ----------
+    container : Container
+    material : Material
+    porosity : float
+        Target porosity φ of the closed volume (0.408, thesis Table 3.1).
+    n_particles : int, optional
+        Default: thesis Eq. 3.10.
+    rng : numpy.random.Generator | int | None
+        Seed or generator; the same seed gives the same packing.
+    initial_multiplier : float
+        m₀: generation radii are the nominal ones divided by m₀ (Appendix A: 1.4).
+    mass_scale : float
+        Density scaling S during expansion and settling (1 = physical masses).
+    grow_steps : int
+        Steps over which the radii grow to their final size.
+    tol : float
+        Mean unbalanced-force ratio that counts as equilibrium (each stage).
+    max_steps : int
+        Step limit per equilibrium stage.
+    packing_friction : float, optional
+        Particle–particle friction used during expansion and the closed-box stage
+        (None: the material's). The material's friction is restored before the open-box
+        settling.
+    lid_headroom : float
+        The lid sits at (1 + lid_headroom) × the fill height during expansion (Appendix B:
+        0.05 m above a 0.25 m fill, i.e. 0.2); 0 is Appendix A's closed box.
+    open_top : bool
+        Remove the lid and settle again (thesis Appendix A) before measuring.
+    progress : callable(stage, sim, force) | None
+        Called every ``check_every`` steps.
+
+    Returns
+    -------
+    PackResult
+    """
+    if not isinstance(container, Container):
+        raise TypeError(f"container must be a Container, got {type(container).__name__}")
+    _validate(container, porosity, material)
+    if not initial_multiplier >= 1.0:
+        raise ValueError(f"initial_multiplier must be >= 1, got {initial_multiplier}")
+    rng = np.random.default_rng(rng)
+    n = thesis_particle_count(container, porosity, material) if n_particles is None else int(n_particles)
+    if n < 1:
+        raise ValueError(f"no sphere fits: n_particles = {n}")
+    t_wall = time.perf_counter()
+    r_lo = material.radius_min_m / initial_multiplier
+    r_hi = material.radius_max_m / initial_multiplier
+    centers, r0 = generate_spheres(container, n, r_lo, r_hi, rng)
+    phi0 = 1.0 - sphere_volume(r0).sum() / container.volume_m3
+    mult = ((1.0 - porosity) / (1.0 - phi0)) ** (1.0 / 3.0)  # thesis Eq. 3.7
+    log.info("generated %d spheres, porosity %.4f, radius multiplier %.4f", n, phi0, mult)
+    mat_pack = material if packing_friction is None else replace(material, friction=float(packing_friction))
+    sim = make_simulation(container, centers, r0, material=mat_pack, lid=True,
+                          lid_height_m=container.fill_height_m * (1 + lid_headroom), mass_scale=mass_scale,
+                          dt_safety=dt_safety)
+    stages = {}
+
+    def cb(stage):
+        return None if progress is None else (lambda s, f: progress(stage, s, f))
+
+    stages["expand"] = sim.run(max_steps=grow_steps, grow_from=r0, grow_to=r0 * mult, check_every=check_every,
+                               callback=cb("expand"))
+    # closed stage: with the packing friction, to a looser criterion when that friction is
+    # not the material's (frictionless assemblies rattle for long; friction stops them)
+    tol_closed = tol if packing_friction is None else max(tol, 1e-2)
+    stages["closed"] = sim.run(max_steps=max_steps, tol=tol_closed, check_every=check_every, callback=cb("closed"))
+    stages["closed"]["max_overlap_fraction"] = _max_overlap_fraction(sim)
+    sim.set_material(material)
+    if open_top:
+        sim.set_walls(container.walls(lid=False))
+    stages["settle"] = sim.run(max_steps=max_steps, tol=tol, check_every=check_every, callback=cb("settle"))
+    for name, st in stages.items():
+        if name != "expand" and not st["converged"]:
+            log.warning("stage %s stopped at the step limit (ratio %.3g > tol %.3g)", name, st["ratio"], tol)
+    wall_s = time.perf_counter() - t_wall
+    summary = summarize(sim.centers, sim.radii, container, material=material, measure_spheres=measure_spheres)
+    steps = sum(st["steps"] for st in stages.values())
+    summary.update({
+        "target_porosity": porosity,
+        "initial_porosity": float(phi0),
+        "radius_multiplier": float(mult),
+        "mass_scale": float(mass_scale),
+        "dt_s": sim.dt,
+        "dt_physical_s": sim.dt / np.sqrt(mass_scale),
+        "simulated_time_s": sim.time_s,
+        "steps": int(steps),
+        "stages": stages,
+        "tol_unbalanced_ratio": tol,
+        "wall_time_s": wall_s,
+        "particle_steps_per_s": steps * n / wall_s,
+        "neighbour_rebuilds": int(sim.stats["rebuilds"]),
+        "max_overlap_fraction": _max_overlap_fraction(sim),
+        "material": {k: getattr(material, k) for k in material.__dataclass_fields__},
+    })
+    return PackResult(sim.centers.copy(), sim.radii.copy(), container, summary)
+
+
+def _max_overlap_fraction(sim):
+    pairs = sim.touching_pairs
+    if len(pairs) == 0:
+        return 0.0
+    i, j = pairs[:, 0], pairs[:, 1]
+    d = np.linalg.norm(sim.centers[j] - sim.centers[i], axis=1)
+    return float(np.max((sim.radii[i] + sim.radii[j] - d) / np.minimum(sim.radii[i], sim.radii[j])))
