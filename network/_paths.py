@@ -68,6 +68,7 @@ __all__ = [
     "branched_path_pressure_drop",
     "branched_table",
     "pressure_along_path",
+    "pore_pressure_array",
 ]
 
 logger = logging.getLogger(__name__)
@@ -359,7 +360,10 @@ def face_graph(tessellation, *, open_area_m2=None):
     if open_area_m2 is None:
         from throats import open_area  # the throats package owns the exact open area
 
-        open_area_m2 = open_area(t.throat_radii, t.throat_sides)
+        # in chunks: open_area's work arrays take ~10 kB per row
+        open_area_m2 = np.concatenate([
+            open_area(t.throat_radii[i:i + 20000], t.throat_sides[i:i + 20000])
+            for i in range(0, t.n_throats, 20000)]) if t.n_throats else np.zeros(0)
     oa = np.asarray(open_area_m2, dtype=float)
     return FaceGraph(
         points=pts,
@@ -1283,6 +1287,33 @@ def branched_path_pressure_drop(points, radii, path, *, superficial_velocity_m_s
     return branched_pressure_drop(cent[:, 0], x[tet].mean(axis=1), cent[:, 1:], d[:, 0],
                                   d[:, 1:], path.exit_local, q0_m3_s, multiplier=multiplier,
                                   branches=branches, mu_pa_s=mu_pa_s)
+
+
+def pore_pressure_array(n_pores, pore_ids, pressure_pa, labels=None):
+    """Pressure of every tetrahedron from a network solution over a sample, (Np,) Pa.
+
+    Parameters
+    ----------
+    n_pores : int
+        Tetrahedra of the tessellation.
+    pore_ids : (Ns,) int array_like
+        Pore-body ids of the solved pores (``FlowResult.pore_ids``): tetrahedron ids, or group
+        labels when tied tetrahedra were merged.
+    pressure_pa : (Ns,) array_like, Pa
+        Their pressures (``FlowResult.pressure_pa``).
+    labels : (Np,) int array_like, optional
+        Group label of each tetrahedron (``network.tie_groups``); None when not merged.
+
+    Returns
+    -------
+    (Np,) ndarray, Pa; NaN outside the sample.
+    """
+    ids = np.asarray(pore_ids, dtype=np.intp)
+    pr = np.asarray(pressure_pa, dtype=float)
+    lab = np.arange(n_pores) if labels is None else np.asarray(labels, dtype=np.intp)
+    body = np.full(max(int(lab.max()) + 1, int(ids.max()) + 1 if ids.size else 0), np.nan)
+    body[ids] = pr
+    return body[lab]
 
 
 def pressure_along_path(graph, path, pore_pressure_pa, *, axis="z"):

@@ -64,6 +64,12 @@ def _parser():
     p.add_argument("--branches", default="all", choices=("all", "path"),
                    help="daughter losses summed: all three (Appendix F) or the path's (Eq. 3.28)")
     p.add_argument("--no-branched", action="store_true", help="skip the branched model")
+    p.add_argument("--pressure", action="store_true",
+                   help="solve the network model (network.solve) and report the pressure along "
+                        "the paths on the tessellation (thesis 4.2.3) at the first --velocity")
+    p.add_argument("--policy", default="shape-factor",
+                   choices=("shape-factor", "table-only", "table+fe", "fe-only"),
+                   help="Q* source of the network model for --pressure (default shape-factor)")
     p.add_argument("--json", metavar="OUT.json")
     p.add_argument("--plot", metavar="OUT.png")
     p.add_argument("--standin", nargs=3, type=float, metavar=("LX", "LY", "LZ"),
@@ -94,13 +100,14 @@ def main(argv=None) -> int:
         xy = random_entry_points(x, r, args.entries or 3, axis=args.axis, rng=args.seed)
     kinds = _ALL if args.kind == "all" else (args.kind,)
     need_graph = any(k in ("maximin", "shortest") for k in kinds) or args.method == "delaunay"
-    graph = None
+    graph = tess = None
     t1 = time.perf_counter()
-    if need_graph:
+    if need_graph or args.pressure:
         from ._io import Packing
         from ._tessellation import tessellate
 
-        graph = face_graph(tessellate(Packing(x, r, source)))
+        tess = tessellate(Packing(x, r, source))
+        graph = face_graph(tess)
     t_graph = time.perf_counter() - t1
     paths, t_kind = [], {}
     for kind in kinds:
@@ -162,6 +169,10 @@ def main(argv=None) -> int:
                 print(f"mean MFx3 average-width at {u} m/s: {avg:.3g} Pa"
                       + (f" (thesis {ref} Pa, measured {meas} Pa)" if ref else ""))
 
+    along = []
+    if args.pressure:
+        along = _pressure_along(args, x, r, source, tess, graph, paths)
+
     if args.json:
         out = {
             "source": source, "n_spheres": int(len(r)), "axis": args.axis, "depth_m": depth,
@@ -170,7 +181,7 @@ def main(argv=None) -> int:
             "paths": [{**p.summary(), "points_m": p.points.tolist(),
                        "widths_m": p.widths_m.tolist(),
                        "turning_angles_deg": p.turning_angles_deg.tolist()} for p in paths],
-            "branched": branched, "thesis": THESIS,
+            "branched": branched, "pressure_along_paths": along, "thesis": THESIS,
             "platform": platform.platform(), "cpu_count": os.cpu_count(),
             "loadavg": os.getloadavg(), "timestamp": time.strftime("%Y-%m-%dT%H:%M:%SZ",
                                                                    time.gmtime()),
@@ -182,6 +193,45 @@ def main(argv=None) -> int:
 
         plot_paths(x, paths, args.plot, axis=args.axis, title=source)
     return 0
+
+
+def _pressure_along(args, x, r, source, tess, graph, paths):
+    """Network-model pressures along the paths that lie on the tessellation."""
+    from ._io import Packing
+    from ._paths import pore_pressure_array, pressure_along_path
+    from ._pipeline import solve_network
+    from ._tessellation import tie_groups
+
+    t = time.perf_counter()
+    ax = "xyz".index(args.axis)
+    lateral = np.ptp(np.delete(x, ax, axis=1), axis=0).min()
+    margin = min(3.0 * r.mean(), 0.2 * lateral)  # the solver's default, unless the bin is thin
+    res = solve_network(Packing(x, r, source), axis=args.axis, tessellation=tess,
+                        policy=args.policy, velocity_m_s=args.velocity[0], porosity_points=0,
+                        margin=margin)
+    labels, n_groups = tie_groups(tess)
+    p_all = pore_pressure_array(tess.n_pores, res.pore_ids, res.pressure_pa,
+                                None if n_groups == tess.n_pores else labels)
+    grad = res.pressure_gradient_pa_per_m
+    print(f"network model ({args.policy}) at {args.velocity[0]:g} m/s: gradient {grad:.4g} Pa/m, "
+          f"{res.pressure_drop_pa:.4g} Pa over {res.depth_m:g} m ({time.perf_counter() - t:.1f} s)")
+    out = []
+    for i, p in enumerate(paths):
+        if p.status != "ok" or np.any(p.pores < 0):
+            continue
+        pos, pr = pressure_along_path(graph, p, p_all, axis=args.axis)
+        inside = np.isfinite(pr)
+        if inside.sum() < 2:
+            continue
+        span = float(pos[inside][-1] - pos[inside][0])
+        dp = float(pr[inside][0] - pr[inside][-1])
+        out.append({"path": i, "kind": p.kind, "entry_xy_m": p.entry_xy.tolist(),
+                    "n_tetrahedra_in_sample": int(inside.sum()), "span_m": span, "dp_pa": dp,
+                    "dp_per_m": dp / span if span > 0 else float("nan"),
+                    "position_m": pos[inside].tolist(), "pressure_pa": pr[inside].tolist()})
+        print(f"  {p.kind:9s} path {i}: {inside.sum()} tetrahedra in the sample, "
+              f"{dp:.4g} Pa over {span:.4f} m ({dp / span:.4g} Pa/m)")
+    return out
 
 
 if __name__ == "__main__":

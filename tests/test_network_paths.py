@@ -188,3 +188,13 @@ def test_cli_json_and_plot(tmp_path):
     assert all(p["tortuosity_span"] >= 1.0 for p in res["paths"])
     assert len(res["branched"]) == 4  # 2 widest + 2 narrowest
     assert png.stat().st_size > 10_000
+
+
+def test_pore_pressure_array_maps_sample_and_groups():
+    from network._paths import pore_pressure_array
+
+    # tetrahedra 0-4; the sample solved bodies 1 and 3; tetrahedra 3 and 4 form body 3
+    p = pore_pressure_array(5, [1, 3], [2.0, 7.0], labels=[0, 1, 2, 3, 3])
+    np.testing.assert_array_equal(np.isnan(p), [True, False, True, False, False])
+    np.testing.assert_allclose(p[[1, 3, 4]], [2.0, 7.0, 7.0])
+    np.testing.assert_allclose(pore_pressure_array(3, [2], [5.0])[2], 5.0)
