@@ -43,6 +43,9 @@ logger = logging.getLogger(__name__)
 
 __all__ = ["GridSpec", "GridTable", "grid_coordinates", "GRIDS", "ERROR_SAFETY"]
 
+#: a gap within this distance below a node (units of r̄) is served by the cell above the node
+GAP_SNAP = 5e-3
+
 #: safety factor on the coarse/fine difference (calibrated: see tests and cache.bench)
 ERROR_SAFETY = 2.0
 
@@ -282,11 +285,13 @@ class GridTable:
                 td = fd - i
                 i = i.astype(np.int64)
             else:
-                i = np.searchsorted(a, xd, side="right") - 1
+                # a point just below a node (a tiny overlap, x = -1e-3) uses the cell above it,
+                # extrapolating by at most GAP_SNAP: its corners are further from closure
+                i = np.searchsorted(a, xd + GAP_SNAP, side="right") - 1
                 np.clip(i, 0, len(a) - 2, out=i)
                 lo = a[i]
                 td = (xd - lo) / (a[i + 1] - lo)
-            outside |= (td < -1e-9) | (td > 1 + 1e-9)
+            outside |= (xd < a[0] - 1e-9) | (xd > a[-1] + 1e-9)
             t[d] = td.astype(np.float32)
             if self._strides[d] != 1:
                 i *= self._strides[d]
