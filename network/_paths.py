@@ -682,7 +682,8 @@ def _path_record(points, radii, kind, method, entry_xy, axis, status, tetra, exi
 
 
 def build_paths(points, radii, entry_xy, *, kind="widest", axis="z", k_neighbors=24,
-                max_steps=None, depth_m=None, angle_rule="eq3.25", closed_rule="eq3.23"):
+                max_steps=None, depth_m=None, angle_rule="eq3.25", closed_rule="eq3.23",
+                min_quality=0.0):
     r"""Step-increment paths built tetrahedron by tetrahedron, as the thesis does (3.4.1).
 
     All entries advance together, one tetrahedron per step.
@@ -720,6 +721,11 @@ def build_paths(points, radii, entry_xy, *, kind="widest", axis="z", k_neighbors
     depth_m : float, optional
         Bed depth for tortuosity (default :func:`bed_depth`).
     angle_rule : {'eq3.25', 'appendix-d'}
+    min_quality : float, optional
+        Not in the thesis (default 0, off): also refuse fourth spheres that make a sliver
+        (:func:`pore_quality` below this). Against flat walls the nearest sphere above is
+        often in the wall layer, and the flat tetrahedron it makes has faces of up to 100 mm²
+        lying in the wall plane, which the widest rule then picks.
     closed_rule : {'eq3.23', 'exact'}
         When a face counts as closed for rule 2: ``'eq3.23'`` (default, as the thesis) when
         the triangle minus the three sectors is negative, which also rejects faces whose
@@ -819,6 +825,12 @@ def build_paths(points, radii, entry_xy, *, kind="widest", axis="z", k_neighbors
                          + np.linalg.norm(np.cross(e1, e2), axis=2)
                          + np.linalg.norm(nrm, axis=1)[:, None])
         feas &= 3.0 * vol / s_faces < rbar
+        if min_quality > 0:  # not in the thesis: refuse slivers (see passable_pores)
+            i_, j_ = np.triu_indices(4, k=1)
+            allv = np.concatenate([np.broadcast_to(pb[:, None], (a, k, 3, 3)), xc[:, :, None]],
+                                  axis=2)  # (a, k, 4, 3)
+            ebar = np.linalg.norm(allv[:, :, i_] - allv[:, :, j_], axis=3).mean(axis=2)
+            feas &= 6.0 * np.sqrt(2.0) * vol / ebar**3 >= min_quality
         # walk the feasible candidates nearest first; open areas only where needed
         order = np.argsort(~feas, axis=1, kind="stable")  # feasible first, by distance
         n_feas = feas.sum(axis=1)
