@@ -645,7 +645,8 @@ class AirflowPath:
             "n_tetrahedra": self.n_tetrahedra, "length_m": self.length_m,
             "smoothed_length_m": self.smoothed_length_m, "depth_m": self.depth_m,
             "tortuosity_raw": self.tortuosity_raw, "tortuosity": self.tortuosity,
-            "tortuosity_span": self.tortuosity_span, "mean_width_m": self.mean_width_m, "bottleneck_width_m": self.bottleneck_width_m,
+            "tortuosity_span": self.tortuosity_span, "mean_width_m": self.mean_width_m,
+            "bottleneck_width_m": self.bottleneck_width_m,
             "turning_below_30deg": float(np.mean(ta < 30.0)) if ta.size else float("nan"),
             "n_relaxed": self.n_relaxed, "n_backtracks": self.n_backtracks,
         }

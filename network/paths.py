@@ -139,10 +139,11 @@ def main(argv=None) -> int:
               + (f" (thesis {ref})" if ref else "")
               + f", width {np.mean([p.mean_width_m for p in ok]) * 1e3:.2f} mm"
               + (f" (thesis {refw[0]}-{refw[1]})" if refw else "")
-              + f", turns < 30 deg {np.mean(np.concatenate([p.turning_angles_deg for p in ok]) < 30):.2f}"
+              + f", turns < 30 deg "
+                f"{np.mean(np.concatenate([p.turning_angles_deg for p in ok]) < 30):.2f}"
               + (" (thesis > 0.5)" if ref else ""))
 
-    branched = []
+    branched, table45 = [], {}
     if not args.no_branched:
         t2 = time.perf_counter()
         for i, p in enumerate(paths):
@@ -168,6 +169,10 @@ def main(argv=None) -> int:
                 meas = THESIS["measured_pa"].get(u)
                 print(f"mean MFx3 average-width at {u} m/s: {avg:.3g} Pa"
                       + (f" (thesis {ref} Pa, measured {meas} Pa)" if ref else ""))
+            table45 = _table_4_5(x, r, depth, args.velocity, branched)
+            print("Table 4.5 layout (Pa over the bed depth): "
+                  + "; ".join(f"{k} " + " ".join(f"{v:.3g}" for v in vals.values())
+                              for k, vals in table45.items()))
 
     along = []
     if args.pressure:
@@ -181,7 +186,7 @@ def main(argv=None) -> int:
             "paths": [{**p.summary(), "points_m": p.points.tolist(),
                        "widths_m": p.widths_m.tolist(),
                        "turning_angles_deg": p.turning_angles_deg.tolist()} for p in paths],
-            "branched": branched, "pressure_along_paths": along, "thesis": THESIS,
+            "branched": branched, "table_4_5_pa": table45, "pressure_along_paths": along, "thesis": THESIS,
             "platform": platform.platform(), "cpu_count": os.cpu_count(),
             "loadavg": os.getloadavg(), "timestamp": time.strftime("%Y-%m-%dT%H:%M:%SZ",
                                                                    time.gmtime()),
@@ -193,6 +198,25 @@ def main(argv=None) -> int:
 
         plot_paths(x, paths, args.plot, axis=args.axis, title=source)
     return 0
+
+
+def _table_4_5(x, r, depth, velocities, branched):
+    """Pressure drops over the bed depth (Pa): measured (thesis), branched model (ours, mean of
+    the MFx3 average-width paths), ASABE D272 and Ergun at the bed's porosity (thesis 4.2.2)."""
+    from ._empirical import asabe_d272_gradient, ergun_gradient
+
+    lo, hi = (x - r[:, None]).min(axis=0), (x + r[:, None]).max(axis=0)
+    porosity = 1.0 - float(np.sum(4.0 / 3.0 * np.pi * r**3) / np.prod(hi - lo))
+    us = [f"{u:g}" for u in velocities]
+    return {
+        "measured (thesis)": {u: THESIS["measured_pa"].get(u, float("nan")) for u in us},
+        "branched model": {u: float(np.mean([b["average"]["MFx3"][u] for b in branched]))
+                           for u in us},
+        "ASABE D272": {f"{u:g}": float(asabe_d272_gradient(u) * depth) for u in velocities},
+        f"Ergun (porosity {porosity:.3f})": {
+            f"{u:g}": float(ergun_gradient(u, porosity=porosity, diameter_m=2 * r.mean()) * depth)
+            for u in velocities},
+    }
 
 
 def _pressure_along(args, x, r, source, tess, graph, paths):
