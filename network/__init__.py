@@ -9,10 +9,11 @@ tessellate(packing) -> Tessellation
 
 Command-line tools: ``python -m network.solve`` (permeability, pressure drop),
 ``python -m network.throats`` (throat table for ``cache.precompute``), ``python -m network.bench``.
+
 """
 
 from ._io import Packing, read_packing, write_packing_csv
-from ._tessellation import QHULL_OPTIONS, Tessellation, tessellate
+from ._tessellation import QHULL_OPTIONS, Tessellation, tessellate, tie_groups
 
 __all__ = [
     "Packing",
@@ -21,4 +22,5 @@ __all__ = [
     "Tessellation",
     "tessellate",
     "QHULL_OPTIONS",
+    "tie_groups",
 ]

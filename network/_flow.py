@@ -28,6 +28,8 @@ from typing import Callable
 import numpy as np
 import scipy.sparse as sp
 
+from ._blas import single_threaded_blas
+
 __all__ = [
     "assemble_laplacian",
     "apply_pressure_bc",
@@ -178,7 +180,8 @@ def solve_pressure(A, b, *, tol: float = 1e-12, maxiter: int = 500,
     -----
     With :math:`D = \mathrm{diag}(A)`, CG runs on :math:`\tilde A = D^{-1/2} A D^{-1/2}`,
     :math:`\tilde b = D^{-1/2} b`, preconditioned by ``smoothed_aggregation_solver(Ã,
-    symmetry='symmetric').aspreconditioner()``, and :math:`x = D^{-1/2} \tilde x`. If CG has
+    symmetry='symmetric', coarse_solver='splu').aspreconditioner()``
+    (run with single-threaded OpenBLAS, see :mod:`network._blas`), and :math:`x = D^{-1/2} \tilde x`. If CG has
     not converged after 150 iterations (random contrast over many decades defeats the classical
     strength measure), the hierarchy is rebuilt with ``strength='evolution'`` and CG continues
     from its last iterate (a 14³ grid with log-uniform conductances over 12 decades then
@@ -223,13 +226,14 @@ def solve_pressure(A, b, *, tol: float = 1e-12, maxiter: int = 500,
     y = np.zeros(n)
     flag, levels, setup, solve_t, method = 1, 0, 0.0, 0.0, "pyamg-sa-pcg"
     for strength, limit in (("symmetric", min(maxiter, 150)), ("evolution", maxiter)):
-        t0 = time.perf_counter()
-        ml = pyamg.smoothed_aggregation_solver(As, symmetry="symmetric", strength=strength,
-                                               max_coarse=500)
-        M = ml.aspreconditioner(cycle="V")
-        t1 = time.perf_counter()
-        y, flag = cg(As, bs, x0=y, rtol=tol, atol=0.0, maxiter=limit, M=M, callback=_cb)
-        t2 = time.perf_counter()
+        with single_threaded_blas():
+            t0 = time.perf_counter()
+            ml = pyamg.smoothed_aggregation_solver(As, symmetry="symmetric", strength=strength,
+                                                   max_coarse=500, coarse_solver="splu")
+            M = ml.aspreconditioner(cycle="V")
+            t1 = time.perf_counter()
+            y, flag = cg(As, bs, x0=y, rtol=tol, atol=0.0, maxiter=limit, M=M, callback=_cb)
+            t2 = time.perf_counter()
         setup += t1 - t0
         solve_t += t2 - t1
         levels = len(ml.levels)

@@ -29,7 +29,7 @@ from ._flow import solve_fixed_pressure
 from ._io import Packing
 from ._porosity import region_porosity
 from ._sample import AXES, Region, default_region, prune_disconnected, select_sample
-from ._tessellation import Tessellation, tessellate
+from ._tessellation import Tessellation, tessellate, tie_groups
 
 __all__ = ["FlowResult", "solve_network", "DEFAULT_VELOCITY_M_S", "DEFAULT_DEPTH_M"]
 
@@ -77,6 +77,7 @@ class FlowResult:
     pore_ids: np.ndarray = dataclasses.field(repr=False)
     throat_ids: np.ndarray = dataclasses.field(repr=False)
     conns: np.ndarray = dataclasses.field(repr=False)
+    pore_xyz: np.ndarray = dataclasses.field(repr=False)
 
     @property
     def k_over_d2(self) -> float:
@@ -151,7 +152,7 @@ def solve_network(packing: Packing, *, axis="z", region: Region | None = None,
                   rtol: float = 1e-3, db=None, workers: int = 1, progress: bool = False,
                   tessellation: Tessellation | None = None, solver: Callable | None = None,
                   porosity_points: int = 400_000, conductance: Callable | None = None,
-                  trace_memory: bool = False) -> FlowResult:
+                  trace_memory: bool = False, merge_ties: bool = True) -> FlowResult:
     """Permeability and pressure drop of a packing by the Delaunay network model.
 
     Parameters
@@ -183,6 +184,10 @@ def solve_network(packing: Packing, *, axis="z", region: Region | None = None,
         ``conductance(tessellation, throat_ids) -> g`` overriding model and policy (tests).
     trace_memory : bool
         Record the peak traced memory of each stage (slower; used by the benchmark).
+    merge_ties : bool
+        Join exactly co-spherical tetrahedra (and slivers) into one pore body
+        (:func:`network.tie_groups`) so lattices do not depend on Qhull's tie-breaking
+        (default True; random packings have no exact ties and are unchanged).
 
     Returns
     -------
@@ -205,7 +210,12 @@ def solve_network(packing: Packing, *, axis="z", region: Region | None = None,
         tess = tessellate(packing) if tessellation is None else tessellation
     with stage("sample"):
         reg = default_region(packing, margin=margin, cylinder=cylinder) if region is None else region
-        sample = select_sample(tess, reg, axis=axis)
+        labels = None
+        if merge_ties:
+            labels, n_groups = tie_groups(tess)
+            if n_groups == tess.n_pores:
+                labels = None
+        sample = select_sample(tess, reg, axis=axis, groups=labels)
     with stage("conductance"):
         qstats: dict = {}
         if conductance is not None:
@@ -257,7 +267,7 @@ def solve_network(packing: Packing, *, axis="z", region: Region | None = None,
         porosity_std=eps_err, solver=solver_info, check=chk, qstar_stats=qstats,
         timings_s=times, pressure_pa=p * scale, throat_flow_m3_s=check["throat_flow"] * scale,
         throat_conductance=g, pore_ids=sample.pores, throat_ids=sample.throats,
-        conns=sample.conns)
+        conns=sample.conns, pore_xyz=sample.pore_xyz)
 
 
 class _Stage:

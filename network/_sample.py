@@ -130,7 +130,10 @@ class SampleNetwork:
         Flow axis (0, 1, 2).
     region : Region
     pores : (Ns,) int ndarray
-        Tessellation pore ids of the sample pores (local pore i is ``pores[i]``).
+        Pore-body ids of the sample pores (local pore i is ``pores[i]``): tessellation pore
+        ids, or group labels when tetrahedra were grouped (see ``groups``).
+    pore_xyz : (Ns, 3) ndarray, m
+        Position of each sample pore (volume-weighted centroid of its tetrahedra).
     throats : (Ms,) int ndarray
         Tessellation throat ids joining two sample pores.
     conns : (Ms, 2) int ndarray
@@ -143,11 +146,14 @@ class SampleNetwork:
         Cross-section A, m².
     n_dropped : int
         Pores removed because they do not connect inlet and outlet (0 before pruning).
+    groups : (Np,) int ndarray or None
+        Pore body of every tetrahedron when tetrahedra were grouped, else None.
     """
 
     axis: int
     region: Region
     pores: np.ndarray
+    pore_xyz: np.ndarray
     throats: np.ndarray
     conns: np.ndarray
     inlet: np.ndarray
@@ -155,6 +161,7 @@ class SampleNetwork:
     length_m: float
     area_m2: float
     n_dropped: int = 0
+    groups: np.ndarray | None = None
 
     @property
     def n_pores(self) -> int:
@@ -165,14 +172,14 @@ class SampleNetwork:
         return int(self.throats.size)
 
 
-def _length(tess, pores, inlet, outlet, axis):
-    s = tess.pore_centroid[pores, axis]
+def _length(xyz, inlet, outlet, axis):
+    s = xyz[:, axis]
     if inlet.size == 0 or outlet.size == 0:
         return float("nan")
     return float(s[outlet].mean() - s[inlet].mean())
 
 
-def select_sample(tessellation, region: Region, *, axis="z") -> SampleNetwork:
+def select_sample(tessellation, region: Region, *, axis="z", groups=None) -> SampleNetwork:
     """Pores of a region, the throats joining them, and the inlet/outlet pores along ``axis``.
 
     Parameters
@@ -180,6 +187,10 @@ def select_sample(tessellation, region: Region, *, axis="z") -> SampleNetwork:
     tessellation : Tessellation
     region : Region
     axis : {'x', 'y', 'z'} or int
+    groups : (Np,) array_like of int, optional
+        Pore body of every tetrahedron (e.g. from :func:`network.tie_groups` or the conduit
+        model's merge). Faces inside a body are dropped; a body's position is the
+        volume-weighted centroid of its tetrahedra. Default: every tetrahedron is a pore.
 
     Returns
     -------
@@ -193,23 +204,39 @@ def select_sample(tessellation, region: Region, *, axis="z") -> SampleNetwork:
     """
     ax = _axis_index(axis)
     t = tessellation
-    inside = region.contains(t.pore_centroid, ax)
+    if groups is None:
+        lab = np.arange(t.n_pores, dtype=np.int64)
+        xyz_all = t.pore_centroid
+    else:
+        lab = np.asarray(groups, dtype=np.int64)
+        if lab.shape != (t.n_pores,) or lab.min() < 0:
+            raise ValueError(f"groups must be (Np,) = ({t.n_pores},) labels >= 0, got {lab.shape}")
+        ng = int(lab.max()) + 1
+        vol = np.bincount(lab, t.pore_volume, ng)
+        cnt = np.bincount(lab, None, ng)
+        w = np.where(vol[lab] > 0, t.pore_volume / np.where(vol[lab] > 0, vol[lab], 1.0),
+                     1.0 / cnt[lab])
+        xyz_all = np.column_stack([np.bincount(lab, w * t.pore_centroid[:, k], ng)
+                                   for k in range(3)])
+    inside = region.contains(xyz_all, ax)
     pores = np.flatnonzero(inside)
     if pores.size == 0:
         raise ValueError(f"the sample region {region.lo}–{region.hi} contains no pore")
-    local = np.full(t.n_pores + 1, -1, dtype=np.int64)   # index -1 (hull) maps to -1
+    local = np.full(xyz_all.shape[0] + 1, -1, dtype=np.int64)   # index -1 (hull) maps to -1
     local[pores] = np.arange(pores.size)
     tp = t.throat_pores
-    a = local[tp[:, 0]]
-    b = local[tp[:, 1]]
-    internal = (a >= 0) & (b >= 0)
+    gb_raw = np.where(tp[:, 1] >= 0, lab[np.maximum(tp[:, 1], 0)], -1)
+    ga_raw = lab[tp[:, 0]]
+    same = ga_raw == gb_raw
+    a = local[ga_raw]
+    b = local[gb_raw]
+    internal = (a >= 0) & (b >= 0) & ~same
     # boundary throats: one side inside, other outside or hull
     cross = (a >= 0) ^ (b >= 0)
     th = np.flatnonzero(cross)
     inner_local = np.where(a[th] >= 0, a[th], b[th])
-    outer = np.where(a[th] >= 0, tp[th, 1], tp[th, 0])
-    s_out = np.where(outer >= 0, t.pore_centroid[np.maximum(outer, 0), ax],
-                     t.throat_centroid[th, ax])
+    outer = np.where(a[th] >= 0, gb_raw[th], ga_raw[th])
+    s_out = np.where(outer >= 0, xyz_all[np.maximum(outer, 0), ax], t.throat_centroid[th, ax])
     inlet = np.unique(inner_local[s_out < region.lo[ax]])
     outlet = np.unique(inner_local[s_out > region.hi[ax]])
     both = np.intersect1d(inlet, outlet)
@@ -220,12 +247,13 @@ def select_sample(tessellation, region: Region, *, axis="z") -> SampleNetwork:
                          f"axis {'xyz'[ax]}: region too thin or outside the packing")
     throats = np.flatnonzero(internal)
     conns = np.column_stack([a[throats], b[throats]])
-    length = _length(t, pores, inlet, outlet, ax)
+    xyz = xyz_all[pores]
+    length = _length(xyz, inlet, outlet, ax)
     log.info("sample along %s: %d pores (%d inlet, %d outlet), %d throats, H = %.4g, A = %.4g",
              "xyz"[ax], pores.size, inlet.size, outlet.size, throats.size, length,
              region.cross_section(ax))
-    return SampleNetwork(ax, region, pores, throats, conns, inlet, outlet, length,
-                         region.cross_section(ax))
+    return SampleNetwork(ax, region, pores, xyz, throats, conns, inlet, outlet, length,
+                         region.cross_section(ax), 0, None if groups is None else lab)
 
 
 def prune_disconnected(sample: SampleNetwork, tessellation, g) -> tuple[SampleNetwork, np.ndarray]:
@@ -235,7 +263,7 @@ def prune_disconnected(sample: SampleNetwork, tessellation, g) -> tuple[SampleNe
     ----------
     sample : SampleNetwork
     tessellation : Tessellation
-        For the pore centroids (to recompute the length H).
+        Unused (kept for a stable signature); pore positions come from the sample.
     g : (Ms,) array_like
         Conductance of ``sample.throats``; throats with g = 0 (closed) do not connect.
 
@@ -263,14 +291,15 @@ def prune_disconnected(sample: SampleNetwork, tessellation, g) -> tuple[SampleNe
     inlet = new[sample.inlet[keep[sample.inlet]]]
     outlet = new[sample.outlet[keep[sample.outlet]]]
     pores = sample.pores[keep]
+    xyz = sample.pore_xyz[keep]
     n_drop = int(n - keep.sum())
     if inlet.size == 0 or outlet.size == 0:
         raise ValueError("no conducting path joins inlet and outlet (all throats closed?)")
     if n_drop:
         log.info("dropped %d of %d sample pores not connected to both inlet and outlet", n_drop, n)
     pruned = dataclasses.replace(
-        sample, pores=pores, throats=sample.throats[tkeep], conns=new[sample.conns[tkeep]],
-        inlet=inlet, outlet=outlet,
-        length_m=_length(tessellation, pores, inlet, outlet, sample.axis),
+        sample, pores=pores, pore_xyz=xyz, throats=sample.throats[tkeep],
+        conns=new[sample.conns[tkeep]], inlet=inlet, outlet=outlet,
+        length_m=_length(xyz, inlet, outlet, sample.axis),
         n_dropped=sample.n_dropped + n_drop)
     return pruned, g[tkeep]

@@ -14,10 +14,12 @@ coordinate; ``Qc`` keeps coplanar points; ``Q12`` allows wide facets from nearly
 the choice depends on point order and rounding. Every valid choice tiles the same convex
 hull, so pore volumes always sum to the hull volume to round-off (tested). Ties are detected
 relative to the mean sphere diameter :math:`\bar d`: a tetrahedron is *flat* when its
-volume is below ``flat_tol`` :math:`\bar d^3` (default 1e-9) and two neighbouring tetrahedra are
+volume is below ``flat_tol`` :math:`\bar d^3` (default 1e-6) and two neighbouring tetrahedra are
 *co-spherical* when their circumcentres differ by less than ``tie_tol`` :math:`\bar d`
-(default 1e-6). These flags are returned; merging such groups into one pore body is the
-conduit model's job (``network._merge``).
+(default 1e-6). These flags are returned, and :func:`tie_groups` joins every exactly tied
+group into one pore body, so that the network does not depend on Qhull's tie-breaking
+(merging *nearly* co-spherical groups, with a tolerance meant for jittered lattices and real
+packings, is the conduit model's ``network._merge``).
 """
 
 from __future__ import annotations
@@ -26,11 +28,13 @@ import dataclasses
 import logging
 
 import numpy as np
+import scipy.sparse as sp
+from scipy.sparse.csgraph import connected_components
 from scipy.spatial import Delaunay, QhullError
 
 from ._io import Packing
 
-__all__ = ["Tessellation", "tessellate", "QHULL_OPTIONS"]
+__all__ = ["Tessellation", "tessellate", "QHULL_OPTIONS", "tie_groups"]
 
 log = logging.getLogger(__name__)
 
@@ -140,7 +144,7 @@ def _circumcenters(p: np.ndarray) -> np.ndarray:
 
 
 def tessellate(packing: Packing, *, qhull_options: str = QHULL_OPTIONS,
-               flat_tol: float = 1e-9, tie_tol: float = 1e-6) -> Tessellation:
+               flat_tol: float = 1e-6, tie_tol: float = 1e-6) -> Tessellation:
     r"""Delaunay tessellation of the sphere centres into pores and throats.
 
     Parameters
@@ -150,7 +154,7 @@ def tessellate(packing: Packing, *, qhull_options: str = QHULL_OPTIONS,
     qhull_options : str, optional
         Options for ``scipy.spatial.Delaunay`` (default ``"Qbb Qc Qz Q12"``).
     flat_tol : float, optional
-        A tetrahedron with volume < ``flat_tol`` :math:`\bar d^3` is flagged flat (default 1e-9).
+        A tetrahedron with volume < ``flat_tol`` :math:`\bar d^3` is flagged flat (default 1e-6).
     tie_tol : float, optional
         Interior faces whose two circumcentres are closer than ``tie_tol`` :math:`\bar d` are
         flagged tied (default 1e-6).
@@ -251,3 +255,49 @@ def tessellate(packing: Packing, *, qhull_options: str = QHULL_OPTIONS,
         throat_sides=np.column_stack([l12, l13, l23]), throat_area=area,
         throat_centroid=xyz.mean(axis=1), pore_flat=flat, throat_tied=tied,
         coplanar_points=coplanar)
+
+
+def tie_groups(tessellation: Tessellation) -> tuple[np.ndarray, int]:
+    """Pore bodies that join tetrahedra whose split is only Qhull's tie-breaking.
+
+    Two neighbouring tetrahedra join when their circumcentres coincide to ``tie_tol`` d̄ (both
+    non-flat): a co-spherical group such as the 8 corners of a simple-cubic cell or an FCC
+    octahedral hole. A flat tetrahedron (sliver, e.g. four coplanar corners of a cube face)
+    joins exactly one neighbour, the one across its largest face (a non-flat one when it has
+    any): joining it to both sides would fuse two different voids. Either side gives the same
+    network by symmetry, and the sliver's remaining faces become the throats of that link.
+
+    Returns
+    -------
+    labels : (Np,) int ndarray
+        Group of every tetrahedron (0 .. n_groups-1); random packings give the identity up to
+        renumbering (no exact ties).
+    n_groups : int
+    """
+    t = tessellation
+    n = t.n_pores
+    flat = t.pore_flat
+    tp = t.throat_pores
+    tied = t.throat_tied & (tp[:, 1] >= 0)
+    both_round = tied & ~flat[tp[:, 0]] & ~flat[np.maximum(tp[:, 1], 0)]
+    e = [tp[both_round]]
+    fl = np.flatnonzero(flat)
+    if fl.size:
+        nb = t.pore_neighbors[fl]                                # (F, 4)
+        area = t.throat_area[t.pore_throats[fl]]
+        valid = nb >= 0
+        round_nb = valid & ~flat[np.maximum(nb, 0)]
+        # prefer non-flat neighbours, then larger faces
+        score = np.where(round_nb, 2.0, np.where(valid, 1.0, 0.0)) * (1.0 + area / (area.max() + 1e-300))
+        pick = np.argmax(score, axis=1)
+        chosen = nb[np.arange(fl.size), pick]
+        ok = chosen >= 0
+        e.append(np.column_stack([fl[ok], chosen[ok]]))
+    edges = np.vstack(e) if e else np.zeros((0, 2), dtype=np.int64)
+    adj = sp.coo_array((np.ones(edges.shape[0]), (edges[:, 0], edges[:, 1])), shape=(n, n))
+    n_groups, labels = connected_components(adj, directed=False)
+    if n_groups < n:
+        log.info("joined %d tied/flat tetrahedra into %d pore bodies (%d pores remain)",
+                 n - n_groups + int((np.bincount(labels) > 1).sum()),
+                 int((np.bincount(labels) > 1).sum()), n_groups)
+    return labels.astype(np.int64), int(n_groups)

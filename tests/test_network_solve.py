@@ -1,0 +1,143 @@
+"""The network model end to end: invariances, isotropy, pruning, tie-breaking (issue 4, item 8)."""
+
+import numpy as np
+import pytest
+from scipy.sparse.linalg import spsolve
+
+import throats
+from network import Packing, tessellate
+from network._generate import random_packing
+from network._lattices import lattice_packing
+from network._pipeline import solve_network
+from network._sample import Region, default_region, prune_disconnected, select_sample
+
+MU = 1.932e-5
+
+
+def area_conductance(t, idx):
+    """A Q*-free stand-in: a circle of the throat's open area over L = 2 r̄, g = A²/(8π μ L)."""
+    a = np.maximum(throats.open_area(t.throat_radii[idx], t.throat_sides[idx]), 0.0)
+    return a**2 / (8 * np.pi * MU * 2 * t.throat_radii[idx].mean(axis=1))
+
+
+@pytest.fixture(scope="module")
+def small_bed():
+    return random_packing(700, rng=4, periodic=True, solid_fraction=0.6)
+
+
+def run(pk, **kw):
+    kw.setdefault("conductance", area_conductance)
+    kw.setdefault("porosity_points", 0)
+    return solve_network(pk, **kw)
+
+
+def test_bcc_lattice_is_isotropic():
+    """A BCC array has cubic symmetry and a unique Delaunay tessellation: k_x = k_y = k_z."""
+    c, r = lattice_packing("bcc", 0.5, n_cells=6, include_far_faces=True)
+    pk = Packing(c, r)
+    reg = default_region(pk, margin=0.6e-3)
+    ks = [run(pk, axis=a, region=reg).permeability_m2 for a in "xyz"]
+    np.testing.assert_allclose(ks, ks[0], rtol=1e-9)
+
+
+def test_translation_and_axis_rotation_invariance(small_bed):
+    pk = small_bed
+    base = run(pk, axis="x")
+    shifted = run(Packing(pk.centers + [0.3, -1.2, 5.0], pk.radii), axis="x")
+    np.testing.assert_allclose(shifted.permeability_m2, base.permeability_m2, rtol=1e-9)
+    # rotate 90 degrees about z: x -> y, y -> -x; flow along x becomes flow along y
+    rot = pk.centers @ np.array([[0, 1, 0], [-1, 0, 0], [0, 0, 1.0]])
+    turned = run(Packing(rot, pk.radii), axis="y")
+    np.testing.assert_allclose(turned.permeability_m2, base.permeability_m2, rtol=1e-9)
+    assert turned.n_pores == base.n_pores
+
+
+def test_amg_equals_direct_solve(small_bed):
+    a = run(small_bed, axis="z")
+    b = run(small_bed, axis="z", solver=spsolve)
+    np.testing.assert_allclose(a.permeability_m2, b.permeability_m2, rtol=1e-9)
+    np.testing.assert_allclose(a.pressure_pa, b.pressure_pa, rtol=1e-8, atol=1e-12)
+    assert a.check["ok"] and a.check["balance_error"] < 1e-8
+
+
+def test_flow_imposed_matches_velocity(small_bed):
+    """Pressures are those of the thesis BC: total inlet flow = v A (Appendix G)."""
+    res = run(small_bed, axis="z", velocity_m_s=0.02)
+    t = tessellate(small_bed)
+    # recover inlet flow from the scaled throat flows leaving inlet pores
+    q = res.throat_flow_m3_s
+    inlet = np.zeros(res.n_pores, bool)
+    sample = select_sample(t, default_region(small_bed), axis="z")
+    assert res.n_inlet == sample.inlet.size
+    net = np.bincount(res.conns[:, 0], q, res.n_pores) - np.bincount(res.conns[:, 1], q, res.n_pores)
+    inlet_flow = None
+    # the outlet pores are at p = 0 and the inlet pores at the top pressure
+    top = res.pressure_pa.max()
+    inlet = np.isclose(res.pressure_pa, top, rtol=1e-12)
+    inlet_flow = net[inlet].sum()
+    np.testing.assert_allclose(inlet_flow, 0.02 * res.area_m2, rtol=1e-8)
+    np.testing.assert_allclose(res.pressure_gradient_pa_per_m, MU * 0.02 / res.permeability_m2)
+
+
+def test_disconnected_pores_are_dropped(small_bed):
+    """Closing every face of some pores isolates them; they are dropped and counted."""
+    t = tessellate(small_bed)
+    reg = default_region(small_bed)
+    sample = select_sample(t, reg, axis="z")
+    victims = sample.pores[len(sample.pores) // 2: len(sample.pores) // 2 + 5]
+    closed = np.isin(t.throat_pores, victims).any(axis=1)
+
+    def cond(tt, idx):
+        g = area_conductance(tt, idx)
+        return np.where(closed[idx], 0.0, g)
+
+    res = run(small_bed, axis="z", region=reg, conductance=cond)
+    assert res.n_dropped >= 5
+    assert res.check["ok"]
+    # direct check of the pruning routine on the same sample
+    g = cond(t, sample.throats)
+    pruned, g_kept = prune_disconnected(sample, t, g)
+    assert not np.isin(victims, pruned.pores).any()
+    assert np.all(g_kept > 0) and pruned.n_dropped == res.n_dropped
+
+
+@pytest.mark.parametrize("kind, phi", [("sc", 0.45), ("fcc", 0.6)])
+def test_tie_breaking_does_not_change_the_answer(kind, phi):
+    """Exact SC/FCC lattices (8 / 6 co-spherical centres per hole) tessellated with different
+    tie-breakings: point order permuted, rotated 90 degrees, jittered by 1e-9 a.
+
+    Stated tolerance: with tied groups joined (default, ``tie_groups``) the permeability agrees
+    to 1e-6 relative (measured ~4e-9). Without joining, the per-face network depends on the
+    split: measured spread 15 % (SC) and 1.8 % (FCC) on these cases.
+    """
+    c, r = lattice_packing(kind, phi, n_cells=5, include_far_faces=True)
+    rot = np.array([[0, 1, 0], [-1, 0, 0], [0, 0, 1.0]])
+    variants = [c, c[np.random.default_rng(1).permutation(len(c))], c @ rot,
+                c + np.random.default_rng(2).normal(0, 1e-12, c.shape)]
+    ks, raw = [], []
+    for cc in variants:
+        reg = Region(cc.min(0) + 1.2e-3, cc.max(0) - 1.2e-3)
+        ks.append(run(Packing(cc, r), axis="z", region=reg).permeability_m2)
+        raw.append(run(Packing(cc, r), axis="z", region=reg, merge_ties=False).permeability_m2)
+    spread = (max(ks) - min(ks)) / np.mean(ks)
+    assert spread < 1e-6, f"tie-breaking spread {spread:.2e}: {ks}"
+    raw_spread = (max(raw) - min(raw)) / np.mean(raw)
+    assert raw_spread > 1e-3   # the problem is real: without joining, ties change the answer
+
+
+@pytest.mark.parametrize("kw, match", [
+    (dict(axis="w"), "axis must be"),
+    (dict(velocity_m_s=-1.0), "velocity must be > 0"),
+    (dict(region=Region([10, 10, 10], [11, 11, 11])), "contains no pore"),
+])
+def test_bad_arguments(small_bed, kw, match):
+    with pytest.raises(ValueError, match=match):
+        run(small_bed, **kw)
+
+
+def test_region_validation():
+    with pytest.raises(ValueError, match="lo < hi"):
+        Region([0, 0, 1], [1, 1, 0])
+    pk = random_packing(50, rng=0, periodic=True)
+    with pytest.raises(ValueError, match="leaves no interior"):
+        default_region(pk, margin=1.0)
