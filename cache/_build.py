@@ -22,7 +22,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ._signature import _throats_attr, as_throats, match_keys, shape_keys, signature
+from ._signature import _throats_attr, as_throats, shape_keys, signature
 
 logger = logging.getLogger(__name__)
 
@@ -165,13 +165,9 @@ def precompute_throats(store, radii, sides, *, rtol=1e-3, solver=None, solver_ve
     uniq = good[np.sort(first)]
     summary.n_unique = len(uniq) + len(bad)
 
-    have = store.load(solver_version=solver_version)
-    same_tol = np.isclose(have["rtol"], rtol, rtol=1e-9, atol=0)
-    idx = match_keys(keys[uniq], have["keys"][same_tol])
-    st = have["status"][same_tol]
-    hit = idx >= 0
-    st_hit = st[np.maximum(idx, 0)] if len(st) else np.full(len(idx), "")
-    done_ok = hit & np.isin(st_hit, ["ok", "closed"])
+    have = store.lookup_keys(keys[uniq], solver_version=solver_version, rtol=rtol)
+    hit = have["found"]
+    done_ok = hit & np.isin(have["status"], ["ok", "closed"])
     done_bad = hit & ~done_ok
     summary.reused = int(done_ok.sum())
     summary.reused_failed = int(done_bad.sum()) if not retry_failed else 0

@@ -20,17 +20,22 @@ evaluation on the raw order) while precomputation solves each distinct shape onl
 
 Interpolated value and error estimate
 -------------------------------------
-The table interpolates :math:`v = \ln Q^*` multilinearly (32 corners).  The error estimate
-compares the grid with its own coarse sub-grid (every other node): at a fine node
-:math:`D = |v - I_{2h} v|` is the coarse interpolant's error, and a multilinear interpolant's
-error scales as :math:`h^2`, so a fine cell's error is estimated as
+The table interpolates :math:`v = \ln Q^*`: multilinearly over the 32 corners of the cell,
+plus a curvature correction per direction (see :class:`GridTable`), which makes the
+interpolant exact for every quadratic in :math:`x` and third-order accurate.  The error
+estimate compares the grid with its own coarse sub-grid (every other node): at a fine node
+:math:`D = |v - I_{2h} v|` is the coarse interpolant's error; a third-order interpolant's
+error scales as :math:`h^3`, so a fine cell's error is estimated as
 
-.. math:: e_\text{cell} = c_s \max_\text{corners} D / 4 + \max_\text{corners} e_\text{FE},
+.. math:: e_\text{cell} = c_s \max_\text{corners} D / 8 + \max_\text{corners} e_\text{FE},
 
-with safety factor :math:`c_s` (``ERROR_SAFETY``) calibrated on held-out FE solves, plus the
-solver's own error estimate at the corners.  Cells with a corner that is missing, invalid or
-closed (Q* = 0) get :math:`e = \infty`: the lookup never serves them from the table.
-Because :math:`|\Delta \ln Q^*|` is the relative error of Q*, the estimate is relative.
+with safety factor :math:`c_s` (``ERROR_SAFETY``, calibrated on held-out FE solves) and the
+solver's own error estimate at the corners.  Where the coarse sub-grid cannot judge a cell
+(one of its coarse corners is invalid) the estimate is the size of the curvature correction,
+:math:`\sum_d |H_d^2 \bar v''_d| / 8`, a conservative bound for a third-order interpolant.
+Cells with a corner that is missing, invalid or closed (Q* = 0), and points outside the
+box, get :math:`e = \infty`: the lookup never serves them from the table.  Because
+:math:`|\Delta \ln Q^*|` is the relative error of Q*, the estimate is relative.
 """
 
 from __future__ import annotations
@@ -194,7 +199,7 @@ class GridTable:
         # per-cell curvature coefficients k_d = H_d^2 * mean(v''_d) / 2, stored at the lower node
         self._k = []
         for d in range(5):
-            if not self.curvature or shape[d] < 3:
+            if shape[d] < 3:
                 self._k.append(None)
                 continue
             h = np.diff(self._axes[d])
@@ -203,13 +208,21 @@ class GridTable:
             hh = np.append(h, h[-1]) ** 2
             kd *= 0.5 * hh.reshape([-1 if k == d else 1 for k in range(5)])
             self._k.append(np.ascontiguousarray(kd.ravel()))
+        # fallback estimate where the coarse sub-grid cannot judge a cell: the largest size of
+        # the curvature correction, sum_d |k_d| / 4 (what plain multilinear would miss)
+        k_size = np.zeros(shape)
+        for d in range(5):
+            if self._k[d] is not None:
+                k_size += np.abs(self._k[d].reshape(shape)) / 4
+        self.estimated = np.zeros(shape, dtype=bool)
         if estimate:
             dnode = self._coarse_difference(v)
             order = 3.0 if self.curvature else 2.0
             e_cell = safety * _cell_max(np.where(np.isfinite(dnode), dnode, np.inf)) / 2**order
-            e_cell = e_cell + _cell_max(fe)
+            self.estimated = np.isfinite(e_cell)
+            e_cell = np.where(self.estimated, e_cell, k_size) + _cell_max(fe)
         else:
-            e_cell = _cell_max(fe)
+            e_cell = k_size + _cell_max(fe)
         e_cell[~_cell_all(good)] = np.inf
         self.cell_error = e_cell
         self._flat_values = np.ascontiguousarray(self.values.ravel())
@@ -262,7 +275,8 @@ class GridTable:
             offsets = [o + b * int(self._strides[d]) for o in offsets for b in (0, 1)]
         # vals[o:] is a view: take(base) from it gathers v[base + o] without an index array
         self._f32 = {"views": [vals[o:] for o in offsets], "dims": dims,
-                     "k": [None if k is None else k.astype(np.float32) for k in self._k],
+                     "k": [None if (k is None or not self.curvature) else k.astype(np.float32)
+                           for k in self._k],
                      "err": self._flat_error.astype(np.float32)}
 
     def _eval(self, x):

@@ -74,7 +74,11 @@ def default_db_path():
     return Path.home() / ".cache" / "grainflow" / "throats.sqlite"
 
 
-def shipped_grid_path(name="coarse"):
+#: grid served when a table has none of its own (shipped in ``cache/data``)
+DEFAULT_GRID = "g1"
+
+
+def shipped_grid_path(name=DEFAULT_GRID):
     """Path of the grid table shipped with the package (``cache/data/grid_<name>.npz``)."""
     return _DATA / f"grid_{name}.npz"
 
@@ -101,9 +105,13 @@ def _grid_from_store(store, name, solver_version):
     qq = rows["qstar"][same][idx[hit]]
     q[hit] = np.where(st == "closed", 0.0, np.where(st == "ok", qq, np.nan))
     fe[hit] = rows["error_estimate"][same][idx[hit]]
-    logger.info("grid %r from %s: %d of %d nodes solved", name, store.path, int(np.isfinite(q).sum()),
-                len(q))
-    return GridTable(spec, q, fe)
+    valid, _ = _throats_attr("validate_throats")(nr, ns)
+    n_missing = int(np.sum(valid & ~hit))
+    logger.info("grid %r from %s: %d of %d nodes solved, %d valid nodes missing", name, store.path,
+                int(np.isfinite(q).sum()), len(q), n_missing)
+    table = GridTable(spec, q, fe)
+    table.n_missing = n_missing
+    return table
 
 
 def export_grid(store, name, path, *, solver_version):
@@ -128,22 +136,25 @@ def load_grid_table(db=None, *, grid=None, solver_version=None):
         solver_version = _build.default_solver()[1]
     path = Path(db) if db is not None else default_db_path()
     if path.exists() and path.stat().st_size > 0:
-        key = (str(path.resolve()), grid, solver_version, path.stat().st_mtime_ns)
-        if key in _TABLES:
-            return _TABLES[key]
+        key = (str(path.resolve()), grid, solver_version)
+        cached = _TABLES.get(key)
+        mtime = path.stat().st_mtime_ns
+        if cached is not None and (cached[0] == mtime or cached[1]):
+            return cached[2]  # unchanged file, or a complete grid (FE rows never alter nodes)
         with open_store(path, create=False) as store:
             names = store.grid_names()
             name = grid if grid is not None else (names[-1] if names else None)
             table = _grid_from_store(store, name, solver_version) if name in names else None
         if table is not None:
-            _TABLES.clear()
-            _TABLES[key] = table
+            complete = table.n_missing == 0
+            _TABLES[key] = (mtime, complete, table)
             return table
-    name = grid or "coarse"
+    name = grid or DEFAULT_GRID
     shipped = shipped_grid_path(name)
     if shipped.exists():
         key = (str(shipped), name, solver_version, shipped.stat().st_mtime_ns)
         if key not in _TABLES:
+            _TABLES[key] = None
             import json
 
             z = np.load(shipped, allow_pickle=False)
@@ -275,8 +286,8 @@ def _settle(r, s, rows, q, err, src, msg, stats, *, db, policy, rtol, workers, p
         return
     with open_store(path, create=policy != "table-only") as store:
         found = _exact(store, keys, rtol, solver_version)
-        hit = found["idx"] >= 0
-        _assign_exact(rows[hit], found, found["idx"][hit], q, err, src, msg, "exact")
+        hit = found["found"]
+        _assign_exact(rows[hit], found, hit, q, err, src, msg, "exact")
         miss, mkeys = rows[~hit], keys[~hit]
         if not len(miss):
             return
@@ -290,28 +301,24 @@ def _settle(r, s, rows, q, err, src, msg, stats, *, db, policy, rtol, workers, p
         stats["n_fe"] += summ.solved + summ.failed
         stats["fe_seconds"] = stats.get("fe_seconds", 0.0) + summ.seconds
         found = _exact(store, mkeys, rtol, solver_version, statuses=None)
-        hit = found["idx"] >= 0
-        _assign_exact(miss[hit], found, found["idx"][hit], q, err, src, msg, "fe")
+        hit = found["found"]
+        _assign_exact(miss[hit], found, hit, q, err, src, msg, "fe")
         lost = miss[~hit]
         q[lost], err[lost], src[lost] = np.nan, np.nan, "failed"
         msg[lost] = "no stored result after the FE solve"
 
 
 def _exact(store, keys, rtol, solver_version, statuses=("ok", "closed")):
-    rows = store.load(solver_version=solver_version, max_rtol=rtol, statuses=statuses)
-    if len(rows["rtol"]) > 1:  # prefer the most accurate row of each shape
-        order = np.lexsort((rows["rtol"],) + tuple(rows["keys"].T[::-1]))
-        rows = {k: v[order] for k, v in rows.items()}
-    rows["idx"] = match_keys(keys, rows["keys"])
-    return rows
+    """Stored rows for ``keys`` with tolerance <= rtol (the most accurate one per shape)."""
+    return store.lookup_keys(keys, solver_version=solver_version, max_rtol=rtol, statuses=statuses)
 
 
-def _assign_exact(dest, rows, idx, q, err, src, msg, label):
-    st = rows["status"][idx]
-    q[dest] = np.where(st == "closed", 0.0, rows["qstar"][idx])
-    err[dest] = np.where(st == "closed", 0.0, rows["error_estimate"][idx])
+def _assign_exact(dest, rows, sel, q, err, src, msg, label):
+    st = rows["status"][sel]
+    q[dest] = np.where(st == "closed", 0.0, rows["qstar"][sel])
+    err[dest] = np.where(st == "closed", 0.0, rows["error_estimate"][sel])
     src[dest] = np.where(st == "closed", "closed", np.where(st == "ok", label, "failed"))
-    msg[dest] = np.where(st == "ok", "", rows["message"][idx])
+    msg[dest] = np.where(st == "ok", "", rows["message"][sel])
 
 
 def _shape_factor_rows(r, s, rows, q, err, src):

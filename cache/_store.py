@@ -220,6 +220,61 @@ class ThroatStore:
             "message": np.array(["" if v is None else v for v in cols[19]], dtype=object),
         }
 
+    def lookup_keys(self, keys, *, solver_version, rtol=None, max_rtol=None, statuses=None):
+        """Stored rows for M given keys, through the unique index (O(M log N), not O(N)).
+
+        Returns a dict of (M,) arrays aligned with ``keys``: ``found`` (bool), ``rtol``,
+        ``qstar``, ``open_area``, ``contact_type``, ``error_estimate``, ``status``,
+        ``message``.  ``rtol`` selects exactly that tolerance; ``max_rtol`` any tolerance up to
+        it, the smallest winning.
+        """
+        keys = np.asarray(keys, dtype=np.int64).reshape(-1, 5)
+        m = len(keys)
+        out = {"found": np.zeros(m, bool), "rtol": np.full(m, np.nan), "qstar": np.full(m, np.nan),
+               "open_area": np.full(m, np.nan), "contact_type": np.full(m, "", dtype="<U1"),
+               "error_estimate": np.full(m, np.nan), "status": np.full(m, "", dtype="<U8"),
+               "message": np.full(m, "", dtype=object)}
+        if m == 0:
+            return out
+        where, args = ["t.solver_version = ?"], [str(solver_version)]
+        if rtol is not None:
+            where.append("t.rtol = ?")
+            args.append(float(rtol))
+        if max_rtol is not None:
+            where.append("t.rtol <= ?")
+            args.append(float(max_rtol) * (1 + 1e-12))
+        if statuses is not None:
+            statuses = list(statuses)
+            where.append(f"t.status IN ({', '.join('?' * len(statuses))})")
+            args += statuses
+        try:
+            c = self.conn
+            c.execute("CREATE TEMP TABLE IF NOT EXISTS _q "
+                      "(i INTEGER, k1 INTEGER, k2 INTEGER, k3 INTEGER, k4 INTEGER, k5 INTEGER)")
+            c.execute("DELETE FROM _q")
+            c.executemany("INSERT INTO _q VALUES (?, ?, ?, ?, ?, ?)",
+                          ((i, *map(int, k)) for i, k in enumerate(keys)))
+            res = c.execute(
+                "SELECT q.i, t.rtol, t.qstar, t.open_area, t.contact_type, t.error_estimate, "
+                "t.status, t.message FROM _q q JOIN throats t ON t.k1 = q.k1 AND t.k2 = q.k2 "
+                "AND t.k3 = q.k3 AND t.k4 = q.k4 AND t.k5 = q.k5 WHERE " + " AND ".join(where)
+                + " ORDER BY q.i, t.rtol DESC", args).fetchall()
+            c.execute("DELETE FROM _q")
+        except sqlite3.DatabaseError as e:
+            if isinstance(e, sqlite3.OperationalError) and "locked" in str(e):
+                raise
+            raise CacheFileError(f"{self.path}: cannot read the throat table ({e})") from e
+        for i, rt, q, a, ct, ee, st, msg in res:  # smallest rtol last: it wins
+            out["found"][i] = True
+            out["rtol"][i] = rt
+            out["qstar"][i] = np.nan if q is None else q
+            out["open_area"][i] = np.nan if a is None else a
+            out["contact_type"][i] = ct or ""
+            out["error_estimate"][i] = np.nan if ee is None else ee
+            out["status"][i] = st
+            out["message"][i] = msg or ""
+        return out
+
     def count(self, **filters):
         """Number of rows (optionally ``status='ok'`` etc.)."""
         if not filters:

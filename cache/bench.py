@@ -1,0 +1,224 @@
+"""Benchmark: speed against error of every way to get Q* (shape factor … tables … FE).
+
+    python -m cache.bench [--db throats.sqlite] [--n-fe 300] [--seed 2024] [--out cache_bench.json]
+
+1. Held-out throats: a random packing of 5.5–7.5 mm spheres (``cache._sample``, seed
+   ``--seed``), ``--n-fe`` of its Delaunay faces; reference Q* by FE at ``rtol=1e-4``
+   (``throats.solve_fem``).  No grid is built from packings, so these are never table nodes.
+2. For every grid table in ``--db`` (and the shipped one): interpolation error (median, p90,
+   p99, max) against the reference, coverage (rows with a finite error estimate), and how
+   often the estimate bounds the true error.
+3. Policies: 'shape-factor', 'table-only', 'table+fe' at several ``rtol`` (on a scratch copy
+   of the table, so the solves do not pollute it), 'fe-only' (FE at rtol 1e-3): error and
+   time per throat.
+4. Throughput: ``lookup_qstar(policy='table-only')`` and 'shape-factor' on one batch of
+   ``--n-batch`` throats (the held-out set tiled and shuffled), wall and CPU seconds, repeated.
+5. Table size on disk and the precompute time recorded in the table.
+
+Prints a table and writes JSON (with load average, platform, CPU count, timestamp).
+"""
+
+from __future__ import annotations
+
+import argparse
+import datetime as _dt
+import json
+import os
+import platform
+import shutil
+import sys
+import tempfile
+import time
+from pathlib import Path
+
+import numpy as np
+
+
+def _pct(err):
+    err = np.asarray(err, float)
+    err = err[np.isfinite(err)]
+    if not len(err):
+        return {"n": 0}
+    p = np.percentile(err, [50, 90, 99, 100])
+    return {"n": int(len(err)), "median": float(p[0]), "p90": float(p[1]), "p99": float(p[2]),
+            "max": float(p[3])}
+
+
+def _timed(fn, repeat):
+    walls, cpus, out = [], [], None
+    for _ in range(repeat):
+        c0, t0 = time.process_time(), time.perf_counter()
+        out = fn()
+        walls.append(time.perf_counter() - t0)
+        cpus.append(time.process_time() - c0)
+    return out, walls, cpus
+
+
+def build_parser():
+    p = argparse.ArgumentParser(prog="python -m cache.bench", description=__doc__.split("\n")[0])
+    p.add_argument("--db", default=None, help="table with grid(s) (default: cache.default_db_path())")
+    p.add_argument("--n-fe", type=int, default=300, help="held-out throats solved by FE")
+    p.add_argument("--seed", type=int, default=2024)
+    p.add_argument("--n-batch", type=int, default=1_000_000, help="rows in the throughput batch")
+    p.add_argument("--repeat", type=int, default=3)
+    p.add_argument("--rtols", default="3e-2,1e-2,3e-3,1e-3", help="rtol values for table+fe")
+    p.add_argument("--reference", default=None,
+                   help="npz to cache the held-out FE reference in (reused when it exists)")
+    p.add_argument("--out", default="cache_bench.json")
+    return p
+
+
+def main(argv=None) -> int:
+    args = build_parser().parse_args(argv)
+    import cache
+    import throats
+    from cache._interp import GridSpec, GridTable
+    from cache._lookup import _grid_from_store, shipped_grid_path
+    from cache._sample import _sample_throats
+
+    db = Path(args.db) if args.db else cache.default_db_path()
+    version = throats.SOLVER_VERSION
+    res = {"timestamp": _dt.datetime.now(_dt.timezone.utc).isoformat(timespec="seconds"),
+           "platform": platform.platform(), "python": sys.version.split()[0],
+           "cpu_count": os.cpu_count(), "loadavg_start": os.getloadavg(), "db": str(db),
+           "solver_version": version, "seed": args.seed}
+
+    # 1. held-out throats and their FE reference -------------------------------------------
+    ref_path = Path(args.reference) if args.reference else None
+    if ref_path and ref_path.exists():
+        z = np.load(ref_path)
+        r, s, q_ref, q_fe, t_fe = z["radii"], z["sides"], z["q_ref"], z["q_fe"], float(z["t_fe"])
+    else:
+        r, s = _sample_throats(args.n_fe, rng=args.seed)
+        ref = throats.solve_fem(r, s, rtol=1e-4)
+        t0 = time.perf_counter()
+        fe = throats.solve_fem(r, s, rtol=1e-3)
+        t_fe = (time.perf_counter() - t0) / len(r)
+        q_ref, q_fe = ref.qstar, fe.qstar
+        if ref_path:
+            np.savez(ref_path, radii=r, sides=s, q_ref=q_ref, q_fe=q_fe, t_fe=t_fe)
+    good = np.isfinite(q_ref) & (q_ref > 0)
+    r, s, q_ref, q_fe = r[good], s[good], q_ref[good], q_fe[good]
+    n = len(r)
+    res["n_heldout"] = n
+    rows = []
+
+    def rel(q):
+        return np.abs(np.asarray(q) / q_ref - 1)
+
+    # 2. grid tables ------------------------------------------------------------------------
+    tables = {}
+    if db.exists():
+        with cache.open_store(db, create=False) as st:
+            for name in st.grid_names():
+                t = _grid_from_store(st, name, version)
+                if t is not None:
+                    tables[f"{name} (db)"] = t
+            res["table_rows"] = st.count()
+            res["table_ok_rows"] = st.count(status="ok")
+            solve_s = st.conn.execute("SELECT sum(seconds) FROM throats").fetchone()[0]
+            res["precompute_solve_seconds"] = solve_s
+        res["db_bytes"] = db.stat().st_size
+    for name in ("g1", "g2"):
+        sp = shipped_grid_path(name)
+        if sp.exists():
+            z = np.load(sp)
+            if str(z["solver_version"]) == version:
+                tables[f"{name} (shipped)"] = GridTable(
+                    GridSpec.from_dict(json.loads(str(z["spec"]))), z["qstar"], z["fe_error"])
+                res[f"shipped_{name}_bytes"] = sp.stat().st_size
+    x = cache.grid_coordinates(r, s)
+    res["tables"] = {}
+    for name, t in tables.items():
+        for curv in (False, True):
+            tt = t if curv else GridTable(t.spec, t.qstar, t.fe_error, curvature=False)
+            q, e = tt(x)
+            err = rel(q)
+            fin = np.isfinite(e)
+            key = f"{name} {'curvature' if curv else 'multilinear'}"
+            res["tables"][key] = {
+                "nodes": int(t.qstar.size), "error_all": _pct(err), "error_covered": _pct(err[fin]),
+                "coverage": float(fin.mean()),
+                "estimate_bounds_error": float(np.mean(err[fin] <= e[fin])) if fin.any() else None,
+                "estimate_median": float(np.median(e[fin])) if fin.any() else None}
+    # 3. policies ---------------------------------------------------------------------------
+    sf, w, _ = _timed(lambda: throats.shape_factor_qstar(r, s), 1)
+    rows.append(("shape-factor", _pct(rel(sf)), w[0] / n, 0.0))
+    best = None
+    for name in tables:
+        if name.startswith("g1"):
+            best = name
+            break
+    if best is None and tables:
+        best = next(iter(tables))
+    if best is not None:
+        t = tables[best]
+        lk, w, _ = _timed(lambda: cache.lookup_qstar(r, s, db=db, policy="table-only", table=t), 1)
+        rows.append((f"table-only [{best}]", _pct(rel(lk.qstar)), w[0] / n,
+                     float(np.mean(lk.source == "shape-factor"))))
+        for rt in [float(v) for v in args.rtols.split(",") if v]:
+            with tempfile.TemporaryDirectory() as tmp:
+                scratch = Path(tmp) / "scratch.sqlite"
+                if db.exists():
+                    with cache.open_store(db, create=False) as st:  # consistent copy (WAL)
+                        st.conn.execute("PRAGMA wal_checkpoint(FULL)")
+                    shutil.copy(db, scratch)
+                lk, w, _ = _timed(lambda: cache.lookup_qstar(r, s, db=scratch, policy="table+fe",
+                                                             rtol=rt, table=t), 1)
+            rows.append((f"table+fe rtol={rt:g} [{best}]", _pct(rel(lk.qstar)), w[0] / n,
+                         lk.stats["n_fe"] / n))
+    rows.append(("fe-only (FE rtol=1e-3)", _pct(rel(q_fe)), t_fe, 1.0))
+    res["policies"] = [{"method": m, "error": e, "seconds_per_throat": sec, "fraction_fe_or_sf": f}
+                       for m, e, sec, f in rows]
+
+    # 4. throughput --------------------------------------------------------------------------
+    if best is not None:
+        rng = np.random.default_rng(args.seed)
+        idx = rng.integers(0, n, args.n_batch)
+        rb, sb = r[idx] * rng.uniform(0.5, 2.0, (args.n_batch, 1)), None
+        sb = s[idx] * (rb[:, :1] / r[idx][:, :1])
+        t = tables[best]
+        _, walls, cpus = _timed(lambda: cache.lookup_qstar(rb, sb, db=db, policy="table-only",
+                                                           table=t), args.repeat)
+        res["throughput_table_only"] = {"n": args.n_batch, "wall_s": walls, "cpu_s": cpus,
+                                        "rows_per_s_wall_best": args.n_batch / min(walls),
+                                        "rows_per_s_cpu_best": args.n_batch / min(cpus)}
+        xb = cache.grid_coordinates(rb, sb)
+        _, walls, cpus = _timed(lambda: t(xb), args.repeat)
+        res["throughput_interp_kernel"] = {"n": args.n_batch, "wall_s": walls, "cpu_s": cpus,
+                                           "rows_per_s_cpu_best": args.n_batch / min(cpus)}
+        _, walls, cpus = _timed(lambda: throats.shape_factor_qstar(rb, sb), args.repeat)
+        res["throughput_shape_factor"] = {"n": args.n_batch, "wall_s": walls, "cpu_s": cpus,
+                                          "rows_per_s_cpu_best": args.n_batch / min(cpus)}
+    res["loadavg_end"] = os.getloadavg()
+
+    # report ---------------------------------------------------------------------------------
+    print(f"held-out throats: {n} (random 5.5-7.5 mm packing, seed {args.seed}); reference FE rtol=1e-4")
+    print(f"load average {res['loadavg_start']} -> {res['loadavg_end']}, {os.cpu_count()} CPUs")
+    print(f"\n{'table':34s} {'nodes':>7s} {'cover':>6s} {'med':>8s} {'p90':>8s} {'p99':>8s} "
+          f"{'max':>8s} {'est>=err':>8s}")
+    for k, v in res["tables"].items():
+        e = v["error_all"]
+        print(f"{k:34s} {v['nodes']:7d} {v['coverage']:6.3f} {e['median']:8.2e} {e['p90']:8.2e} "
+              f"{e['p99']:8.2e} {e['max']:8.2e} {v['estimate_bounds_error'] or float('nan'):8.3f}")
+    print(f"\n{'method':40s} {'s/throat':>9s} {'med err':>9s} {'p99 err':>9s} {'max err':>9s} {'FE/SF':>6s}")
+    for m, e, sec, f in rows:
+        print(f"{m:40s} {sec:9.2e} {e['median']:9.2e} {e['p99']:9.2e} {e['max']:9.2e} {f:6.3f}")
+    for key in ("throughput_table_only", "throughput_interp_kernel", "throughput_shape_factor"):
+        if key in res:
+            v = res[key]
+            print(f"{key}: {v['n']} rows, wall {min(v['wall_s']):.3f} s (median "
+                  f"{np.median(v['wall_s']):.3f}), cpu {min(v['cpu_s']):.3f} s -> "
+                  f"{v['n'] / min(v['cpu_s']):.3g} rows/s per core (cpu)")
+    for k in ("db_bytes", "shipped_g1_bytes", "shipped_g2_bytes", "table_rows",
+              "precompute_solve_seconds"):
+        if k in res:
+            print(f"{k}: {res[k]}")
+    with open(args.out, "w") as fh:
+        json.dump(res, fh, indent=1, default=float)
+    print(f"wrote {args.out}")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
