@@ -371,6 +371,13 @@ class Simulation:
                     f"overlap {frac.max():.2f} of a radius at t = {self.time_s:.4g} s: particles "
                     "pass through each other (stiffness too low for the load or dt too large)"
                 )
+        if len(self.last_wall_fn):
+            wmax = float(self.last_wall_fn.max()) / self.material.kn_pw / float(self.radii.min())
+            if wmax > max_overlap_fraction:
+                raise DemInstabilityError(
+                    f"wall overlap {wmax:.2f} of a radius at t = {self.time_s:.4g} s: particles are "
+                    "pressed through a wall (container too small for the grains, or dt too large)"
+                )
         if self.bounds_m is not None:
             lo, hi = self.bounds_m
             out = np.any((self.centers < lo) | (self.centers > hi), axis=1)

@@ -3,7 +3,7 @@ r"""Porosity and coordination measurements on sphere packings.
 * Local porosity in measurement spheres (thesis B1–B5, PFC3D ``measure``): exact
   sphere–sphere lens volumes.
 * Porosity of a box or cylinder region: spheres wholly inside count fully; spheres cut
-  by the region boundary are integrated with a fixed 1 791-point quadrature inside the
+  by the region boundary are integrated with a fixed 2 176-point quadrature inside the
   unit sphere (error of the cut volume ~ 1e-3 of a sphere volume each, averaging out).
 * Coordination numbers: neighbours within a cutoff distance (thesis: 1.05 d_max) and
   true contacts (overlap > −tol).
@@ -128,8 +128,9 @@ class Region:
                 "radius": float(self.radius), "center_xy": list(map(float, self.center_xy))}
 
 
-def _unit_ball_points(spacing=0.13):
-    g = np.arange(-1 + spacing / 2, 1, spacing)
+def _unit_ball_points(m=16):
+    """Cell centres of an m^3 grid on [-1, 1]^3 inside the unit ball (symmetric about 0)."""
+    g = (np.arange(m) - (m - 1) / 2) * (2.0 / m)
     p = np.stack(np.meshgrid(g, g, g, indexing="ij"), axis=-1).reshape(-1, 3)
     return p[np.einsum("ij,ij->i", p, p) <= 1.0]
 

@@ -32,7 +32,9 @@ def _parser():
     p.add_argument("--mass-scale", type=float, default=100.0, help="density scaling during packing (1 = none)")
     p.add_argument("--packing-friction", type=float, default=None,
                    help="particle friction during expansion/closed stage (default: the material's)")
-    p.add_argument("--lid-headroom", type=float, default=0.2)
+    p.add_argument("--lid-headroom", type=float, default=0.2,
+                   help="lid height above the fill height during expansion, as a fraction (0: Appendix A closed box)")
+    p.add_argument("--keep-lid", action="store_true", help="do not remove the lid before the last settling")
     p.add_argument("--tol", type=float, default=1e-3, help="mean unbalanced-force ratio at equilibrium")
     p.add_argument("--max-steps", type=int, default=200000)
     p.add_argument("--dt-safety", type=float, default=0.25)
@@ -75,7 +77,7 @@ def main(argv=None) -> int:
     try:
         res = pack(container, material=material, porosity=args.porosity, n_particles=args.n_particles,
                    rng=args.seed, mass_scale=args.mass_scale, packing_friction=args.packing_friction,
-                   lid_headroom=args.lid_headroom, tol=args.tol, max_steps=args.max_steps,
+                   lid_headroom=args.lid_headroom, open_top=not args.keep_lid, tol=args.tol, max_steps=args.max_steps,
                    dt_safety=args.dt_safety, progress=progress)
     except ValueError as e:
         print(f"error: {e}", file=sys.stderr)

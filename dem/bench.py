@@ -1,0 +1,114 @@
+"""Benchmark: particle-steps per second against N, and the cost/effect of density scaling.
+
+    python -m dem.bench                       # N = 1000 ... 50000, writes dem_bench.json
+    python -m dem.bench --n 20000 --repeat 3
+    python -m dem.bench --mass-scale-study    # small packing made with S = 1, 10, 100
+
+Scene for the rate: N spheres of radius 3.25 mm on a simple cubic lattice 6.5 mm apart
+(overlap 1e-4 r, six contacts each, close to the 4–6 true contacts of a settled bed),
+with gravity, box walls and the Verlet list, density scaling 100: the inner loop of
+``dem.pack``. The JSON records the load average, platform, CPU count and a timestamp.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import os
+import platform
+import sys
+import time
+
+import numpy as np
+
+from ._scenes import Container, make_simulation, pack
+
+
+def lattice_simulation(n, *, rng=0, mass_scale=100.0):
+    """N spheres (r = 3.25 mm) on a simple cubic lattice in a closed box (benchmark scene)."""
+    rng = np.random.default_rng(rng)
+    a = 0.0065
+    nx = max(2, int(round((n / 2) ** (1 / 3))))
+    ny = nx
+    nz = int(np.ceil(n / (nx * ny)))
+    g = np.stack(np.meshgrid(np.arange(nx), np.arange(ny), np.arange(nz), indexing="ij"), -1).reshape(-1, 3)[:n]
+    x = (g + 0.5) * a + rng.normal(0, 1e-7, (len(g), 3))
+    x[:, 0] -= nx * a / 2
+    x[:, 1] -= ny * a / 2
+    c = Container("box", (nx * a, ny * a), nz * a)
+    return make_simulation(c, x, np.full(len(x), a / 2 * (1 + 1e-4)), lid=True, mass_scale=mass_scale)
+
+
+def rate(n, *, steps=None, repeat=3):
+    """Particle-steps per second for N (min/median over ``repeat`` timings)."""
+    sim = lattice_simulation(n)
+    for _ in range(5):
+        sim.step()
+    steps = steps or max(20, int(2e6 / n))
+    times = []
+    for _ in range(repeat):
+        t = time.perf_counter()
+        for _ in range(steps):
+            sim.step()
+        times.append(time.perf_counter() - t)
+    times = np.array(times)
+    return {
+        "n": int(sim.n), "steps": steps, "pairs": int(len(sim.verlet.pairs)), "contacts": int(len(sim.contact_fn)),
+        "rebuilds": int(sim.stats["rebuilds"]), "seconds": times.tolist(),
+        "rate_best": float(n * steps / times.min()), "rate_median": float(n * steps / np.median(times)),
+        "ms_per_step_best": float(1e3 * times.min() / steps),
+    }
+
+
+def mass_scale_study(scales=(1.0, 10.0, 100.0), *, seed=1):
+    """Pack the same small box (0.06 x 0.02 x 0.06 m) with several density scalings."""
+    c = Container("box", (0.06, 0.02), 0.06)
+    out = []
+    for s in scales:
+        res = pack(c, rng=seed, mass_scale=s, max_steps=400000)
+        m = res.summary
+        out.append({"mass_scale": s, "n": m["n_spheres"], "porosity_interior": m["porosity_interior"],
+                    "porosity_global_surface": m["porosity_global_surface"],
+                    "coordination_cutoff": m["coordination"]["cutoff_mean"],
+                    "coordination_contacts": m["coordination"]["contact_mean"],
+                    "max_overlap_fraction": m["max_overlap_fraction"], "steps": m["steps"],
+                    "wall_time_s": m["wall_time_s"]})
+        print(f"S = {s:6g}: interior porosity {m['porosity_interior']:.4f}, global {m['porosity_global_surface']:.4f}, "
+              f"Z(1.05 dmax) {m['coordination']['cutoff_mean']:.2f}, Z(contact) {m['coordination']['contact_mean']:.2f}, "
+              f"{m['steps']} steps, {m['wall_time_s']:.1f} s", flush=True)
+    return out
+
+
+def main(argv=None) -> int:
+    p = argparse.ArgumentParser(prog="python -m dem.bench", description=__doc__.split("\n")[0])
+    p.add_argument("--n", type=int, nargs="+", default=[1000, 2000, 5000, 10000, 20000, 50000])
+    p.add_argument("--repeat", type=int, default=3)
+    p.add_argument("--steps", type=int, default=None)
+    p.add_argument("--mass-scale-study", action="store_true")
+    p.add_argument("--json", default="dem_bench.json")
+    args = p.parse_args(argv)
+    meta = {"loadavg_before": os.getloadavg(), "platform": platform.platform(), "cpu_count": os.cpu_count(),
+            "python": sys.version.split()[0], "numpy": np.__version__,
+            "timestamp": time.strftime("%Y-%m-%dT%H:%M:%SZ", time.gmtime())}
+    result = {"meta": meta}
+    if args.mass_scale_study:
+        result["mass_scale_study"] = mass_scale_study()
+    else:
+        print(f"{'N':>7} {'pairs':>8} {'contacts':>9} {'ms/step':>8} {'p-steps/s best':>15} {'median':>12}")
+        rows = []
+        for n in args.n:
+            r = rate(n, steps=args.steps, repeat=args.repeat)
+            rows.append(r)
+            print(f"{r['n']:7d} {r['pairs']:8d} {r['contacts']:9d} {r['ms_per_step_best']:8.2f} "
+                  f"{r['rate_best']:15.3e} {r['rate_median']:12.3e}", flush=True)
+        result["rates"] = rows
+    meta["loadavg_after"] = os.getloadavg()
+    print(f"load average before {meta['loadavg_before']}, after {meta['loadavg_after']}; {meta['cpu_count']} CPUs")
+    with open(args.json, "w") as f:
+        json.dump(result, f, indent=1)
+    print(f"-> {args.json}")
+    return 0
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())

@@ -1,0 +1,113 @@
+"""Scenes, packing procedure, measurements and file I/O of dem (issue 5 items 1, 2, 4, 7)."""
+
+import numpy as np
+import pytest
+
+from dem import (Container, Material, Region, SCENES, pack, porosity_in_region, porosity_in_spheres,
+                 read_packing, thesis_particle_count, write_packing)
+from dem._measure import coordination_numbers, lens_volume, sphere_volume
+from dem._scenes import generate_spheres
+from dem._vibrate import intensity_g
+
+TINY = Container("box", (0.03, 0.02), 0.03)
+
+
+def test_thesis_particle_counts():
+    # Appendix A/B: num = int((1 - 0.408) V / (4/3 pi rbar^3)), rbar = 3.25 mm; thesis 4.1.1
+    # reports 5 146 (rect bin) and 18 188 (cylinder) spheres.
+    assert thesis_particle_count(SCENES["rect-bin"], 0.408) == 5146
+    assert thesis_particle_count(SCENES["cyl-bin"], 0.408) == 18188
+
+
+def test_intensity_matches_thesis_list():
+    # thesis 3.2: 0.45, 0.91, 1.81, 2.72, 3.62 g for 0.5-4 mm at 15 Hz
+    got = [intensity_g(15, a) for a in (0.0005, 0.001, 0.002, 0.003, 0.004)]
+    np.testing.assert_allclose(got, [0.45, 0.91, 1.81, 2.72, 3.62], atol=0.006)
+
+
+def test_lens_volume_limits_and_hemisphere():
+    R = 1.0
+    assert lens_volume(R, 0.5, 0.2) == pytest.approx(sphere_volume(0.5))  # inside
+    assert lens_volume(R, 0.5, 1.6) == 0.0  # apart
+    # two unit spheres one radius apart: 5 pi / 12 (classical lens)
+    assert lens_volume(1.0, 1.0, 1.0) == pytest.approx(5 * np.pi / 12, rel=1e-12)
+
+
+def test_porosity_in_sphere_and_region_exact_cases():
+    # one sphere r = 1 mm centred in a measurement sphere of 2 mm: porosity 1 - 1/8
+    c = np.array([[0.0, 0.0, 0.0]])
+    r = np.array([0.001])
+    assert porosity_in_spheres(c, r, c, 0.002)[0] == pytest.approx(1 - 1 / 8, rel=1e-12)
+    # a sphere cut in half by the region's floor: solid = half a sphere (quadrature ~1e-3)
+    box = Region("box", (-0.002, -0.002, 0.0), (0.002, 0.002, 0.004))
+    expected = 1 - 0.5 * sphere_volume(0.001) / box.volume
+    assert porosity_in_region(c, r, box) == pytest.approx(expected, abs=2e-3)
+    cyl = Region("cylinder", (0, 0, -0.01), (0, 0, 0.01), radius=0.01)
+    assert porosity_in_region(c, r, cyl) == pytest.approx(1 - sphere_volume(0.001) / cyl.volume, rel=1e-12)
+
+
+def test_coordination_counts_on_a_square():
+    # four touching spheres on a square of side 2r: 2 contacts each, 3 neighbours within 1.5*2r*sqrt2
+    x = np.array([[0, 0, 0], [2, 0, 0], [0, 2, 0], [2, 2, 0]], float)
+    r = np.ones(4)
+    np.testing.assert_array_equal(coordination_numbers(x, r, contact_tol_m=1e-9), [2, 2, 2, 2])
+    np.testing.assert_array_equal(coordination_numbers(x, r, cutoff_m=2.9), [3, 3, 3, 3])
+
+
+def test_generated_spheres_do_not_overlap_and_stay_inside():
+    rng = np.random.default_rng(5)
+    cyl = Container("cylinder", (0.05,), 0.04)
+    x, r = generate_spheres(cyl, 300, 0.002, 0.0027, rng)
+    assert len(r) == 300
+    d = np.linalg.norm(x[:, None] - x[None], axis=2) + np.eye(300)
+    assert np.all(d >= r[:, None] + r[None] - 1e-15)
+    assert np.all(np.hypot(x[:, 0], x[:, 1]) + r <= 0.025 + 1e-12)
+    assert np.all((x[:, 2] - r >= 0) & (x[:, 2] + r <= 0.04))
+
+
+@pytest.mark.parametrize("kwargs,match", [
+    (dict(porosity=0.2), "unreachable"),
+    (dict(porosity=0.30), "unreachable"),
+    (dict(porosity=1.2), r"porosity must be in \(0, 1\)"),
+])
+def test_impossible_porosity_is_refused(kwargs, match):
+    with pytest.raises(ValueError, match=match):
+        pack(TINY, **kwargs)
+
+
+def test_container_smaller_than_grain_is_refused():
+    with pytest.raises(ValueError, match="smaller than a grain"):
+        pack(Container("box", (0.005, 0.02), 0.05))
+
+
+@pytest.mark.parametrize("field", ["kn_n_m", "ks_n_m", "wall_kn_n_m", "density_kg_m3"])
+def test_non_positive_stiffness_is_refused(field):
+    with pytest.raises(ValueError, match=field):
+        Material(**{field: 0.0})
+    with pytest.raises(ValueError, match=field):
+        Material(**{field: -1.0})
+
+
+def test_same_seed_same_packing_and_io_roundtrip(tmp_path):
+    # short stages (the test checks reproducibility, not convergence)
+    kw = dict(rng=7, tol=2e-2, grow_steps=500, max_steps=2500, lid_headroom=1.0)
+    a = pack(TINY, **kw)
+    b = pack(TINY, **kw)
+    np.testing.assert_array_equal(a.centers, b.centers)
+    np.testing.assert_array_equal(a.radii, b.radii)
+    x7, _ = generate_spheres(TINY, 50, 0.002, 0.0027, np.random.default_rng(7))
+    x8, _ = generate_spheres(TINY, 50, 0.002, 0.0027, np.random.default_rng(8))
+    assert not np.array_equal(x7, x8)
+    # the packing is physical: every sphere inside the bin, overlaps below 1 % of a radius
+    s = a.summary
+    assert s["n_spheres"] == thesis_particle_count(TINY, 0.408)
+    assert s["max_overlap_fraction"] < 0.01
+    assert np.all(np.abs(a.centers[:, 0]) + a.radii <= 0.015 + 1e-5)
+    assert np.all(a.centers[:, 2] - a.radii >= -1e-5)
+    # closed-volume porosity is the target by construction (Eq. 3.7)
+    assert s["porosity_closed_volume"] == pytest.approx(0.408, abs=1e-12)
+    p = tmp_path / "p.csv"
+    write_packing(p, a.centers, a.radii, s)
+    x, r, js = read_packing(p)
+    np.testing.assert_allclose(x, a.centers, rtol=1e-8, atol=1e-12)
+    assert js["n_spheres"] == s["n_spheres"]
