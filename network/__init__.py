@@ -12,13 +12,14 @@ Command-line tools: ``python -m network.solve`` (permeability, pressure drop),
 
 """
 
-from ._io import Packing, read_packing, write_packing_csv
+from ._io import Packing, default_packing_path, read_packing, write_packing_csv
 from ._tessellation import QHULL_OPTIONS, Tessellation, tessellate, tie_groups
 
 __all__ = [
     "Packing",
     "read_packing",
     "write_packing_csv",
+    "default_packing_path",
     "Tessellation",
     "tessellate",
     "QHULL_OPTIONS",

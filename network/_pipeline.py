@@ -151,8 +151,9 @@ def solve_network(packing: Packing, *, axis="z", region: Region | None = None,
                   velocity_m_s: float = DEFAULT_VELOCITY_M_S, depth_m: float = DEFAULT_DEPTH_M,
                   rtol: float = 1e-3, db=None, workers: int = 1, progress: bool = False,
                   tessellation: Tessellation | None = None, solver: Callable | None = None,
-                  porosity_points: int = 400_000, conductance: Callable | None = None,
-                  trace_memory: bool = False, merge_ties: bool = True) -> FlowResult:
+                  porosity_points: int = 200_000, conductance: Callable | None = None,
+                  trace_memory: bool = False, merge_ties: bool = True,
+                  porosity: tuple | None = None) -> FlowResult:
     """Permeability and pressure drop of a packing by the Delaunay network model.
 
     Parameters
@@ -184,6 +185,8 @@ def solve_network(packing: Packing, *, axis="z", region: Region | None = None,
         ``conductance(tessellation, throat_ids) -> g`` overriding model and policy (tests).
     trace_memory : bool
         Record the peak traced memory of each stage (slower; used by the benchmark).
+    porosity : (float, float), optional
+        Precomputed (porosity, standard error) of the region (e.g. from another axis).
     merge_ties : bool
         Join exactly co-spherical tetrahedra (and slivers) into one pore body
         (:func:`network.tie_groups`) so lattices do not depend on Qhull's tie-breaking
@@ -237,7 +240,9 @@ def solve_network(packing: Packing, *, axis="z", region: Region | None = None,
         log.warning("mass balance check failed: %s", {k: v for k, v in check.items()
                                                        if k != "throat_flow"})
     with stage("porosity"):
-        if porosity_points:
+        if porosity is not None:
+            eps, eps_err = map(float, porosity)
+        elif porosity_points:
             eps, eps_err = region_porosity(packing, reg, ax, n_points=porosity_points)
         else:
             eps, eps_err = float("nan"), float("nan")

@@ -1,0 +1,221 @@
+"""``python -m network.solve``: permeability and pressure drop of a packing by the network model.
+
+Examples
+--------
+    python -m network.solve                                  # the bundled soybean scene
+    python -m network.solve bed.csv --axis all --policy shape-factor --json out.json
+    python -m network.solve bed.csv --sample 0.01 0.09 0.01 0.09 0.02 0.2 --vtk bed.vtu
+
+Lengths are in the packing's own unit (metres by default); ``--sample`` overrides the automatic
+interior box (packing extent less ``--margin`` on every side, default 1.5 mean diameters).
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import logging
+import sys
+import time
+from pathlib import Path
+
+import numpy as np
+
+from ._conductance import MODELS, MU_AIR_PA_S, POLICIES
+from ._io import default_packing_path, read_packing
+from ._pipeline import DEFAULT_DEPTH_M, DEFAULT_VELOCITY_M_S, solve_network
+from ._sample import Region, default_region
+from ._tessellation import tessellate
+from ._vtk import write_network_vtu
+
+# Thesis section 4.2.3 and Table 4.5: pressure drop over 0.25 m at 0.013 m/s (Pa)
+THESIS_LSV = {"measured": 2.44, "measured_sd": 0.20, "asabe_d272": 2.28, "thesis_network": 2.20,
+              "ergun": 1.27, "branched_model": 2.74}
+
+
+def build_parser() -> argparse.ArgumentParser:
+    ap = argparse.ArgumentParser(
+        prog="python -m network.solve",
+        description="Permeability, pressure gradient and pressure drop of a sphere packing by "
+                    "the Delaunay pore-network model (thesis 3.5.2), solved with pyamg.")
+    ap.add_argument("packing", nargs="?", default=None,
+                    help="CSV x,y,z,r / .npz / LIGGGHTS dump (default: the bundled soybean "
+                         f"scene {default_packing_path().name})")
+    ap.add_argument("--axis", default="z", choices=["x", "y", "z", "all"],
+                    help="flow direction; 'all' solves x, y and z (default z)")
+    ap.add_argument("--sample", nargs=6, type=float, metavar=("XMIN", "XMAX", "YMIN", "YMAX",
+                                                              "ZMIN", "ZMAX"),
+                    help="sample box (packing units); default: the interior box")
+    ap.add_argument("--margin", type=float, default=None,
+                    help="wall margin of the default box (default 1.5 mean diameters)")
+    ap.add_argument("--cylinder", action="store_true",
+                    help="use the cylinder inscribed in the sample box (axis = flow axis)")
+    ap.add_argument("--viscosity", type=float, default=MU_AIR_PA_S,
+                    help=f"dynamic viscosity, Pa s (default {MU_AIR_PA_S})")
+    ap.add_argument("--velocity", type=float, default=DEFAULT_VELOCITY_M_S,
+                    help=f"superficial velocity, m/s (default {DEFAULT_VELOCITY_M_S})")
+    ap.add_argument("--depth", type=float, default=DEFAULT_DEPTH_M,
+                    help=f"bed depth for the pressure drop, m (default {DEFAULT_DEPTH_M})")
+    ap.add_argument("--policy", default="table+fe", choices=POLICIES,
+                    help="Q* source (default table+fe; shape-factor is the fast mode)")
+    ap.add_argument("--conductance-model", default="thesis", choices=MODELS,
+                    help="throat conductance model (default thesis, Eq. 3.41)")
+    ap.add_argument("--rtol", type=float, default=1e-3, help="Q* relative tolerance (1e-3)")
+    ap.add_argument("--db", default=None, help="throat table (default: the cache's default)")
+    ap.add_argument("--workers", type=int, default=1, help="processes for FE solves")
+    ap.add_argument("--json", dest="json_out", default=None, help="write every number here")
+    ap.add_argument("--vtk", default=None,
+                    help="write pores (pressure) and throats (flow, conductance) as .vtu "
+                         "(with --axis all: one file per axis, suffixed _x/_y/_z)")
+    ap.add_argument("--quiet", "-q", action="store_true", help="no stage progress on stderr")
+    return ap
+
+
+def _vtk_path(base: str, axis: str, multi: bool) -> Path:
+    p = Path(base)
+    return p.with_name(f"{p.stem}_{axis}{p.suffix or '.vtu'}") if multi else p
+
+
+def _print_result(res, out):
+    s = res.summary()
+    c = s["comparisons"]
+    print(f"axis {res.axis}: {s['n_pores']} pores, {s['n_throats']} throats "
+          f"({s['n_inlet_pores']} inlet, {s['n_outlet_pores']} outlet, "
+          f"{s['n_dropped_pores']} disconnected dropped)", file=out)
+    print(f"  sample H = {s['sample_length_m']:.4g} m, A = {s['sample_area_m2']:.4g} m², "
+          f"porosity {s['porosity']:.4f} ± {s['porosity_std']:.4f}", file=out)
+    print(f"  permeability k = {s['permeability_m2']:.4e} m²   k/d32² = {s['k_over_d2']:.4e}",
+          file=out)
+    print(f"  at v = {s['velocity_m_s']:g} m/s: gradient {s['pressure_gradient_pa_per_m']:.4g} "
+          f"Pa/m, drop over {s['depth_m']:g} m = {s['pressure_drop_pa']:.4g} Pa", file=out)
+    print(f"    Ergun {c['ergun']['pressure_drop_pa']:.4g} Pa, Kozeny-Carman "
+          f"{c['kozeny_carman']['pressure_drop_pa']:.4g} Pa, ASABE D272 (soybeans) "
+          f"{c['asabe_d272']['pressure_drop_pa']:.4g} Pa", file=out)
+    sv, mb = s["solver"], s["mass_balance"]
+    print(f"  solver {sv['method']}: {sv['iterations']} it, residual {sv['residual']:.1e}; "
+          f"inlet/outlet mismatch {mb['balance_error']:.1e} ({'ok' if mb['ok'] else 'FAILED'})",
+          file=out)
+    print("  seconds: " + ", ".join(f"{k} {v:.2f}" for k, v in s["seconds"].items()
+                                     if isinstance(v, float)), file=out)
+
+
+def main(argv=None) -> int:
+    args = build_parser().parse_args(argv)
+    if not args.quiet:
+        logging.basicConfig(level=logging.INFO, format="[%(relativeCreated)7.0f ms] %(message)s",
+                            stream=sys.stderr)
+    t0 = time.perf_counter()
+    path = Path(args.packing) if args.packing else default_packing_path()
+    try:
+        packing = read_packing(path)
+    except (OSError, ValueError) as e:
+        print(f"error: {e}", file=sys.stderr)
+        return 2
+    t_read = time.perf_counter() - t0
+    if args.sample:
+        s = args.sample
+        region = Region([s[0], s[2], s[4]], [s[1], s[3], s[5]])
+        if args.cylinder:
+            region = Region(region.lo, region.hi, 0.5 * float(np.min(region.hi - region.lo)))
+    else:
+        try:
+            region = default_region(packing, margin=args.margin, cylinder=args.cylinder)
+        except ValueError as e:
+            print(f"error: {e}", file=sys.stderr)
+            return 2
+    axes = ["x", "y", "z"] if args.axis == "all" else [args.axis]
+    t1 = time.perf_counter()
+    tess = tessellate(packing) if len(axes) > 1 else None   # one tessellation for three axes
+    t_tess = time.perf_counter() - t1
+    results = []
+    for ax in axes:
+        reg = region
+        if args.cylinder and args.sample is None:
+            reg = default_region(packing, margin=args.margin, cylinder=True)
+        try:
+            res = solve_network(
+                packing, axis=ax, region=reg, conductance_model=args.conductance_model,
+                policy=args.policy, viscosity_pa_s=args.viscosity, velocity_m_s=args.velocity,
+                depth_m=args.depth, rtol=args.rtol, db=args.db, workers=args.workers,
+                progress=not args.quiet, tessellation=tess,
+                porosity=(results[0].porosity, results[0].porosity_std)
+                if results and reg.radius is None else None)
+        except (ValueError, RuntimeError, NotImplementedError) as e:
+            print(f"error: {e}", file=sys.stderr)
+            return 1
+        results.append(res)
+        if args.vtk:
+            p = _vtk_path(args.vtk, ax, len(axes) > 1)
+            write_network_vtu(p, res.pore_xyz, res.conns,
+                              point_data={"pressure": res.pressure_pa},
+                              cell_data={"flow": np.abs(res.throat_flow_m3_s),
+                                         "conductance": res.throat_conductance})
+            print(f"wrote {p}")
+    total = time.perf_counter() - t0
+    print(f"packing {path} ({packing.n} spheres), model {args.conductance_model}, "
+          f"policy {args.policy}")
+    for res in results:
+        _print_result(res, sys.stdout)
+    out = _combine(results, t_read, total)
+    if tess is not None:
+        out["seconds"]["tessellate"] = t_tess
+    out["packing"] = str(path)
+    out["n_spheres"] = packing.n
+    out["thesis_lsv_reference_pa"] = THESIS_LSV
+    if len(results) > 1:
+        k = out["by_axis"]
+        print("anisotropy: k_x : k_y : k_z = " + " : ".join(
+            f"{k[a]['permeability_m2'] / out['permeability_m2']:.3f}" for a in axes)
+            + " (relative to the mean)")
+    print(f"total {total:.2f} s")
+    if args.json_out:
+        with open(args.json_out, "w") as f:
+            json.dump(out, f, indent=2, default=_json_default)
+        print(f"wrote {args.json_out}")
+    ok = all(r.check["ok"] for r in results)
+    return 0 if ok else 3
+
+
+def _combine(results, t_read, total) -> dict:
+    if len(results) == 1:
+        out = results[0].summary()
+        out["seconds"] = dict(out["seconds"], read=t_read, wall=total)
+        return out
+    by = {r.axis: r.summary() for r in results}
+    ks = np.array([r.permeability_m2 for r in results])
+    first = results[0]
+    k = float(ks.mean())
+    grad = first.viscosity_pa_s * first.velocity_m_s / k
+    out = {
+        "axis": "all",
+        "conductance_model": first.conductance_model,
+        "policy": first.policy,
+        "permeability_m2": k,
+        "permeability_note": "arithmetic mean of the three directional permeabilities",
+        "k_over_d2": k / first.sauter_diameter_m**2,
+        "pressure_gradient_pa_per_m": grad,
+        "pressure_drop_pa": grad * first.depth_m,
+        "porosity": first.porosity,
+        "porosity_std": first.porosity_std,
+        "n_pores": max(r.n_pores for r in results),
+        "n_throats": max(r.n_throats for r in results),
+        "anisotropy": {r.axis: float(r.permeability_m2 / k) for r in results},
+        "comparisons": by[first.axis]["comparisons"],
+        "by_axis": by,
+        "seconds": {"read": t_read, "wall": total},
+    }
+    return out
+
+
+def _json_default(o):
+    if isinstance(o, (np.integer,)):
+        return int(o)
+    if isinstance(o, (np.floating,)):
+        return float(o)
+    if isinstance(o, np.ndarray):
+        return o.tolist()
+    return str(o)
+
+
+if __name__ == "__main__":
+    sys.exit(main())
