@@ -1256,7 +1256,7 @@ def trace_paths(points, radii, entry_xy, *, kind="widest", method="build", graph
 # --------------------------------------------------------------------------------------------
 def branched_path_pressure_drop(points, radii, path, *, superficial_velocity_m_s=None,
                                 q0_m3_s=None, width="average", multiplier="MFx3",
-                                branches="all", mu_pa_s=MU_AIR_PA_S) -> BranchedResult:
+                                branches="path", mu_pa_s=MU_AIR_PA_S) -> BranchedResult:
     r"""Branched-path model (thesis 3.5.1, Appendix F) along the tetrahedra of a path.
 
     Each tetrahedron is entered through its inlet face (``path.tetra_vertices[:, :3]``) and
@@ -1359,7 +1359,7 @@ def pressure_along_path(graph, path, pore_pressure_pa, *, axis="z"):
 
 def branched_table(points, radii, path, *, velocities_m_s=(0.013, 0.027),
                    widths=("max", "min", "average"), multipliers=("MFx3", "MFx2"),
-                   branches="all", mu_pa_s=MU_AIR_PA_S):
+                   branches="path", mu_pa_s=MU_AIR_PA_S):
     """Branched-model pressure drops of one path in the layout of thesis Table 4.4, Pa.
 
     Face areas are computed once and reused for every combination.

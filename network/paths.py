@@ -61,8 +61,9 @@ def _parser():
     p.add_argument("--seed", type=int, default=0)
     p.add_argument("--velocity", type=float, nargs="+", default=[0.013, 0.027],
                    help="superficial velocities for the branched model (m/s)")
-    p.add_argument("--branches", default="all", choices=("all", "path"),
-                   help="daughter losses summed: all three (Appendix F) or the path's (Eq. 3.28)")
+    p.add_argument("--branches", default="path", choices=("all", "path"),
+                   help="daughter losses counted: the path's (Eq. 3.28, default) or all three "
+                        "(Appendix F)")
     p.add_argument("--no-branched", action="store_true", help="skip the branched model")
     p.add_argument("--pressure", action="store_true",
                    help="solve the network model (network.solve) and report the pressure along "

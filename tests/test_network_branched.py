@@ -67,7 +67,8 @@ def test_symmetric_branching_matches_hand_sum():
     c_tet = np.zeros((1, 3))
     ang = np.array([0, 2 * np.pi / 3, 4 * np.pi / 3])
     c_out = np.stack([seg * np.cos(ang), seg * np.sin(ang), np.zeros(3)], axis=1)[None]
-    res = branched_pressure_drop(c_in, c_tet, c_out, [d], [[d, d, d]], [1], q, mu_pa_s=MU)
+    res = branched_pressure_drop(c_in, c_tet, c_out, [d], [[d, d, d]], [1], q, mu_pa_s=MU,
+                                 branches="all")
     straight = 128 * MU * q * seg / (np.pi * d**4)
     branch = 3.0 * (2100 / 64) * 128 * MU * (q / 3) * seg / (np.pi * d**4)
     assert res.dp_straight_pa[0] == pytest.approx(straight, rel=1e-12)
@@ -77,7 +78,8 @@ def test_symmetric_branching_matches_hand_sum():
                                   branches="path")
     assert path.total_pa == pytest.approx(straight + branch, rel=1e-12)
     # laminar: linear in the flow rate
-    res2 = branched_pressure_drop(c_in, c_tet, c_out, [d], [[d, d, d]], [1], 2 * q, mu_pa_s=MU)
+    res2 = branched_pressure_drop(c_in, c_tet, c_out, [d], [[d, d, d]], [1], 2 * q, mu_pa_s=MU,
+                                  branches="all")
     assert res2.total_pa == pytest.approx(2 * res.total_pa, rel=1e-12)
 
 
