@@ -152,9 +152,10 @@ class SolveInfo:
     setup_s: float
     solve_s: float
     method: str
+    assemble_s: float = 0.0
 
 
-def solve_pressure(A, b, *, tol: float = 1e-12, maxiter: int = 500,
+def solve_pressure(A, b, *, tol: float = 1e-10, maxiter: int = 500,
                    solver: Callable | None = None) -> tuple[np.ndarray, SolveInfo]:
     r"""Solve the condensed SPD system with AMG-preconditioned CG (or a given solver).
 
@@ -164,7 +165,8 @@ def solve_pressure(A, b, *, tol: float = 1e-12, maxiter: int = 500,
         SPD matrix, e.g. ``A_ii`` from :func:`apply_pressure_bc`.
     b : (n,) array_like
     tol : float, optional
-        Relative residual target of the diagonally scaled system (default 1e-12).
+        Relative residual target of the diagonally scaled system (default 1e-10; the mass
+        balance is then verified to 1e-8 by the caller).
     maxiter : int, optional
         CG iteration limit (default 500).
     solver : callable, optional
@@ -205,8 +207,7 @@ def solve_pressure(A, b, *, tol: float = 1e-12, maxiter: int = 500,
     if bnorm == 0:
         return np.zeros(n), SolveInfo(True, 0, 0.0, [], 0.0, 0.0, "zero rhs")
     import pyamg
-    from scipy.sparse.linalg import cg
-
+    
     d = A.diagonal()
     if np.any(d <= 0):
         raise ValueError("matrix has a non-positive diagonal entry: a free pore with no "
@@ -217,10 +218,6 @@ def solve_pressure(A, b, *, tol: float = 1e-12, maxiter: int = 500,
     bs = s * b
     hist: list[float] = []
     bsn = np.linalg.norm(bs)
-
-    def _cb(xk):
-        hist.append(float(np.linalg.norm(bs - As @ xk) / bsn))
-
     # plain SA first; strong random contrast (log-uniform over many decades) defeats its
     # strength-of-connection measure, then the evolution measure is used from where CG stopped
     y = np.zeros(n)
@@ -230,14 +227,16 @@ def solve_pressure(A, b, *, tol: float = 1e-12, maxiter: int = 500,
             t0 = time.perf_counter()
             ml = pyamg.smoothed_aggregation_solver(As, symmetry="symmetric", strength=strength,
                                                    max_coarse=500, coarse_solver="splu")
-            M = ml.aspreconditioner(cycle="V")
             t1 = time.perf_counter()
-            y, flag = cg(As, bs, x0=y, rtol=tol, atol=0.0, maxiter=limit, M=M, callback=_cb)
+            res_abs: list[float] = []
+            y = ml.solve(bs, x0=y, tol=tol, maxiter=limit, accel="cg", residuals=res_abs)
             t2 = time.perf_counter()
+        hist.extend(r / bsn for r in res_abs[1:])    # res_abs[0] is the initial residual
         setup += t1 - t0
         solve_t += t2 - t1
         levels = len(ml.levels)
-        if flag == 0:
+        if np.linalg.norm(bs - As @ y) <= tol * bsn * 1.0000001:
+            flag = 0
             break
         method = "pyamg-sa(evolution)-pcg"
         log.info("SA-PCG not converged after %d iterations (residual %.2e): rebuilding with "
@@ -302,7 +301,7 @@ def verify_solution(throat_conns, g, p, inlet, outlet, *, rtol: float = 1e-8):
 
 
 def solve_fixed_pressure(n_pores, throat_conns, g, inlet, outlet, *, p_in: float = 1.0,
-                         p_out: float = 0.0, tol: float = 1e-12, maxiter: int = 500,
+                         p_out: float = 0.0, tol: float = 1e-10, maxiter: int = 500,
                          solver: Callable | None = None, check_rtol: float = 1e-8):
     """Assemble, fix inlet/outlet pressures, solve and verify (one call for the pipeline).
 
@@ -319,10 +318,12 @@ def solve_fixed_pressure(n_pores, throat_conns, g, inlet, outlet, *, p_in: float
     outlet = np.asarray(outlet, dtype=np.int64)
     if inlet.size == 0 or outlet.size == 0:
         raise ValueError(f"need inlet and outlet pores, got {inlet.size} and {outlet.size}")
+    t0 = time.perf_counter()
     A = assemble_laplacian(n_pores, throat_conns, g)
     pores = np.concatenate([inlet, outlet])
     vals = np.concatenate([np.full(inlet.size, p_in), np.full(outlet.size, p_out)])
     A_ii, b_i, free, p = apply_pressure_bc(A, np.zeros(n_pores), pores, vals)
+    t_asm = time.perf_counter() - t0
     x, info = solve_pressure(A_ii, b_i, tol=tol, maxiter=maxiter, solver=solver)
     p[free] = x
     check = verify_solution(throat_conns, g, p, inlet, outlet, rtol=check_rtol)
@@ -334,4 +335,5 @@ def solve_fixed_pressure(n_pores, throat_conns, g, inlet, outlet, *, p_in: float
                                    solve_s=info.solve_s + info2.solve_s)
         check = verify_solution(throat_conns, g, p, inlet, outlet, rtol=check_rtol)
         log.info("re-solved with tol %.0e: check ok = %s", tol * 1e-2, check["ok"])
+    info.assemble_s = t_asm
     return p, info, check

@@ -236,6 +236,8 @@ def solve_network(packing: Packing, *, axis="z", region: Region | None = None,
     with stage("solve"):
         p, info, check = solve_fixed_pressure(sample.n_pores, sample.conns, g, sample.inlet,
                                               sample.outlet, p_in=1.0, p_out=0.0, solver=solver)
+    times["assemble"] = info.assemble_s
+    times["solve"] -= info.assemble_s
     if not check["ok"]:
         log.warning("mass balance check failed: %s", {k: v for k, v in check.items()
                                                        if k != "throat_flow"})
@@ -256,7 +258,8 @@ def solve_network(packing: Packing, *, axis="z", region: Region | None = None,
     times["total"] = float(sum(v for kk, v in times.items()))
     if trace_memory:
         times["peak_memory_mb"] = peaks
-    solver_info = {"method": info.method, "iterations": info.iterations,
+    solver_info = {"method": info.method, "iterations": info.iterations, "n_unknowns":
+                   int(sample.n_pores - sample.inlet.size - sample.outlet.size),
                    "converged": info.converged, "residual": info.residual,
                    "setup_s": info.setup_s, "solve_s": info.solve_s}
     chk = {k2: v for k2, v in check.items() if k2 != "throat_flow"}
@@ -311,6 +314,10 @@ def _jsonable(d):
             out[str(k)] = float(v)
         elif isinstance(v, (str, int, float, bool)) or v is None:
             out[str(k)] = v
+        elif isinstance(v, np.ndarray):
+            if v.size <= 8:
+                out[str(k)] = v.tolist()
+            # long per-throat arrays are not summary material: left out
         elif isinstance(v, (list, tuple)):
             out[str(k)] = [x.item() if hasattr(x, "item") else x for x in v]
         else:

@@ -1,0 +1,240 @@
+"""``python -m network.bench``: speed against error of the network model.
+
+Two parts (issue 4, item 10):
+
+1. **Policies** — the same packing solved with each Q* policy (shape-factor, table-only,
+   table+fe, fe-only): permeability, its difference from the fe-only answer (the reference) and
+   the wall time. FE runs against a fresh temporary throat table unless ``--db`` is given, so
+   their cost is really paid.
+2. **Scaling** — packings of 5 000, 20 000, 100 000 and 500 000 spheres (``random_packing``,
+   periodic box, solid fraction 0.60, d = 5.5–7.5 mm; generated once and kept in ``--workdir``),
+   each run in its own subprocess: time per stage (read CSV, tessellate, sample, conductance,
+   prune, assemble, solve), solver iterations, peak resident memory (``ru_maxrss``) and the peak
+   memory traced per stage (``tracemalloc``: numpy and Python allocations; Qhull's own C
+   allocations are only in ``ru_maxrss``).
+
+Prints a table and writes JSON with the load average, platform, CPU count and a timestamp.
+
+Examples
+--------
+    python -m network.bench --sizes 5000 20000 --policy-spheres 600
+    python -m network.bench --sizes 5000 20000 100000 500000 --skip-policies --json bench.json
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import os
+import platform
+import resource
+import shutil
+import subprocess
+import sys
+import tempfile
+import time
+from pathlib import Path
+
+import numpy as np
+
+from ._conductance import POLICIES
+from ._generate import random_packing
+from ._io import read_packing, write_packing_csv
+from ._pipeline import solve_network
+
+
+def _machine() -> dict:
+    return {"platform": platform.platform(), "python": platform.python_version(),
+            "cpu_count": os.cpu_count(), "loadavg": list(os.getloadavg()),
+            "timestamp": time.strftime("%Y-%m-%dT%H:%M:%SZ", time.gmtime())}
+
+
+def _packing_file(n: int, workdir: Path, seed: int) -> Path:
+    path = workdir / f"bench_{n}_s{seed}.csv"
+    if not path.exists():
+        t0 = time.perf_counter()
+        pk = random_packing(n, rng=seed, periodic=True, solid_fraction=0.60)
+        write_packing_csv(pk, path, digits=7)
+        print(f"  generated {n} spheres in {time.perf_counter() - t0:.1f} s -> {path}",
+              flush=True)
+    return path
+
+
+def run_one(path: Path, policy: str, db, repeats: int) -> dict:
+    """One scaling case in this process: stage times, iterations, memory."""
+    best = None
+    for _ in range(repeats):
+        t0 = time.perf_counter()
+        pk = read_packing(path)
+        t_read = time.perf_counter() - t0
+        res = solve_network(pk, axis="z", policy=policy, db=db, porosity_points=0,
+                            trace_memory=False)
+        wall = time.perf_counter() - t0
+        if best is None or wall < best["wall_s"]:
+            best = {"wall_s": wall, "read_s": t_read, "stages_s": dict(res.timings_s),
+                    "iterations": res.solver["iterations"], "n_unknowns": res.solver["n_unknowns"],
+                    "solver_setup_s": res.solver["setup_s"], "solver_solve_s": res.solver["solve_s"],
+                    "n_pores": res.n_pores, "n_throats": res.n_throats,
+                    "permeability_m2": res.permeability_m2, "mass_balance_ok": res.check["ok"],
+                    "qstar_sources": res.qstar_stats.get("sources", {})}
+    walls_rss = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024.0
+    # one more pass with tracemalloc for per-stage traced peaks (slower; not timed)
+    pk = read_packing(path)
+    res = solve_network(pk, axis="z", policy=policy, db=db, porosity_points=0, trace_memory=True)
+    best["traced_peak_mb"] = res.timings_s.get("peak_memory_mb", {})
+    best["max_rss_mb"] = max(walls_rss, resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024.0)
+    best["n_spheres"] = pk.n
+    best["policy"] = policy
+    best["repeats"] = repeats
+    return best
+
+
+def _scaling(sizes, workdir, policy, db, seed, repeats, timeout):
+    rows = []
+    for n in sizes:
+        path = _packing_file(n, workdir, seed)
+        cmd = [sys.executable, "-m", "network.bench", "--one", str(path), "--policy", policy,
+               "--repeats", str(repeats if n <= 100_000 else 1)]
+        if db:
+            cmd += ["--db", str(db)]
+        load0 = os.getloadavg()[0]
+        t0 = time.perf_counter()
+        try:
+            out = subprocess.run(cmd, capture_output=True, text=True, timeout=timeout, check=False)
+        except subprocess.TimeoutExpired:
+            rows.append({"n_spheres": n, "error": f"timeout after {timeout} s"})
+            print(f"  {n}: timeout", flush=True)
+            continue
+        if out.returncode != 0:
+            rows.append({"n_spheres": n, "error": out.stderr.strip().splitlines()[-1:]})
+            print(f"  {n}: failed: {out.stderr.strip().splitlines()[-1:]}", flush=True)
+            continue
+        row = json.loads(out.stdout.strip().splitlines()[-1])
+        row["subprocess_s"] = time.perf_counter() - t0
+        row["loadavg_1min_before"] = load0
+        rows.append(row)
+        st = row["stages_s"]
+        print(f"  {n:>7d} spheres: wall {row['wall_s']:7.2f} s (read {row['read_s']:.2f}, "
+              f"tess {st['tessellate']:.2f}, cond {st['conductance']:.2f}, "
+              f"asm {st['assemble']:.2f}, solve {st['solve']:.2f}); {row['iterations']} it; "
+              f"{row['n_unknowns']} unknowns; max RSS {row['max_rss_mb']:.0f} MB", flush=True)
+    return rows
+
+
+def _has_table(db) -> bool:
+    try:
+        from cache import load_grid_table
+        return load_grid_table(db) is not None
+    except Exception:  # noqa: BLE001 - no cache, no grid, foreign file: no table
+        return False
+
+
+def _policies(n, policy_list, db, seed, workers):
+    pk = random_packing(n, rng=seed, periodic=True, solid_fraction=0.60)
+    tmp = None
+    if db is None:
+        tmp = Path(tempfile.mkdtemp(prefix="grainflow-bench-"))
+        db_used = tmp / "throats.sqlite"
+        # the interpolation grid of the default table serves table policies: copy it if present
+        try:
+            from cache import default_db_path
+            src = Path(default_db_path())
+            if src.exists():
+                shutil.copy(src, db_used)
+        except Exception:  # noqa: BLE001 - bench goes on without a grid
+            pass
+    else:
+        db_used = Path(db)
+    rows = []
+    for pol in policy_list:
+        t0 = time.perf_counter()
+        try:
+            res = solve_network(pk, axis="z", policy=pol, db=db_used, workers=workers,
+                                porosity_points=0)
+            rows.append({"policy": pol, "permeability_m2": res.permeability_m2,
+                         "seconds": time.perf_counter() - t0,
+                         "conductance_s": res.timings_s["conductance"],
+                         "sources": res.qstar_stats.get("sources", {}),
+                         "n_throats": res.n_throats})
+        except Exception as e:  # noqa: BLE001 - report every policy
+            rows.append({"policy": pol, "error": f"{type(e).__name__}: {e}",
+                         "seconds": time.perf_counter() - t0})
+    ref = next((r["permeability_m2"] for r in rows
+                if r["policy"] == "fe-only" and "permeability_m2" in r), None)
+    for r in rows:
+        if ref and "permeability_m2" in r:
+            r["rel_diff_vs_fe_only"] = r["permeability_m2"] / ref - 1.0
+    if tmp is not None:
+        shutil.rmtree(tmp, ignore_errors=True)
+    return {"n_spheres": n, "seed": seed, "rows": rows}
+
+
+def main(argv=None) -> int:
+    ap = argparse.ArgumentParser(prog="python -m network.bench", description=__doc__.split("\n")[0])
+    ap.add_argument("--sizes", type=int, nargs="*", default=[5000, 20000, 100000],
+                    help="sphere counts of the scaling part (default 5000 20000 100000; add "
+                         "500000 for the full run)")
+    ap.add_argument("--policy", default="table-only", choices=POLICIES,
+                    help="Q* policy of the scaling part (default table-only: a precomputed table)")
+    ap.add_argument("--policies", nargs="*", default=list(POLICIES), choices=POLICIES)
+    ap.add_argument("--policy-spheres", type=int, default=600,
+                    help="packing size of the policy comparison (FE cost grows with it)")
+    ap.add_argument("--skip-policies", action="store_true")
+    ap.add_argument("--db", default=None, help="throat table (default: a temporary copy)")
+    ap.add_argument("--workers", type=int, default=1, help="FE processes")
+    ap.add_argument("--workdir", default=None,
+                    help="where generated packings are kept (default ~/.cache/grainflow/bench)")
+    ap.add_argument("--seed", type=int, default=1)
+    ap.add_argument("--repeats", type=int, default=2, help="repeats per size (minimum reported)")
+    ap.add_argument("--timeout", type=float, default=1800.0, help="per-size limit, s")
+    ap.add_argument("--json", dest="json_out", default="network_bench.json")
+    ap.add_argument("--one", default=None, help=argparse.SUPPRESS)
+    args = ap.parse_args(argv)
+
+    if args.one:  # child process of the scaling part
+        row = run_one(Path(args.one), args.policy, args.db, args.repeats)
+        print(json.dumps(row))
+        return 0
+
+    workdir = Path(args.workdir or Path.home() / ".cache" / "grainflow" / "bench")
+    workdir.mkdir(parents=True, exist_ok=True)
+    report = {"machine_start": _machine()}
+    if not args.skip_policies:
+        print(f"policies on a {args.policy_spheres}-sphere packing:", flush=True)
+        pol = _policies(args.policy_spheres, args.policies, args.db, args.seed, args.workers)
+        report["policies"] = pol
+        for r in pol["rows"]:
+            if "error" in r:
+                print(f"  {r['policy']:>13s}: {r['error']}")
+            else:
+                d = r.get("rel_diff_vs_fe_only")
+                print(f"  {r['policy']:>13s}: k = {r['permeability_m2']:.4e} m²"
+                      + (f" ({d:+.2%} vs fe-only)" if d is not None else "")
+                      + f", {r['seconds']:.2f} s (Q* {r['conductance_s']:.2f} s) {r['sources']}")
+    if args.sizes:
+        policy = args.policy
+        if policy in ("table-only", "table+fe") and not _has_table(args.db):
+            report["scaling_policy_note"] = (f"no interpolation table for {args.db or 'the default db'}"
+                                             f": {policy} replaced by shape-factor")
+            print(f"  note: {report['scaling_policy_note']}")
+            policy = "shape-factor"
+        report["scaling_policy"] = policy
+        print(f"scaling ({policy}):", flush=True)
+        report["scaling"] = _scaling(args.sizes, workdir, policy, args.db, args.seed,
+                                     args.repeats, args.timeout)
+        ok = [r for r in report["scaling"] if "wall_s" in r]
+        if len(ok) >= 2:
+            n = np.array([r["n_spheres"] for r in ok], dtype=float)
+            w = np.array([r["wall_s"] for r in ok])
+            slope = np.polyfit(np.log(n), np.log(w), 1)[0]
+            report["scaling_exponent"] = float(slope)
+            print(f"  wall time ~ N^{slope:.2f} over {int(n.min())}..{int(n.max())} spheres")
+    report["machine_end"] = _machine()
+    with open(args.json_out, "w") as f:
+        json.dump(report, f, indent=2, default=str)
+    print(f"load average {report['machine_end']['loadavg']}; wrote {args.json_out}")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
