@@ -351,6 +351,14 @@ def mesh_geometry(geom, h, *, lfs_factor=1.0, h_min=1e-4, curv_angle=0.6, grade=
         if kind == "arc":
             on_arc[[i0, i1]] = np.minimum(on_arc[[i0, i1]], rad)
     cap = np.minimum(h, curv_angle * on_arc)
+    # at least two elements on every curve: one-element curves made gmsh's 2D mesher
+    # loop forever on a coarse hexagon-like region (h = 1, [1,1,1], [3,3,3])
+    half_len = np.full(len(pts), np.inf)
+    for kind, i0, i1, cen, rad, bc in geom.curves:
+        chord = np.linalg.norm(pts[i1] - pts[i0])
+        length = chord if kind == "line" else 2 * rad * np.arcsin(min(chord / (2 * rad), 1.0))
+        half_len[[i0, i1]] = np.minimum(half_len[[i0, i1]], 0.5 * length)
+    cap = np.minimum(cap, np.maximum(half_len, h_min))
     lc = np.clip(np.minimum(cap, lfs_factor * geom.lfs), h_min, None)
     ptag = [g.addPoint(x, y, 0.0, float(s)) for (x, y), s in zip(pts, lc)]
     ctag, noslip, sym = [], [], []

@@ -42,7 +42,7 @@ __all__ = ["SOLVER_VERSION", "ThroatSolution", "solve_fem"]
 logger = logging.getLogger(__name__)
 
 #: bump whenever results could change (the cache keys on it)
-SOLVER_VERSION = "1.0"
+SOLVER_VERSION = "1.1"
 
 _FORMS = {}
 
