@@ -870,6 +870,7 @@ def build_paths(points, radii, entry_xy, *, kind="widest", axis="z", k_neighbors
         up = x[tri].mean(axis=2)[:, :, ax] > hc[go, None]
         step_areas[ga, count[ga]] = areas[go]
         step_up[ga, count[ga]] = up
+        banned[ga, count[ga]] = False  # the slot may hold bans of a tetrahedron dropped before
         tetra[ga, count[ga]] = tet
         used[ga, choice[go]] = True
         count[ga] += 1
