@@ -114,7 +114,8 @@ def lattice_radius(kind: str, solid_fraction: float, *, lattice_constant_m: floa
     Raises
     ------
     ValueError
-        Fraction out of (0, touching] (a 1e-12 relative excess is tolerated and
+        Fraction out of (0, touching] (a 1e-4 relative excess, as in a published 0.5236 for
+        pi/6, is tolerated and
         clipped), or a non-positive lattice constant.
 
     Examples
@@ -130,7 +131,7 @@ def lattice_radius(kind: str, solid_fraction: float, *, lattice_constant_m: floa
     if not (math.isfinite(a) and a > 0):
         raise ValueError(f"lattice_constant_m must be positive and finite, got {lattice_constant_m!r}")
     phi_max = TOUCHING_FRACTION[k]
-    if not (math.isfinite(phi) and 0.0 < phi <= phi_max * (1.0 + 1e-12)):
+    if not (math.isfinite(phi) and 0.0 < phi <= phi_max * (1.0 + 1e-4)):
         raise ValueError(
             f"solid_fraction must be in (0, {phi_max:.7f}] for {k} (touching), got {solid_fraction!r}"
         )
