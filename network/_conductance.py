@@ -202,7 +202,8 @@ def throat_qstar(radii, sides, *, policy: str = "table+fe", rtol: float = 1e-3, 
 
 def throat_conductance(tessellation, throats_idx, *, model: str = "thesis",
                        policy: str = "table+fe", viscosity_pa_s: float = MU_AIR_PA_S,
-                       rtol: float = 1e-3, db=None, workers: int = 1, progress: bool = False):
+                       rtol: float = 1e-3, db=None, workers: int = 1, progress: bool = False,
+                       **model_options):
     """Conductance g (m³ Pa⁻¹ s⁻¹) of selected throats of a tessellation under a model.
 
     Parameters
@@ -216,6 +217,9 @@ def throat_conductance(tessellation, throats_idx, *, model: str = "thesis",
         Passed to :func:`throat_qstar` (and to the conduit model).
     viscosity_pa_s : float
         μ, Pa·s (default 1.932e-5).
+    **model_options
+        Passed to the conduit model only (e.g. ``merge``, the pore bodies already used to
+        contract the network).
 
     Returns
     -------
@@ -237,9 +241,11 @@ def throat_conductance(tessellation, throats_idx, *, model: str = "thesis",
                 "network._conduit.conduit_conductance(tessellation, throats_idx, *, "
                 "viscosity_pa_s, policy, rtol, db, workers, progress) -> (g, info)") from e
         out = fn(tessellation, idx, viscosity_pa_s=viscosity_pa_s, policy=policy, rtol=rtol,
-                 db=db, workers=workers, progress=progress)
+                 db=db, workers=workers, progress=progress, **model_options)
         g, info = out if isinstance(out, tuple) else (out, None)
         return np.asarray(g, dtype=float), info
+    if model_options:
+        raise TypeError(f"options {sorted(model_options)} apply to the conduit model only")
     radii = tessellation.throat_radii[idx]
     sides = tessellation.throat_sides[idx]
     qres = throat_qstar(radii, sides, policy=policy, rtol=rtol, db=db, workers=workers,

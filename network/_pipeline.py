@@ -213,8 +213,19 @@ def solve_network(packing: Packing, *, axis="z", region: Region | None = None,
         tess = tessellate(packing) if tessellation is None else tessellation
     with stage("sample"):
         reg = default_region(packing, margin=margin, cylinder=cylinder) if region is None else region
-        labels = None
-        if merge_ties:
+        labels, model_opts = None, {}
+        if conductance is None and conductance_model == "conduit" and merge_ties:
+            # the conduit model's pore bodies (near-co-spherical groups, slivers) are
+            # contracted here, so its near-infinite internal conductances never reach the solver
+            try:
+                from ._merge import merge_pores
+            except ImportError:
+                merge_pores = None
+            if merge_pores is not None:
+                merge = merge_pores(tess)
+                labels = np.asarray(merge.labels)
+                model_opts = {"merge": merge}
+        if labels is None and merge_ties:
             labels, n_groups = tie_groups(tess)
             if n_groups == tess.n_pores:
                 labels = None
@@ -226,7 +237,8 @@ def solve_network(packing: Packing, *, axis="z", region: Region | None = None,
         else:
             g, qres = throat_conductance(tess, sample.throats, model=conductance_model,
                                          policy=policy, viscosity_pa_s=viscosity_pa_s, rtol=rtol,
-                                         db=db, workers=workers, progress=progress)
+                                         db=db, workers=workers, progress=progress,
+                                         **model_opts)
             if qres is not None and hasattr(qres, "stats"):
                 qstats = _jsonable(qres.stats)
             elif isinstance(qres, dict):
