@@ -88,11 +88,18 @@ def test_non_positive_stiffness_is_refused(field):
         Material(**{field: -1.0})
 
 
-def test_same_seed_same_packing_and_io_roundtrip(tmp_path):
-    # short stages (the test checks reproducibility, not convergence)
-    kw = dict(rng=7, tol=2e-2, grow_steps=500, max_steps=2500, lid_headroom=1.0)
-    a = pack(TINY, **kw)
-    b = pack(TINY, **kw)
+KW = dict(rng=7, tol=2e-2, grow_steps=500, max_steps=2500, lid_headroom=1.0)
+
+
+@pytest.fixture(scope="module")
+def tiny_bed():
+    # short stages (the tests check reproducibility and bookkeeping, not convergence)
+    return pack(TINY, **KW)
+
+
+def test_same_seed_same_packing_and_io_roundtrip(tmp_path, tiny_bed):
+    a = tiny_bed
+    b = pack(TINY, **KW)
     np.testing.assert_array_equal(a.centers, b.centers)
     np.testing.assert_array_equal(a.radii, b.radii)
     x7, _ = generate_spheres(TINY, 50, 0.002, 0.0027, np.random.default_rng(7))
@@ -111,3 +118,19 @@ def test_same_seed_same_packing_and_io_roundtrip(tmp_path):
     x, r, js = read_packing(p)
     np.testing.assert_allclose(x, a.centers, rtol=1e-8, atol=1e-12)
     assert js["n_spheres"] == s["n_spheres"]
+
+
+def test_vibration_records_histories(tiny_bed):
+    from dem import vibrate
+
+    res = vibrate(tiny_bed.centers, tiny_bed.radii, TINY, freq_hz=15, amplitude_m=0.0, duration_s=0.02,
+                  record_every_s=0.005, snapshot_times_s=[0.01], max_settle_steps=200)
+    # 0.02 s recorded every 0.005 s, plus the initial and the post-settling records
+    assert len(res.times_s) == 6 and res.porosity_spheres.shape == (6, 5)
+    assert 0.01 in res.snapshots
+    for h in (res.porosity_spheres, res.porosity_interior, res.porosity_global):
+        assert np.all((h > 0) & (h < 1))
+    assert np.all(res.centers[:, 2] - res.radii > -1e-4)  # nobody fell through the floor
+    assert res.summary["intensity_g"] == 0.0
+    with pytest.raises(ValueError, match="freq_hz"):
+        vibrate(tiny_bed.centers, tiny_bed.radii, TINY, freq_hz=0.0, amplitude_m=0.001, duration_s=0.1)
