@@ -460,8 +460,9 @@ def entry_faces(graph, entry_xy, *, axis="z", min_quality=MIN_QUALITY):
     """Start tetrahedron and face of a path on the tessellation for each entry point.
 
     The start tetrahedron is the enterable one (see :func:`passable_pores`) within
-    :data:`END_BAND_DIAMETERS` mean diameters of the floor whose centroid is nearest to the
-    entry point on the floor; the path starts at its lowest face.
+    :data:`END_BAND_DIAMETERS` mean diameters of the floor, connected to the top through open
+    faces and enterable tetrahedra, whose centroid is nearest to the entry point on the floor;
+    the path starts at its lowest face.
 
     Returns
     -------
@@ -472,10 +473,20 @@ def entry_faces(graph, entry_xy, *, axis="z", min_quality=MIN_QUALITY):
     if xy.ndim != 2 or xy.shape[1] != 2:
         raise ValueError(f"entry points must have shape (n, 2), got {xy.shape}")
     passable = passable_pores(graph, min_quality=min_quality)
-    low, _, bottom, _, pc = _ends(graph, ax, passable)
-    cand = np.flatnonzero(low)
+    low, high, bottom, _, pc = _ends(graph, ax, passable)
+    # keep start tetrahedra that open (through open faces and enterable tetrahedra) onto the top
+    tp = graph.throat_pores
+    inner = tp[:, 1] >= 0
+    link = inner & (graph.throat_open_area > 0)
+    link[inner] &= passable[tp[inner, 0]] & passable[tp[inner, 1]]
+    adj = sparse.csr_array((np.ones(int(link.sum())), (tp[link, 0], tp[link, 1])),
+                           shape=(graph.n_pores, graph.n_pores))
+    _, comp = csgraph.connected_components(adj, directed=False)
+    through = np.intersect1d(comp[low], comp[high])
+    cand = np.flatnonzero(low & np.isin(comp, through))
     if cand.size == 0:
-        raise ValueError("no enterable tetrahedron near the floor (min_quality too high?)")
+        raise ValueError("no enterable tetrahedron near the floor opens onto the top "
+                         "(min_quality too high?)")
     plane = _plane_axes(ax)
     cc = graph.points[graph.pore_vertices[cand]].mean(axis=1)
     lo = graph.points[:, ax].min()

@@ -228,12 +228,19 @@ def _pressure_along(args, x, r, source, tess, graph, paths):
     from ._tessellation import tie_groups
 
     t = time.perf_counter()
+    from ._sample import Region
+
+    # sample: 1.5 mean diameters from the side walls (less in a thin bin), 4 mean diameters
+    # (the thesis's 0.026 m) from the floor and from the highest centre, so a loose top surface
+    # still leaves outlet pores
     ax = "xyz".index(args.axis)
-    lateral = np.ptp(np.delete(x, ax, axis=1), axis=0).min()
-    margin = min(3.0 * r.mean(), 0.2 * lateral)  # the solver's default, unless the bin is thin
+    d = 2.0 * r.mean()
+    lo, hi = x.min(axis=0), x.max(axis=0)
+    m = np.minimum(1.5 * d, 0.2 * (hi - lo))
+    m[ax] = 4.0 * d
     res = solve_network(Packing(x, r, source), axis=args.axis, tessellation=tess,
                         policy=args.policy, velocity_m_s=args.velocity[0], porosity_points=0,
-                        margin=margin)
+                        region=Region(lo + m, hi - m))
     labels, n_groups = tie_groups(tess)
     p_all = pore_pressure_array(tess.n_pores, res.pore_ids, res.pressure_pa,
                                 None if n_groups == tess.n_pores else labels)
