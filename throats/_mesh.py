@@ -70,6 +70,8 @@ class ThroatGeometry:
         Closed loops of curve indices (one per connected piece of the open region).
     area : float
         Exact area of the region (after closing), from Green's theorem.
+    error : str
+        Why the boundary could not be assembled ('' when it could).
     """
 
     points: np.ndarray
@@ -77,6 +79,7 @@ class ThroatGeometry:
     curves: list
     loops: list
     area: float
+    error: str = ""
 
 
 def _unit(v):
@@ -132,12 +135,16 @@ def _closing_rules(verts, radii, delta, feature_width):
             xs = np.sqrt(ri**2 - (h - 0.5 * delta) ** 2)
             on = (h - ri < 0.5 * delta) & np.isfinite(xs)
             lo, hi = -0.5 * delta, min(delta, 1.0)
+            # orient each cut so that the fluid (x > x* on the right cut, x < -x* on the
+            # left one) is on its left; whether the left normal of +n is +e depends on the
+            # vertex (the frame (e, n) flips handedness for i = 1)
+            plus_e_left = (np.sum(_left(n) * e, axis=1) > 0)[:, None]
             for sign in (1.0, -1.0):
-                top = foot + e * (sign * xs)[:, None] + n * hi
-                bot = foot + e * (sign * xs)[:, None] + n * lo
-                # right cut (+x side fluid): downwards; left cut: upwards
-                segs_a.append(np.where(on[:, None], top if sign > 0 else bot, 0.0))
-                segs_b.append(np.where(on[:, None], bot if sign > 0 else top, 0.0))
+                low = foot + e * (sign * xs)[:, None] + n * lo
+                high = foot + e * (sign * xs)[:, None] + n * hi
+                up = plus_e_left if sign > 0 else ~plus_e_left   # direction +n
+                segs_a.append(np.where(on[:, None], np.where(up, low, high), 0.0))
+                segs_b.append(np.where(on[:, None], np.where(up, high, low), 0.0))
                 owner.append(4 + m)
                 present.append(on)
             for key, val in (("origin", foot), ("e", e), ("n", n), ("x0", -xs), ("x1", xs),
@@ -212,7 +219,11 @@ def _extract(res, verts, radii, q):
     pts, idx = _snap(ends, 1e-8)
     idx = idx.reshape(-1, 2)
     curves = [(p[0], int(i0), int(i1), p[3], p[4], p[5]) for p, (i0, i1) in zip(pieces, idx)]
-    loops = _chain(idx)
+    try:
+        loops = _chain(idx)
+    except ValueError as exc:
+        return ThroatGeometry(pts, np.zeros(len(pts)), curves, [], float(res["area"][q]),
+                              error=str(exc))
     lfs = _local_feature_size(pts, curves)
     return ThroatGeometry(pts, lfs, curves, loops, float(res["area"][q]))
 

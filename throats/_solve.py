@@ -35,7 +35,7 @@ import numpy as np
 
 from ._geometry import (_as_throats, canonical_form, contact_type, mean_radius, open_area,
                         validate_throats)
-from ._mesh import DELTA_DEFAULT, TriMesh, build_geometries, mesh_geometry
+from ._mesh import DELTA_DEFAULT, ThroatGeometry, TriMesh, build_geometries, mesh_geometry
 
 __all__ = ["SOLVER_VERSION", "ThroatSolution", "solve_fem"]
 
@@ -224,6 +224,8 @@ def _h_for_rtol(rtol):
 
 def _solve_geometry(geom, rtol, *, max_refine=2):
     """Q*, error estimate, element count, status, message for one ThroatGeometry."""
+    if geom.error:
+        return np.nan, np.nan, 0, "failed", f"boundary construction failed: {geom.error}"
     if not geom.loops or geom.area <= 0:
         return 0.0, 0.0, 0, "closed", "open region closed (narrower than the closing width)"
     h, ca = _h_for_rtol(rtol)
@@ -260,7 +262,17 @@ def _solve_chunk(radii, sides, rtol, delta):
     _gmsh()                      # initialise gmsh and import skfem outside the timings
     _reference(4, 8)
     rs, ss = canonical_form(radii, sides)
-    geoms = build_geometries(rs, ss, delta=delta)
+    try:
+        geoms = build_geometries(rs, ss, delta=delta)
+    except Exception as exc:   # never raise for a batch: fall back to one throat at a time
+        logger.warning("vectorised geometry failed (%s); building throats one by one", exc)
+        geoms = []
+        for k in range(rs.shape[0]):
+            try:
+                geoms.append(build_geometries(rs[k:k + 1], ss[k:k + 1], delta=delta)[0])
+            except Exception as exc1:
+                geoms.append(ThroatGeometry(np.zeros((0, 2)), np.zeros(0), [], [], 0.0,
+                                            error=f"{type(exc1).__name__}: {exc1}"))
     out = []
     for g in geoms:
         t0 = time.perf_counter()
