@@ -4,15 +4,19 @@ Usage::
 
     python -m network.paths PACKING [--entry X Y | --entries N] [--kind widest|narrowest|
         maximin|shortest|all] [--axis z] [--method build|delaunay] [--seed S]
-        [--velocity U ...] [--json OUT.json] [--plot OUT.png]
+        [--velocity U ...] [--branches path|all] [--pressure [--policy P]]
+        [--json OUT.json] [--plot OUT.png] [--standin LX LY LZ]
 
 ``widest``/``narrowest`` are the thesis's step-increment paths (``--method build``: tetrahedra
 built sphere by sphere as in Appendices D-E; ``--method delaunay``: the same rule walked on the
 Delaunay tessellation); ``maximin`` is the optimal widest (maximin-bottleneck) path and
 ``shortest`` the shortest path on the tessellation. Entry points are (X, Y) in metres in the
 plane normal to ``--axis`` (the other two axes in x, y, z order); ``--entries N`` draws N at
-random (``--seed``) away from the walls. The branched-path model (Table 4.4 layout) is evaluated
-on every widest/narrowest path at each ``--velocity``.
+random (``--seed``) away from the walls. The branched-path model (Table 4.4 layout, then the
+Table 4.5 comparison with ASABE D272 and Ergun) is evaluated on every widest/narrowest path at
+each ``--velocity``; ``--pressure`` solves the network model (``network._pipeline.solve_network``)
+and prints the pressure drop along every path that lies on the tessellation (thesis 4.2.3).
+Timings, load average and platform go into the JSON.
 """
 
 from __future__ import annotations
