@@ -116,7 +116,8 @@ def _check_policy(policy):
 
 
 def throat_qstar(radii, sides, *, policy: str = "table+fe", rtol: float = 1e-3, db=None,
-                 workers: int = 1, progress: bool = False) -> QstarResult:
+                 workers: int = 1, progress: bool = False,
+                 on_failed: str = "shape-factor") -> QstarResult:
     """Dimensionless flow rate Q* (r̄ units) of N throats under a policy.
 
     Parameters
@@ -132,6 +133,10 @@ def throat_qstar(radii, sides, *, policy: str = "table+fe", rtol: float = 1e-3, 
         Processes for finite-element solves.
     progress : bool
         Progress bar on long FE batches.
+    on_failed : {'shape-factor', 'raise'}
+        What to do with throats the policy could not answer (FE failure, ``'failed'`` source):
+        use their shape-factor estimate (default; counted in ``stats`` and logged as a
+        warning), or raise.
 
     Returns
     -------
@@ -142,9 +147,11 @@ def throat_qstar(radii, sides, *, policy: str = "table+fe", rtol: float = 1e-3, 
     ValueError
         Unknown policy, or a policy needing the table while ``cache`` is unavailable.
     RuntimeError
-        Some throats could not be solved (their count and first message are given).
+        Some throats have no valid Q* (``on_failed='raise'``, or the fallback failed too).
     """
     _check_policy(policy)
+    if on_failed not in ("shape-factor", "raise"):
+        raise ValueError(f"on_failed must be 'shape-factor' or 'raise', got {on_failed!r}")
     radii = np.asarray(radii, dtype=float)
     sides = np.asarray(sides, dtype=float)
     n = radii.shape[0]
@@ -186,6 +193,20 @@ def throat_qstar(radii, sides, *, policy: str = "table+fe", rtol: float = 1e-3, 
             raise ValueError(f"policy {policy!r} needs the throat table, but cache.lookup_qstar "
                              "is not available; use 'shape-factor' or 'fe-only'")
     bad = ~np.isfinite(q) | (q < 0)
+    n_fallback = 0
+    if bad.any() and on_failed == "shape-factor":
+        import throats
+
+        q = q.copy()
+        src = src.astype("<U24")
+        q[bad] = np.asarray(throats.shape_factor_qstar(radii[bad], sides[bad]), dtype=float)
+        src[bad] = "shape-factor-fallback"
+        err = err.copy()
+        err[bad] = np.nan
+        n_fallback = int(bad.sum())
+        log.warning("%d of %d throats had no valid Q* from %s (FE failure or table miss): "
+                    "their shape-factor estimate is used instead", n_fallback, n, policy)
+        bad = ~np.isfinite(q) | (q < 0)
     if bad.any():
         k = int(np.flatnonzero(bad)[0])
         raise RuntimeError(f"{int(bad.sum())} of {n} throats have no valid Q* (first: radii "
@@ -193,6 +214,7 @@ def throat_qstar(radii, sides, *, policy: str = "table+fe", rtol: float = 1e-3, 
     seconds = time.perf_counter() - t0
     kinds, counts = np.unique(src, return_counts=True)
     stats.update({"policy": policy, "backend": backend, "seconds": seconds, "rtol": rtol,
+                  "n_shape_factor_fallback": n_fallback,
                   "n_throats": int(n),
                   "sources": {str(k): int(c) for k, c in zip(kinds, counts)}})
     log.info("Q* of %d throats by %s (%s) in %.2f s: %s", n, policy, backend, seconds,

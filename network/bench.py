@@ -4,8 +4,8 @@ Two parts (issue 4, item 10):
 
 1. **Policies** — the same packing solved with each Q* policy (shape-factor, table-only,
    table+fe, fe-only): permeability, its difference from the fe-only answer (the reference) and
-   the wall time. FE runs against a fresh temporary throat table unless ``--db`` is given, so
-   their cost is really paid.
+   the wall time. Each policy runs against its own fresh copy of the table (``--db``, default
+   the cache's default table), so FE cost is really paid and no policy reuses another's solves.
 2. **Scaling** — packings of 5 000, 20 000, 100 000 and 500 000 spheres (``random_packing``,
    periodic box, solid fraction 0.60, d = 5.5–7.5 mm; generated once and kept in ``--workdir``),
    each run in its own subprocess: time per stage (read CSV, tessellate, sample, conductance,
@@ -129,24 +129,32 @@ def _has_table(db) -> bool:
         return False
 
 
+def _copy_db(src: Path | None, dst: Path) -> None:
+    """Consistent copy of a (WAL-mode) SQLite table through the backup API."""
+    import sqlite3
+
+    if src is None or not Path(src).exists():
+        return
+    with sqlite3.connect(f"file:{src}?mode=ro", uri=True) as a, sqlite3.connect(dst) as b:
+        a.backup(b)
+
+
 def _policies(n, policy_list, db, seed, workers):
+    """Every policy on the same packing, each against its own fresh copy of the table, so that
+    no policy profits from FE solves stored by another."""
     pk = random_packing(n, rng=seed, periodic=True, solid_fraction=0.60)
-    tmp = None
-    if db is None:
-        tmp = Path(tempfile.mkdtemp(prefix="grainflow-bench-"))
-        db_used = tmp / "throats.sqlite"
-        # the interpolation grid of the default table serves table policies: copy it if present
+    base = Path(db) if db else None
+    if base is None:
         try:
             from cache import default_db_path
-            src = Path(default_db_path())
-            if src.exists():
-                shutil.copy(src, db_used)
-        except Exception:  # noqa: BLE001 - bench goes on without a grid
-            pass
-    else:
-        db_used = Path(db)
+            base = Path(default_db_path())
+        except Exception:  # noqa: BLE001 - bench goes on without a table
+            base = None
+    tmp = Path(tempfile.mkdtemp(prefix="grainflow-bench-"))
     rows = []
     for pol in policy_list:
+        db_used = tmp / f"{pol}.sqlite"
+        _copy_db(base, db_used)
         t0 = time.perf_counter()
         try:
             res = solve_network(pk, axis="z", policy=pol, db=db_used, workers=workers,
@@ -164,9 +172,8 @@ def _policies(n, policy_list, db, seed, workers):
     for r in rows:
         if ref and "permeability_m2" in r:
             r["rel_diff_vs_fe_only"] = r["permeability_m2"] / ref - 1.0
-    if tmp is not None:
-        shutil.rmtree(tmp, ignore_errors=True)
-    return {"n_spheres": n, "seed": seed, "rows": rows}
+    shutil.rmtree(tmp, ignore_errors=True)
+    return {"n_spheres": n, "seed": seed, "table": str(base) if base else None, "rows": rows}
 
 
 def main(argv=None) -> int:
@@ -180,7 +187,9 @@ def main(argv=None) -> int:
     ap.add_argument("--policy-spheres", type=int, default=600,
                     help="packing size of the policy comparison (FE cost grows with it)")
     ap.add_argument("--skip-policies", action="store_true")
-    ap.add_argument("--db", default=None, help="throat table (default: a temporary copy)")
+    ap.add_argument("--db", default=None,
+                    help="throat table with the interpolation grid (default: the cache's default; "
+                         "the policy part works on copies)")
     ap.add_argument("--workers", type=int, default=1, help="FE processes")
     ap.add_argument("--workdir", default=None,
                     help="where generated packings are kept (default ~/.cache/grainflow/bench)")

@@ -167,6 +167,12 @@ def main(argv=None) -> int:
         print("anisotropy: k_x : k_y : k_z = " + " : ".join(
             f"{k[a]['permeability_m2'] / out['permeability_m2']:.3f}" for a in axes)
             + " (relative to the mean)")
+    if np.isclose(args.velocity, 0.013) and np.isclose(args.depth, 0.25):
+        t = THESIS_LSV
+        print(f"thesis (soybeans, 0.25 m at 0.013 m/s; section 4.2.3, Table 4.5): measured "
+              f"{t['measured']} ± {t['measured_sd']} Pa, ASABE {t['asabe_d272']} Pa, thesis network "
+              f"{t['thesis_network']} Pa, Ergun {t['ergun']} Pa; this run: "
+              f"{out['pressure_drop_pa']:.3g} Pa")
     print(f"total {total:.2f} s")
     if args.json_out:
         with open(args.json_out, "w") as f:
