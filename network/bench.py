@@ -7,7 +7,8 @@ Two parts (issue 4, item 10):
    the wall time. Each policy runs against its own fresh copy of the table (``--db``, default
    the cache's default table), so FE cost is really paid and no policy reuses another's solves.
 2. **Scaling** — packings of 5 000, 20 000, 100 000 and 500 000 spheres (``random_packing``,
-   periodic box, solid fraction 0.60, d = 5.5–7.5 mm; generated once and kept in ``--workdir``),
+   periodic box, solid fraction 0.60, d = 5.5–7.5 mm; above 100 000 spheres a crop of periodic
+   copies of the 100 000 packing; generated once and kept in ``--workdir``),
    each run in its own subprocess: time per stage (read CSV, tessellate, sample, conductance,
    prune, assemble, solve), solver iterations, peak resident memory (``ru_maxrss``) and the peak
    memory traced per stage (``tracemalloc``: numpy and Python allocations; Qhull's own C
@@ -49,11 +50,38 @@ def _machine() -> dict:
             "timestamp": time.strftime("%Y-%m-%dT%H:%M:%SZ", time.gmtime())}
 
 
+#: Largest packing generated directly; bigger ones tile it periodically (see _packing_file).
+_DIRECT_MAX = 100_000
+
+
+def _tiled(base_n: int, n: int, workdir: Path, seed: int):
+    """A packing of about ``n`` spheres cut from periodic copies of the ``base_n`` packing.
+
+    The base packing is periodic (box side L = (4/3 π Σr³ / 0.60)^(1/3)), so its periodic
+    images tile space without overlaps; a cube of k³ copies is cropped to the sub-cube holding
+    about n spheres. The structure repeats every L, which does not matter for timing.
+    """
+    from ._io import Packing
+
+    base = read_packing(_packing_file(base_n, workdir, seed))
+    box = (4.0 / 3.0 * np.pi * np.sum(base.radii**3) / 0.60) ** (1.0 / 3.0)
+    k = int(np.ceil((n / base.n) ** (1.0 / 3.0)))
+    shifts = np.stack(np.meshgrid(*[np.arange(k)] * 3, indexing="ij"), -1).reshape(-1, 3) * box
+    c = (base.centers[None, :, :] + shifts[:, None, :]).reshape(-1, 3)
+    r = np.tile(base.radii, len(shifts))
+    side = k * box * (n / c.shape[0]) ** (1.0 / 3.0)
+    keep = np.all(c < side, axis=1)
+    return Packing(c[keep], r[keep], source=f"{k}^3 tiling of {base_n} periodic spheres")
+
+
 def _packing_file(n: int, workdir: Path, seed: int) -> Path:
     path = workdir / f"bench_{n}_s{seed}.csv"
     if not path.exists():
         t0 = time.perf_counter()
-        pk = random_packing(n, rng=seed, periodic=True, solid_fraction=0.60)
+        if n <= _DIRECT_MAX:
+            pk = random_packing(n, rng=seed, periodic=True, solid_fraction=0.60)
+        else:
+            pk = _tiled(_DIRECT_MAX, n, workdir, seed)
         write_packing_csv(pk, path, digits=7)
         print(f"  generated {n} spheres in {time.perf_counter() - t0:.1f} s -> {path}",
               flush=True)

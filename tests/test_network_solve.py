@@ -164,3 +164,17 @@ def test_unknown_model_and_policy(small_bed):
         solve_network(small_bed, conductance_model="magic", porosity_points=0)
     with pytest.raises(ValueError, match="unknown Q\\* policy"):
         solve_network(small_bed, policy="guess", porosity_points=0)
+
+
+def test_cylinder_sample(small_bed):
+    """A cylindrical sample (inscribed in the default box) uses A = pi R^2 and only pores whose
+    centre lies inside the cylinder; its permeability is close to the box's (same medium)."""
+    box = default_region(small_bed)
+    cyl = default_region(small_bed, cylinder=True)
+    rb = run(small_bed, axis="z", region=box)
+    rc = run(small_bed, axis="z", region=cyl)
+    np.testing.assert_allclose(rc.area_m2, np.pi * cyl.radius**2)
+    assert rc.n_pores < rb.n_pores
+    lat = rc.pore_xyz[:, :2] - 0.5 * (cyl.lo[:2] + cyl.hi[:2])
+    assert np.all(np.hypot(lat[:, 0], lat[:, 1]) <= cyl.radius)
+    assert 0.7 < rc.permeability_m2 / rb.permeability_m2 < 1.3
