@@ -41,6 +41,9 @@ log = logging.getLogger(__name__)
 #: Qhull options used for the 3-D Delaunay tessellation (see module docstring).
 QHULL_OPTIONS = "Qbb Qc Qz Q12"
 
+# rows per chunk of the vectorised geometry (bounds the temporaries of 500k-sphere packings)
+_CHUNK = 262_144
+
 # face k of a tetrahedron is opposite vertex k (scipy's ``neighbors`` convention)
 _FACE = np.array([[1, 2, 3], [0, 2, 3], [0, 1, 3], [0, 1, 2]])
 
@@ -200,44 +203,66 @@ def tessellate(packing: Packing, *, qhull_options: str = QHULL_OPTIONS,
                          f"(coplanar or degenerate input?): {str(e).splitlines()[0]}") from e
     simp = np.ascontiguousarray(dt.simplices, dtype=np.int64)
     neigh = np.ascontiguousarray(dt.neighbors, dtype=np.int64)
+    del dt
     n_p = simp.shape[0]
     dbar = packing.mean_diameter
 
-    # pores
-    pv = pts[simp]                                   # (Np, 4, 3)
-    centroid = pv.mean(axis=1)
-    e = pv[:, 1:] - pv[:, :1]
-    volume = np.abs(np.linalg.det(e)) / 6.0
-    circ = _circumcenters(pv)
+    # pores, in chunks so that the (chunk, 4, 3) temporaries stay small
+    centroid = np.empty((n_p, 3))
+    volume = np.empty(n_p)
+    circ = np.empty((n_p, 3))
+    for a in range(0, n_p, _CHUNK):
+        b = min(a + _CHUNK, n_p)
+        pv = pts[simp[a:b]]                                   # (m, 4, 3)
+        centroid[a:b] = pv.mean(axis=1)
+        volume[a:b] = np.abs(np.linalg.det(pv[:, 1:] - pv[:, :1])) / 6.0
+        circ[a:b] = _circumcenters(pv)
     flat = volume < flat_tol * dbar**3
 
     # throats: face k of t kept when t < neighbour or neighbour is -1
-    t_idx = np.repeat(np.arange(n_p), 4)
-    k_idx = np.tile(np.arange(4), n_p)
     nb = neigh.ravel()
-    keep = (nb < 0) | (t_idx < nb)
-    ft, fk, fn = t_idx[keep], k_idx[keep], nb[keep]
-    tv = np.sort(simp[ft[:, None], _FACE[fk]], axis=1)
-    n_t = tv.shape[0]
+    keep = nb < 0
+    keep |= np.repeat(np.arange(n_p), 4) < nb
+    slots = np.flatnonzero(keep)
+    del keep
+    ft, fk = np.divmod(slots, 4)
+    fn = nb[slots]
+    n_t = slots.size
+    tv = np.empty((n_t, 3), dtype=np.int64)
+    for a in range(0, n_t, _CHUNK):
+        b = min(a + _CHUNK, n_t)
+        tv[a:b] = np.sort(simp[ft[a:b, None], _FACE[fk[a:b]]], axis=1)
+    del fk
     # throat id of every (pore, face) slot
     tid = np.full(n_p * 4, -1, dtype=np.int64)
-    tid[np.flatnonzero(keep)] = np.arange(n_t)
+    tid[slots] = np.arange(n_t)
+    del slots
     # the other side of each interior face: find k' with neigh[fn, k'] == ft
     inner = fn >= 0
-    other_k = np.argmax(neigh[fn[inner]] == ft[inner, None], axis=1)
-    tid[fn[inner] * 4 + other_k] = np.flatnonzero(inner)
+    inner_idx = np.flatnonzero(inner)
+    for a in range(0, inner_idx.size, _CHUNK):
+        j = inner_idx[a:a + _CHUNK]
+        other_k = np.argmax(neigh[fn[j]] == ft[j, None], axis=1)
+        tid[fn[j] * 4 + other_k] = j
     pore_throats = tid.reshape(n_p, 4)
     throat_pores = np.column_stack([ft, fn])
 
-    xyz = pts[tv]                                     # (Nt, 3, 3)
     r = packing.radii[tv]
-    l12 = np.linalg.norm(xyz[:, 1] - xyz[:, 0], axis=1)
-    l13 = np.linalg.norm(xyz[:, 2] - xyz[:, 0], axis=1)
-    l23 = np.linalg.norm(xyz[:, 2] - xyz[:, 1], axis=1)
-    area = 0.5 * np.linalg.norm(np.cross(xyz[:, 1] - xyz[:, 0], xyz[:, 2] - xyz[:, 0]), axis=1)
+    sides = np.empty((n_t, 3))
+    area = np.empty(n_t)
+    tcent = np.empty((n_t, 3))
+    for a in range(0, n_t, _CHUNK):
+        b = min(a + _CHUNK, n_t)
+        p0, p1, p2 = pts[tv[a:b, 0]], pts[tv[a:b, 1]], pts[tv[a:b, 2]]
+        sides[a:b, 0] = np.linalg.norm(p1 - p0, axis=1)
+        sides[a:b, 1] = np.linalg.norm(p2 - p0, axis=1)
+        sides[a:b, 2] = np.linalg.norm(p2 - p1, axis=1)
+        area[a:b] = 0.5 * np.linalg.norm(np.cross(p1 - p0, p2 - p0), axis=1)
+        tcent[a:b] = (p0 + p1 + p2) / 3.0
     tied = np.zeros(n_t, dtype=bool)
     cc = circ[ft[inner]] - circ[fn[inner]]
     tied[inner] = np.linalg.norm(cc, axis=1) < tie_tol * dbar  # NaN compares False
+    del cc
     tied[inner] |= flat[ft[inner]] | flat[fn[inner]]
 
     in_simplex = np.zeros(packing.n, dtype=bool)
@@ -252,8 +277,8 @@ def tessellate(packing: Packing, *, qhull_options: str = QHULL_OPTIONS,
         packing=packing, pore_vertices=simp, pore_neighbors=neigh, pore_throats=pore_throats,
         pore_centroid=centroid, pore_volume=volume, pore_circumcenter=circ,
         throat_pores=throat_pores, throat_vertices=tv, throat_radii=r,
-        throat_sides=np.column_stack([l12, l13, l23]), throat_area=area,
-        throat_centroid=xyz.mean(axis=1), pore_flat=flat, throat_tied=tied,
+        throat_sides=sides, throat_area=area,
+        throat_centroid=tcent, pore_flat=flat, throat_tied=tied,
         coplanar_points=coplanar)
 
 
