@@ -292,7 +292,7 @@ def conduit_conductance(tessellation, throats_idx=None, *, viscosity_pa_s: float
                         workers: int = 1, progress: bool = False, sections: str = "qstar",
                         n_sections: int = 8, merge: PoreMerge | bool = True,
                         merge_tolerance: float = 0.02, internal_factor: float = 1e6,
-                        qstar_fn=None):
+                        qstar_fn=None, section_rtol: float | None = None):
     r"""Conduit-model conductance of throats, m³ Pa⁻¹ s⁻¹ (module docstring for the model).
 
     Parameters
@@ -319,6 +319,10 @@ def conduit_conductance(tessellation, throats_idx=None, *, viscosity_pa_s: float
     internal_factor : float, keyword-only
         Conductance of throats inside a merged body, relative to the largest conduit
         conductance of this call (default 1e6).
+    section_rtol : float or None, keyword-only
+        Q* tolerance for the sections away from the window (default ``max(rtol, 1e-2)``:
+        a 1 % error there changes the conduit resistance by well under 1 %, and with
+        'table+fe' a tighter tolerance sends many sections to FE).
     qstar_fn : callable or None, keyword-only
         ``qstar_fn(radii (M,3), sides (M,3)) -> (M,)`` Q* in r̄ units, used instead of the
         policy (tests, or a caller with its own Q* source). Default: the policy.
@@ -397,6 +401,7 @@ def conduit_conductance(tessellation, throats_idx=None, *, viscosity_pa_s: float
         with np.errstate(divide="ignore"):
             y0 = np.where(q_win > 0, 1.0 / (q_win * rbar**4), np.inf)
         section_q = None
+        srtol = max(rtol, 1e-2) if section_rtol is None else float(section_rtol)
         if sections == "qstar":
             def section_q(rho, s):
                 out = np.full(rho.shape[0], np.inf)
@@ -404,7 +409,7 @@ def conduit_conductance(tessellation, throats_idx=None, *, viscosity_pa_s: float
                 # section is still a valid throat (a pinpoint wall, nearly free flow)
                 rr = np.maximum(rho, 2e-2 * s.min(axis=1, keepdims=True))
                 live = rho.max(axis=1) > 0
-                res = throat_qstar(rr[live], s[live], policy=policy, rtol=rtol, db=db,
+                res = throat_qstar(rr[live], s[live], policy=policy, rtol=srtol, db=db,
                                    workers=workers, progress=progress)
                 rb = rr[live].mean(axis=1)
                 out[live] = np.asarray(res.qstar) * rb**4
