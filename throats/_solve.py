@@ -12,15 +12,17 @@ Weak form: find :math:`u` with :math:`\int \nabla u\cdot\nabla v = \int v` for a
 :math:`Q^*` from below on the exact geometry.
 
 Discretisation: second-order (curved, isoparametric) triangles from gmsh, Lagrange elements of
-degree p = 3 and p + 1 = 4 on the same mesh (p-refinement).  The reported value is the
-degree-4 one; its error estimate is
+degree p and p + 1 on the same mesh (p-refinement; p = 3 for rtol < 5e-3, else p = 2).  The
+reported value is the degree-(p+1) one; its error estimate is
 
 .. math::
-    \eta = \frac{|Q_4 - Q_3|}{Q_4} + 3\,\frac{|A_h - A|}{A},
+    \eta = \frac{|Q_{p+1} - Q_p|}{Q_{p+1}} + 5\,\frac{|A_h - A|}{A},
 
-a discretisation part (conservative: the degree-3 error) plus a geometric part from the
-quadratic arcs (A_h the meshed area, A the exact area of the meshed region; the factor 3 is
-d ln Q / d ln A of a thin channel, Q ∝ w³).  ``rtol`` sets the first mesh size; while
+a discretisation part (conservative: the degree-p error) plus a geometric part from the
+quadratic arcs (A_h the meshed area, A the exact area of the meshed region).  d ln Q/d ln A is
+2 for a disk and 3 for a thin channel; as the arc errors partly cancel in A_h, the factor 5
+was calibrated so that η covers the error against the finest solve for >= 95 % of packing
+throats (``throats.bench``, column est>=err).  ``rtol`` sets the first mesh size; while
 η > rtol the mesh is refined (at most twice).  A meshed area that differs from the exact
 area by more than 1 % means the mesher lost a piece or a gap: refined, then 'failed'.
 """
@@ -42,7 +44,7 @@ __all__ = ["SOLVER_VERSION", "ThroatSolution", "solve_fem"]
 logger = logging.getLogger(__name__)
 
 #: bump whenever results could change (the cache keys on it)
-SOLVER_VERSION = "1.1"
+SOLVER_VERSION = "1.2"
 
 _FORMS = {}
 
@@ -247,7 +249,7 @@ def _solve_geometry(geom, rtol, *, max_refine=2):
             logger.debug(msg)
             h, ca = 0.6 * h, 0.7 * ca
             continue
-        est = abs(q_hi - q_lo) / abs(q_hi) + 3.0 * geo_err if q_hi > 0 else np.inf
+        est = abs(q_hi - q_lo) / abs(q_hi) + 5.0 * geo_err if q_hi > 0 else np.inf
         if est <= rtol or level == max_refine:
             return q_hi, est, tm.t.shape[1], "ok", ("" if est <= rtol else
                                                      f"error estimate {est:.2e} > rtol")
