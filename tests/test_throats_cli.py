@@ -67,3 +67,15 @@ def test_usage_errors_exit_2():
     assert exc.value.code == 2
     with pytest.raises(SystemExit):
         main(["--csv", "x.csv"])
+
+
+def test_bench_runs_small(tmp_path, capsys):
+    from throats.bench import main as bench_main
+    out = tmp_path / "b.json"
+    assert bench_main(["--n", "4", "--rtols", "1e-3", "--json", str(out)]) == 0
+    data = json.loads(out.read_text())
+    assert {"loadavg_start", "platform", "cpu_count", "timestamp"} <= set(data)
+    res = data["results"]["fem rtol=0.001"]["packing"]
+    assert res["error"]["max"] < 1e-3
+    assert "shape-factor" in data["results"]
+    assert "fem rtol=0.001" in capsys.readouterr().out

@@ -79,6 +79,8 @@ class ThroatSolution:
     error_estimate : float, relative error estimate of qstar
     n_elements : int, triangles of the final mesh
     seconds : float, wall time of this throat
+    cpu_seconds : float, CPU time of this process for this throat (insensitive to other
+        processes on a shared machine)
     status : str, 'ok' | 'closed' | 'invalid' | 'failed'
     message : str, why a row is not 'ok'
     """
@@ -91,6 +93,7 @@ class ThroatSolution:
     seconds: np.ndarray
     status: np.ndarray
     message: np.ndarray
+    cpu_seconds: np.ndarray = None
 
 
 def _sort_t6(t):
@@ -139,7 +142,7 @@ def _assemble(mesh, t6, p, degree, intorder):
     with :math:`J_q = \sum_k x_k \nabla_\xi N_k(\xi_q)` from the six P2 geometry nodes.
     Same quantities as scikit-fem's ``laplace``/``unit_load`` on a ``Basis`` (checked in the
     tests), without its per-basis-function Python loop, which dominated on ~100 elements.
-    Returns (K csr, f, element dofs (nb, Ne)).
+    Returns (K csc, f, skfem ``Dofs``).
     """
     from scipy.sparse import coo_matrix
     from skfem.assembly import Dofs
@@ -149,18 +152,21 @@ def _assemble(mesh, t6, p, degree, intorder):
     J = np.einsum("ake,kbq->abeq", x, g2)                # dx_a/dxi_b, (2, 2, Ne, Nq)
     det = J[0, 0] * J[1, 1] - J[0, 1] * J[1, 0]
     inv = np.array([[J[1, 1], -J[0, 1]], [-J[1, 0], J[0, 0]]]) / det   # dxi_a/dx_b
-    grad = np.einsum("baeq,ibq->iaeq", inv, dphi)        # physical gradients
     wdet = np.abs(det) * W                                # (Ne, Nq)
-    K = np.einsum("iaeq,jaeq,eq->ije", grad, grad, wdet)
-    f = np.einsum("iq,eq->ie", phi, wdet)
-    edofs = Dofs(mesh, elem).element_dofs                 # (nb, Ne)
+    # physical gradients scaled by sqrt(w |J|): K_e = G_e G_e^T as one batched matmul
+    grad = np.einsum("baeq,ibq->eiaq", inv * np.sqrt(wdet), dphi)     # (Ne, nb, 2, Nq)
+    ne, nb = grad.shape[0], grad.shape[1]
+    grad = grad.reshape(ne, nb, -1)
+    K = grad @ grad.transpose(0, 2, 1)                    # (Ne, nb, nb)
+    f = wdet @ phi.T                                       # (Ne, nb)
+    dofs = Dofs(mesh, elem)
+    edofs = dofs.element_dofs                              # (nb, Ne)
     n = int(edofs.max()) + 1
-    nb = edofs.shape[0]
-    rows = np.broadcast_to(edofs[:, None, :], (nb, nb, edofs.shape[1])).ravel()
-    cols = np.broadcast_to(edofs[None, :, :], (nb, nb, edofs.shape[1])).ravel()
+    rows = np.broadcast_to(edofs.T[:, :, None], (ne, nb, nb)).ravel()
+    cols = np.broadcast_to(edofs.T[:, None, :], (ne, nb, nb)).ravel()
     A = coo_matrix((K.ravel(), (rows, cols)), shape=(n, n)).tocsc()
-    b = np.bincount(edofs.ravel(), weights=f.ravel(), minlength=n)
-    return A, b, edofs
+    b = np.bincount(edofs.T.ravel(), weights=f.ravel(), minlength=n)
+    return A, b, dofs
 
 
 def _noslip_facets(mesh, t6, noslip):
@@ -206,13 +212,13 @@ def _fe_solve(trimesh: TriMesh, orders=(3, 4), *, use_skfem_basis=False):
             f = unit_load.assemble(basis)
             dirichlet = basis.get_dofs(facets=facets).all()
         else:
-            A, f, _ = _assemble(mesh, t6, trimesh.p, deg, 2 * deg)
-            from skfem.assembly import Dofs
-            dirichlet = Dofs(mesh, _reference(deg, 2 * deg)[0]).get_facet_dofs(facets).all()
+            A, f, dofs = _assemble(mesh, t6, trimesh.p, deg, 2 * deg)
+            dirichlet = dofs.get_facet_dofs(facets).all()
         free = np.ones(f.size, dtype=bool)
         free[dirichlet] = False
         u = np.zeros(f.size)
-        u[free] = splu(A[free][:, free].tocsc()).solve(f[free])
+        # symmetric positive definite: a symmetric fill-reducing ordering
+        u[free] = splu(A[free][:, free].tocsc(), permc_spec="MMD_AT_PLUS_A").solve(f[free])
         q.append(float(f @ u))
         area_h = float(f.sum())
     return q, area_h
@@ -277,12 +283,12 @@ def _solve_chunk(radii, sides, rtol, delta):
                                             error=f"{type(exc1).__name__}: {exc1}"))
     out = []
     for g in geoms:
-        t0 = time.perf_counter()
+        t0, c0 = time.perf_counter(), time.process_time()
         try:
             res = _solve_geometry(g, rtol)
         except Exception as exc:   # never raise for one throat
             res = (np.nan, np.nan, 0, "failed", f"{type(exc).__name__}: {exc}")
-        out.append(res + (time.perf_counter() - t0,))
+        out.append(res + (time.perf_counter() - t0, time.process_time() - c0))
     return out
 
 
@@ -341,6 +347,7 @@ def solve_fem(radii, sides, *, rtol=1e-3, workers=1, progress=False, delta=DELTA
     est = np.full(n, np.nan)
     nel = np.zeros(n, dtype=int)
     secs = np.zeros(n)
+    cpu = np.zeros(n)
     status = np.where(ok, "ok", "invalid").astype(object)
     area = np.full(n, np.nan)
     ctype = np.full(n, "", dtype=object)
@@ -364,24 +371,25 @@ def solve_fem(radii, sides, *, rtol=1e-3, workers=1, progress=False, delta=DELTA
     try:
         if workers == 1 or len(tasks) <= 1:
             results = (_solve_chunk(*t) for t in tasks)
-            _collect(results, chunks, qstar, est, nel, status, msg, secs, bar)
+            _collect(results, chunks, qstar, est, nel, status, msg, secs, cpu, bar)
         else:
             import multiprocessing as mp
             from concurrent.futures import ProcessPoolExecutor
             ctx = mp.get_context("spawn")
             with ProcessPoolExecutor(max_workers=int(workers), mp_context=ctx) as pool:
                 results = pool.map(_worker_chunk, tasks)
-                _collect(results, chunks, qstar, est, nel, status, msg, secs, bar)
+                _collect(results, chunks, qstar, est, nel, status, msg, secs, cpu, bar)
     finally:
         if bar is not None:
             bar.close()
     return ThroatSolution(qstar, area, ctype.astype(str), est, nel, secs,
-                          status.astype(str), msg.astype(str))
+                          status.astype(str), msg.astype(str), cpu)
 
 
-def _collect(results, chunks, qstar, est, nel, status, msg, secs, bar):
+def _collect(results, chunks, qstar, est, nel, status, msg, secs, cpu, bar):
     for c, res in zip(chunks, results):
-        for k, (q, e, ne, st, m, sec) in zip(c, res):
-            qstar[k], est[k], nel[k], status[k], msg[k], secs[k] = q, e, ne, st, m, sec
+        for k, (q, e, ne, st, m, sec, cs) in zip(c, res):
+            qstar[k], est[k], nel[k], status[k], msg[k], secs[k], cpu[k] = \
+                q, e, ne, st, m, sec, cs
         if bar is not None:
             bar.update(len(c))

@@ -9,7 +9,8 @@ Throats: ``--n`` interior Delaunay faces of a random 5.5–7.5 mm packing
 of 1e-4 r̄, a disk across the opposite side, slivers, large radius ratios).  The reference
 is the finest solve: ``solve_fem(rtol=1e-6, delta=0.002)`` (five times narrower closing
 width, so the closing-rule error is part of the measured error).  Each FE tolerance is run
-twice and the per-throat minimum time is kept (the machine is shared); one core, in process.
+twice and the per-throat minimum time is kept (the machine is shared); the process is pinned
+to one CPU; wall and CPU (process) time per throat are both reported.
 Prints a table and writes JSON with load average, platform, CPU count and a timestamp.
 
 ``--fit`` refits the shape-factor constants on 1600 throats (seed 2026) and prints them.
@@ -51,7 +52,19 @@ def _stats(x):
 
 
 def run(n=200, seed=1, rtols=(1e-2, 3e-3, 1e-3, 1e-4), repeats=2):
-    """Measure; returns the JSON-ready dict."""
+    """Measure on one core (the process is pinned to one CPU); returns the JSON dict."""
+    pinned = None
+    if hasattr(os, "sched_setaffinity"):
+        pinned = os.sched_getaffinity(0)
+        os.sched_setaffinity(0, {min(pinned)})
+    try:
+        return _run(n, seed, rtols, repeats)
+    finally:
+        if pinned is not None:
+            os.sched_setaffinity(0, pinned)
+
+
+def _run(n, seed, rtols, repeats):
     from throats import SOLVER_VERSION, contact_type, shape_factor_qstar, solve_fem
     from throats._sampling import sample_throats
 
@@ -75,11 +88,12 @@ def run(n=200, seed=1, rtols=(1e-2, 3e-3, 1e-3, 1e-4), repeats=2):
     for rtol in rtols:
         runs = [solve_fem(r_all, s_all, rtol=rtol) for _ in range(repeats)]
         secs = np.min([s.seconds for s in runs], axis=0)
+        cpu = np.min([s.cpu_seconds for s in runs], axis=0)
         sol = runs[0]
         with np.errstate(invalid="ignore", divide="ignore"):
             err = np.abs(sol.qstar / q_ref - 1)
         methods[f"fem rtol={rtol:g}"] = dict(
-            kind="fem", rtol=rtol, qstar=sol.qstar, err=err, seconds=secs,
+            kind="fem", rtol=rtol, qstar=sol.qstar, err=err, seconds=secs, cpu=cpu,
             estimate=sol.error_estimate, n_elements=sol.n_elements, status=sol.status)
     # shape factor: batched time per throat (min over repeats of a 1e5-row batch)
     big = np.tile(np.arange(r_all.shape[0]), int(np.ceil(1e5 / r_all.shape[0])))
@@ -113,6 +127,8 @@ def run(n=200, seed=1, rtols=(1e-2, 3e-3, 1e-3, 1e-4), repeats=2):
         for g, idx in groups.items():
             e = m["err"][idx]
             row = dict(error=_stats(e), ms_per_throat=_stats(1e3 * m["seconds"][idx]))
+            if "cpu" in m:
+                row["cpu_ms_per_throat"] = _stats(1e3 * m["cpu"][idx])
             if m["kind"] == "fem":
                 est = m["estimate"][idx]
                 row["estimate_covers_error"] = float(np.mean(est >= e))
@@ -159,13 +175,15 @@ def fit(n=1600, seed=2026, rtol=1e-4):
 def _table(out):
     lines = [f"throats bench  (solver {out['solver_version']}, load "
              f"{out['loadavg_start'][0]:.2f}, {out['cpu_count']} CPUs, {out['timestamp']})",
-             f"{'method':<18} {'set':<8} {'ms/throat med':>13} {'p95':>8} "
+             f"{'method':<18} {'set':<8} {'ms/throat med':>13} {'p95':>8} {'cpu ms med':>10} "
              f"{'rel.err med':>11} {'p95':>9} {'max':>9} {'est>=err':>8}"]
     for name, res in out["results"].items():
         for g, row in res.items():
             ms, e = row["ms_per_throat"], row["error"]
             cover = row.get("estimate_covers_error")
+            cpu = row.get("cpu_ms_per_throat", {}).get("median")
             lines.append(f"{name:<18} {g:<8} {ms['median']:>13.4g} {ms['p95']:>8.4g} "
+                         f"{'' if cpu is None else f'{cpu:.4g}':>10} "
                          f"{e['median']:>11.2e} {e['p95']:>9.2e} {e['max']:>9.2e} "
                          f"{'' if cover is None else f'{cover:.2f}':>8}")
     sf = out["results"]["shape-factor"]["packing"]["throughput_per_s"]
