@@ -192,3 +192,16 @@ def test_random_extreme_throats_all_solve():
     assert valid.sum() > 40
     assert set(sol.status[valid]) <= {"ok", "closed"}
     assert np.all(sol.error_estimate[valid] <= 1e-2)
+
+
+def test_folded_curved_element_is_detected():
+    from throats._mesh import TriMesh
+    g = build_geometries([[1, 1, 1]], [[2.2, 2.2, 2.2]])[0]
+    m = mesh_geometry(g, 0.6)
+    p = m.p.copy()
+    e = 0
+    mid = m.t[3, e]                      # mid-edge node of edge (0, 1) of element 0
+    v0, v1, v2 = p[:, m.t[0, e]], p[:, m.t[1, e]], p[:, m.t[2, e]]
+    p[:, mid] = v2 + 3.0 * (0.5 * (v0 + v1) - v2)   # pushed far across the opposite vertex
+    with pytest.raises(RuntimeError, match="inverted"):
+        _fe_solve(TriMesh(p, m.t, m.noslip), (2,))

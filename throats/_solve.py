@@ -99,14 +99,16 @@ class ThroatSolution:
 def _sort_t6(t):
     """Sort the vertices of each quadratic triangle (gmsh order) ascending, carrying the
     mid-edge nodes along.  scikit-fem orients the edge dofs of P3/P4 by vertex order, so
-    unsorted elements give a non-conforming space."""
+    unsorted elements give a non-conforming space.  Returns the sorted (6, Ne) array and
+    the parity (±1) of each element's vertex permutation."""
     o = np.argsort(t[:3], axis=0)
     mid = np.array([[-1, 3, 5], [3, -1, 4], [5, 4, -1]])
     cols = np.arange(t.shape[1])
     v = t[o, cols]
     m = np.stack([t[mid[o[0], o[1]], cols], t[mid[o[1], o[2]], cols],
                   t[mid[o[0], o[2]], cols]])
-    return np.vstack([v, m])
+    parity = np.sign((o[1] - o[0]) * (o[2] - o[0]) * (o[2] - o[1]))
+    return np.vstack([v, m]), parity
 
 
 _REF = {}
@@ -132,7 +134,7 @@ def _reference(p, intorder):
     return _REF[key]
 
 
-def _assemble(mesh, t6, p, degree, intorder):
+def _assemble(mesh, t6, p, degree, intorder, orientation=None):
     r"""Stiffness matrix and load vector of degree-``degree`` Lagrange elements on the
     quadratic (isoparametric) triangles, vectorised over elements with ``numpy.einsum``:
 
@@ -142,7 +144,8 @@ def _assemble(mesh, t6, p, degree, intorder):
     with :math:`J_q = \sum_k x_k \nabla_\xi N_k(\xi_q)` from the six P2 geometry nodes.
     Same quantities as scikit-fem's ``laplace``/``unit_load`` on a ``Basis`` (checked in the
     tests), without its per-basis-function Python loop, which dominated on ~100 elements.
-    Returns (K csc, f, skfem ``Dofs``).
+    ``orientation`` (Ne,) of ±1 (parity of the vertex sort, see :func:`_sort_t6`) enables the
+    check for inverted elements.  Returns (K csc, f, skfem ``Dofs``).
     """
     from scipy.sparse import coo_matrix
     from skfem.assembly import Dofs
@@ -151,6 +154,13 @@ def _assemble(mesh, t6, p, degree, intorder):
     x = p[:, t6]                                         # (2, 6, Ne)
     J = np.einsum("ake,kbq->abeq", x, g2)                # dx_a/dxi_b, (2, 2, Ne, Nq)
     det = J[0, 0] * J[1, 1] - J[0, 1] * J[1, 0]
+    if orientation is not None:
+        # gmsh's orientation of every element restored: all Jacobians must share one sign,
+        # else a curved element folded over (e.g. a coarse element across a thin passage)
+        signed = det * orientation[:, None]
+        if not (np.all(signed > 0) or np.all(signed < 0)):
+            bad = int(np.sum(np.any(signed * np.sign(signed.sum()) <= 0, axis=1)))
+            raise RuntimeError(f"{bad} inverted curved elements")
     inv = np.array([[J[1, 1], -J[0, 1]], [-J[1, 0], J[0, 0]]]) / det   # dxi_a/dx_b
     wdet = np.abs(det) * W                                # (Ne, Nq)
     # physical gradients scaled by sqrt(w |J|): K_e = G_e G_e^T as one batched matmul
@@ -198,7 +208,7 @@ def _fe_solve(trimesh: TriMesh, orders=(3, 4), *, use_skfem_basis=False):
     from scipy.sparse.linalg import splu
     from skfem import MeshTri2
 
-    t6 = _sort_t6(trimesh.t)
+    t6, parity = _sort_t6(trimesh.t)
     mesh = MeshTri2(trimesh.p, t6)
     facets = _noslip_facets(mesh, t6, trimesh.noslip)
     q, area_h = [], np.nan
@@ -212,7 +222,7 @@ def _fe_solve(trimesh: TriMesh, orders=(3, 4), *, use_skfem_basis=False):
             f = unit_load.assemble(basis)
             dirichlet = basis.get_dofs(facets=facets).all()
         else:
-            A, f, dofs = _assemble(mesh, t6, trimesh.p, deg, 2 * deg)
+            A, f, dofs = _assemble(mesh, t6, trimesh.p, deg, 2 * deg, parity)
             dirichlet = dofs.get_facet_dofs(facets).all()
         free = np.ones(f.size, dtype=bool)
         free[dirichlet] = False
