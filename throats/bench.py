@@ -58,13 +58,16 @@ def run(n=200, seed=1, rtols=(1e-2, 3e-3, 1e-3, 1e-4), repeats=2):
         pinned = os.sched_getaffinity(0)
         os.sched_setaffinity(0, {min(pinned)})
     try:
-        return _run(n, seed, rtols, repeats)
+        out = _run(n, seed, rtols, repeats)
+        out["pinned_to_cpu"] = None if pinned is None else int(min(pinned))
+        return out
     finally:
         if pinned is not None:
             os.sched_setaffinity(0, pinned)
 
 
 def _run(n, seed, rtols, repeats):
+    load_start = list(os.getloadavg())
     from throats import SOLVER_VERSION, contact_type, shape_factor_qstar, solve_fem
     from throats._sampling import sample_throats
 
@@ -115,7 +118,7 @@ def _run(n, seed, rtols, repeats):
         benchmark="throats", solver_version=SOLVER_VERSION,
         timestamp=time.strftime("%Y-%m-%dT%H:%M:%SZ", time.gmtime()),
         platform=platform.platform(), python=sys.version.split()[0],
-        cpu_count=os.cpu_count(), loadavg_start=list(os.getloadavg()),
+        cpu_count=os.cpu_count(), loadavg_start=load_start,
         throats=dict(n_packing=n, seed=seed, hard_cases=names,
                      contact_types={t: int(np.sum(ctype[:n] == t)) for t in "abcd"}),
         reference=dict(method="solve_fem(rtol=1e-6, delta=0.002)", seconds_total=t_ref,
