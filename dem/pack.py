@@ -18,6 +18,7 @@ import time
 from ._integrate import DemInstabilityError, Material
 from ._io import summary_path, write_packing
 from ._scenes import SCENES, Container, pack
+from ._perf import tune_malloc
 
 
 def _parser():
@@ -47,6 +48,7 @@ def _parser():
 
 
 def main(argv=None) -> int:
+    tune_malloc()
     args = _parser().parse_args(argv)
     try:
         material = Material(

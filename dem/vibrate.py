@@ -24,6 +24,7 @@ from ._integrate import DemInstabilityError, Material
 from ._io import read_packing, write_packing
 from ._scenes import SCENES, Container
 from ._vibrate import intensity_g, vibrate
+from ._perf import tune_malloc
 
 THESIS_AMPLITUDES_M = (0.0005, 0.001, 0.002, 0.003, 0.004)
 
@@ -46,6 +47,7 @@ def _parser():
 
 
 def main(argv=None) -> int:
+    tune_malloc()
     args = _parser().parse_args(argv)
     try:
         centers, radii, summary = read_packing(args.packing)
