@@ -205,3 +205,14 @@ def test_folded_curved_element_is_detected():
     p[:, mid] = v2 + 3.0 * (0.5 * (v0 + v1) - v2)   # pushed far across the opposite vertex
     with pytest.raises(RuntimeError, match="inverted"):
         _fe_solve(TriMesh(p, m.t, m.noslip), (2,))
+
+
+def test_region_narrower_than_closing_width_is_closed():
+    # three deep overlaps leave a sliver of area 1.3e-4 rbar^2 whose passages are all
+    # narrower than delta: closed, Q* = 0 (bound A delta^2 / 8 = 1.7e-9)
+    r = [[0.8945563816440452, 0.9983046244403401, 1.1071389939156149]]
+    s = [[1.272632011878966, 1.818883013505285, 2.027573616353877]]
+    sol = solve_fem(r, s, rtol=1e-3)
+    assert 0 < sol.open_area[0] < 2e-4
+    assert sol.status[0] == "closed" and sol.qstar[0] == 0.0
+    assert "narrower than the closing width" in sol.message[0]

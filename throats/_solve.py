@@ -44,7 +44,7 @@ __all__ = ["SOLVER_VERSION", "ThroatSolution", "solve_fem"]
 logger = logging.getLogger(__name__)
 
 #: bump whenever results could change (the cache keys on it)
-SOLVER_VERSION = "1.2"
+SOLVER_VERSION = "1.3"
 
 _FORMS = {}
 
@@ -240,12 +240,18 @@ def _h_for_rtol(rtol):
     return float(np.clip(0.6 * s, 0.05, 1.0)), float(np.clip(0.5 * s, 0.08, 0.8))
 
 
-def _solve_geometry(geom, rtol, *, max_refine=2):
-    """Q*, error estimate, element count, status, message for one ThroatGeometry."""
+def _solve_geometry(geom, rtol, *, max_refine=2, delta=DELTA_DEFAULT):
+    """Q*, error estimate, element count, status, message for one ThroatGeometry.
+
+    A region that the closing rule leaves smaller than ``delta``² (every passage narrower
+    than about ``delta``) is reported 'closed' with Q* = 0: its flow is below
+    A δ²/8 (plane Poiseuille bound, A the open area), under 1e-8 for δ = 0.01.
+    """
     if geom.error:
         return np.nan, np.nan, 0, "failed", f"boundary construction failed: {geom.error}"
-    if not geom.loops or geom.area <= 0:
-        return 0.0, 0.0, 0, "closed", "open region closed (narrower than the closing width)"
+    if not geom.loops or geom.area < delta**2:
+        return 0.0, 0.0, 0, "closed", (f"open region narrower than the closing width "
+                                       f"{delta:g} rbar everywhere: Q* taken as 0")
     h, ca = _h_for_rtol(rtol)
     orders = (2, 3) if rtol >= 5e-3 else (3, 4)
     msg = ""
@@ -295,7 +301,7 @@ def _solve_chunk(radii, sides, rtol, delta):
     for g in geoms:
         t0, c0 = time.perf_counter(), time.process_time()
         try:
-            res = _solve_geometry(g, rtol)
+            res = _solve_geometry(g, rtol, delta=delta)
         except Exception as exc:   # never raise for one throat
             res = (np.nan, np.nan, 0, "failed", f"{type(exc).__name__}: {exc}")
         out.append(res + (time.perf_counter() - t0, time.process_time() - c0))
@@ -331,7 +337,9 @@ def solve_fem(radii, sides, *, rtol=1e-3, workers=1, progress=False, delta=DELTA
     -------
     ThroatSolution
         Rows that fail :func:`validate_throats` get status 'invalid' and NaN; throats whose
-        disks cover the triangle get status 'closed' and Q* = 0.  Never raises for one row.
+        disks cover the triangle get status 'closed' and Q* = 0, and so do throats whose open
+        region is narrower than ``delta`` everywhere (deep overlaps: Q* < A δ²/8, below 1e-8
+        for the default δ; the message says so).  Never raises for one row.
 
     Raises
     ------
