@@ -210,12 +210,20 @@ def merge_pores(tessellation, *, tolerance: float = 0.02, min_quality: float = 0
     core = ~sliver
     has_core = np.bincount(labels, weights=core.astype(float), minlength=n_g) > 0
     use = core | ~has_core[labels]
-    key = np.unique(labels[use, None].astype(np.int64) * (pts.shape[0] + 1) + pv[use])
-    grp = key // (pts.shape[0] + 1)
-    vtx = key % (pts.shape[0] + 1)
-    cnt = np.bincount(grp, minlength=n_g).astype(float)
-    center = np.stack([np.bincount(grp, weights=pts[vtx, k], minlength=n_g) for k in range(3)],
-                      axis=1) / cnt[:, None]
+    # singletons: the tetrahedron's centroid; groups: unique vertices of their members
+    center = np.zeros((n_g, 3))
+    single = size[labels] == 1
+    center[labels[single]] = xyz[single].mean(axis=1)
+    sel = ~single & use
+    if sel.any():
+        key = np.unique(labels[sel, None].astype(np.int64) * (pts.shape[0] + 1) + pv[sel])
+        grp = key // (pts.shape[0] + 1)
+        vtx = key % (pts.shape[0] + 1)
+        cnt = np.bincount(grp, minlength=n_g).astype(float)
+        multi = cnt > 0
+        sums = np.stack([np.bincount(grp, weights=pts[vtx, k], minlength=n_g)
+                         for k in range(3)], axis=1)
+        center[multi] = sums[multi] / cnt[multi, None]
     internal = np.zeros(tp.shape[0], dtype=bool)
     internal[inner] = labels[p] == labels[q]
     logger.info("merged %d of %d tetrahedra into %d multi-tetrahedron pore bodies "
