@@ -87,7 +87,8 @@ sphere walls turn steep); each side is integrated up to its own height by the tr
 (the last part-segment linearly interpolated); :math:`y'` by second-order differences with
 :math:`y'(0) = 0`. ``sections='qstar'`` (default) asks the Q* policy for every section
 (``n_sections`` lookups per throat beyond the window's; with FE Q* the simple-cubic results
-above). ``sections='ratio'`` asks it only for the window (the lookups of the thesis model) and scales
+above).
+``sections='ratio'`` asks it only for the window (the lookups of the thesis model) and scales
 along the conduit with a closed-form estimate :math:`Q \propto A^3/P_w^2` (open area A,
 wetted arc length P_w); that estimate opens too fast away from the window (Q(h)/Q(0) 2-5
 times the FE ratio half-way to the pore centre) and the model then comes out 30-45 % too

@@ -30,6 +30,8 @@ Functions
 ---------
 lattice_radius(kind, solid_fraction, *, lattice_constant_m=1.0)
 lattice_packing(kind, solid_fraction, *, n_cells=4, lattice_constant_m=1e-3, ...)
+lattice_sample_permeability(kind, solid_fraction, *, model='conduit', policy=..., ...)
+    The network model's permeability of such an array (validation helper).
 """
 
 from __future__ import annotations
@@ -46,6 +48,7 @@ __all__ = [
     "lattice_basis",
     "lattice_radius",
     "lattice_packing",
+    "lattice_sample_permeability",
 ]
 
 logger = logging.getLogger(__name__)
@@ -129,11 +132,13 @@ def lattice_radius(kind: str, solid_fraction: float, *, lattice_constant_m: floa
     phi = float(solid_fraction)
     a = float(lattice_constant_m)
     if not (math.isfinite(a) and a > 0):
-        raise ValueError(f"lattice_constant_m must be positive and finite, got {lattice_constant_m!r}")
+        raise ValueError("lattice_constant_m must be positive and finite, "
+                         f"got {lattice_constant_m!r}")
     phi_max = TOUCHING_FRACTION[k]
     if not (math.isfinite(phi) and 0.0 < phi <= phi_max * (1.0 + 1e-4)):
         raise ValueError(
-            f"solid_fraction must be in (0, {phi_max:.7f}] for {k} (touching), got {solid_fraction!r}"
+            f"solid_fraction must be in (0, {phi_max:.7f}] for {k} (touching), "
+            f"got {solid_fraction!r}"
         )
     phi = min(phi, phi_max)
     r = a * (3.0 * phi / (4.0 * math.pi * SPHERES_PER_CELL[k])) ** (1.0 / 3.0)
@@ -229,5 +234,70 @@ def lattice_packing(
         gen = np.random.default_rng(rng)
         centers = centers + gen.normal(0.0, jitter * a, size=centers.shape)
     radii = np.full(centers.shape[0], r)
-    logger.debug("%s lattice: %d spheres, phi=%.4f, r=%.4g m", k, centers.shape[0], solid_fraction, r)
+    logger.debug("%s lattice: %d spheres, phi=%.4f, r=%.4g m", k, centers.shape[0],
+                 solid_fraction, r)
     return centers, radii
+
+
+def lattice_sample_permeability(kind: str, solid_fraction: float, *, model: str = "conduit",
+                                policy: str = "fe-only", qstar_fn=None, n_cells: int = 7,
+                                axis: int = 0, n_sections: int = 6, jitter: float = 0.0,
+                                rng=None, offset: float = 0.137):
+    r"""Permeability of a lattice sample through the network pipeline (validation helper).
+
+    Builds an ``n_cells``³ array of lattice constant 1 (:func:`lattice_packing`), tessellates
+    it, keeps the box :math:`[1 + o, n - 2 + o]^3` (``offset`` o keeps the box faces off the
+    planes of pore centres), merges pore bodies (:mod:`network._merge`; for the thesis model
+    only exact ties, ``network.tie_groups``), computes conductances with viscosity 1, solves
+    with 1 Pa across and returns :math:`k = Q H / (A \cdot 1)` in units of the lattice
+    constant squared, with the sphere radius, to compare with
+    :func:`network._references.lattice_permeability`.
+
+    Parameters
+    ----------
+    kind, solid_fraction
+        As :func:`lattice_packing`.
+    model : {'conduit', 'thesis'}, keyword-only
+    policy : str, keyword-only
+        Q* policy (``network._conductance.throat_qstar``) when ``qstar_fn`` is None.
+    qstar_fn : callable, keyword-only
+        ``qstar_fn(radii, sides) -> Q*`` (r̄ units) instead of the policy.
+    n_cells, axis, n_sections, jitter, rng, offset : keyword-only
+        Box size, flow axis, conduit section intervals, centre jitter (units of the lattice
+        constant) and its seed, region offset.
+
+    Returns
+    -------
+    k : float
+        Permeability, (lattice constant)².
+    radius : float
+        Sphere radius, lattice constants.
+    """
+    from ._conduit import conduit_conductance
+    from ._conductance import thesis_conductance, throat_qstar
+    from ._flow import solve_fixed_pressure
+    from ._io import Packing
+    from ._merge import merge_pores
+    from ._sample import Region, prune_disconnected, select_sample
+    from ._tessellation import tessellate, tie_groups
+
+    if model not in ("conduit", "thesis"):
+        raise ValueError(f"model must be 'conduit' or 'thesis', got {model!r}")
+    c, r = lattice_packing(kind, solid_fraction, n_cells=n_cells, lattice_constant_m=1.0,
+                           jitter=jitter, rng=rng)
+    tess = tessellate(Packing(c, r))
+    region = Region(np.full(3, 1.0 + offset), np.full(3, n_cells - 2 + offset))
+    if model == "conduit":
+        pm = merge_pores(tess)
+        smp = select_sample(tess, region, axis=axis, groups=pm.labels)
+        g, _ = conduit_conductance(tess, smp.throats, viscosity_pa_s=1.0, policy=policy,
+                                   qstar_fn=qstar_fn, merge=pm, n_sections=n_sections)
+    else:
+        labels, _ = tie_groups(tess)
+        smp = select_sample(tess, region, axis=axis, groups=labels)
+        rad, sid = tess.throat_radii[smp.throats], tess.throat_sides[smp.throats]
+        q = throat_qstar(rad, sid, policy=policy).qstar if qstar_fn is None else qstar_fn(rad, sid)
+        g = thesis_conductance(q, rad, viscosity_pa_s=1.0)
+    smp2, g2 = prune_disconnected(smp, tess, g)
+    _, _, chk = solve_fixed_pressure(smp2.n_pores, smp2.conns, g2, smp2.inlet, smp2.outlet)
+    return float(chk["q_in"] * smp2.length_m / smp2.area_m2), float(r[0])

@@ -28,7 +28,8 @@ unrelated voids together. A flat sliver (radius ratio below
 ``flat_quality``) instead joins the one neighbour across its largest face (a non-flat one when
 it has any), as in ``network.tie_groups``: joining both sides would fuse two voids. (Left alone a
 sliver would do little harm in the conduit model, whose conduit lengths are measured from pore
-centres and are ~0 inside a sliver, but it would be an extra pore of the sample.) Groups are the connected components of the merge graph
+centres and are ~0 inside a sliver, but it would be an extra pore of the sample.) Groups are
+the connected components of the merge graph
 (union-find through ``scipy.sparse.csgraph.connected_components``).
 
 Each group's centre is the mean of the distinct sphere centres of its non-sliver tetrahedra
@@ -197,7 +198,8 @@ def merge_pores(tessellation, *, tolerance: float = 0.02, min_quality: float = 0
         area = t.throat_area[t.pore_throats[fl]]
         valid = nb >= 0
         good = valid & ~sliver[np.maximum(nb, 0)]
-        score = np.where(good, 2.0, np.where(valid, 1.0, 0.0)) * (1.0 + area / (area.max() + 1e-300))
+        score = (np.where(good, 2.0, np.where(valid, 1.0, 0.0))
+                 * (1.0 + area / (area.max() + 1e-300)))
         pick = nb[np.arange(fl.size), np.argmax(score, axis=1)]
         okp = pick >= 0
         mp = np.concatenate([mp, fl[okp]])

@@ -303,7 +303,10 @@ def kozeny_carman_permeability(porosity, diameter):
 
 
 def ergun_viscous_permeability(porosity, diameter):
-    r"""Permeability of Ergun's viscous term, :math:`k = d^2\varepsilon^3 / (150(1-\varepsilon)^2)`."""
+    r"""Permeability of Ergun's viscous term.
+
+    .. math:: k = d^2\varepsilon^3 / (150(1-\varepsilon)^2)
+    """
     eps = np.asarray(porosity, dtype=float)
     if np.any(~np.isfinite(eps)) or np.any(eps <= 0) or np.any(eps >= 1):
         raise ValueError(f"porosity must lie in (0, 1), got {porosity!r}")
