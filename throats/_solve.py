@@ -324,7 +324,9 @@ def solve_fem(radii, sides, *, rtol=1e-3, workers=1, progress=False, delta=DELTA
         Requested relative accuracy of Q*, default 1e-3; sets the mesh (as coarse as it
         allows) and triggers refinement while the error estimate exceeds it.
     workers : int, optional
-        Processes (gmsh is initialised once per process), default 1 (this process).
+        Processes (gmsh is initialised once per process), default 1 (this process).  Workers
+        are started with the 'spawn' method: a calling script needs the usual
+        ``if __name__ == "__main__":`` guard.
     progress : bool, optional
         Show a tqdm progress bar.
     delta : float, optional
