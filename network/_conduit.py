@@ -62,9 +62,12 @@ section (``sections='qstar'``), through the network pipeline (merged cells), aga
 Zick & Homsy (1982): simple cubic +7.6 % (phi = 0.5236), +8.0 % (0.45), +8.2 % (0.343),
 +8.7 % (0.3) with 8 intervals (+8.7 to +9.9 % with the default 6; +6.1 % and +7.0 % at
 0.5236 and 0.3 converged); first order alone +21 % to +28 %; the thesis model 0.48-0.63 of
-exact. Random monodisperse packings (periodic, 2000 spheres, Q* from the g1 table) against
-the LBM law of van der Hoef et al. (2005): +2.6 %, +1.7 %, +0.7 %, +2.6 %, +0.8 % at porosity
-0.45, 0.42, 0.40, 0.38, 0.36 (8 intervals); the thesis model 0.30-0.33 of it.
+exact. Random monodisperse packings (periodic, 2000 spheres, Q* from the cache's g1 table)
+against the LBM law of van der Hoef et al. (2005): +2.8 %, +1.9 %, +0.9 %, +2.8 %, +1.0 % at
+porosity 0.45, 0.42, 0.40, 0.38, 0.36 (default 6 intervals; 8 give 0.1-0.2 % less); the
+thesis model 0.30-0.33 of it. BCC and FCC arrays have no exact reference here (see
+:mod:`network._references`); the conduit model gives 2.2-3.3 (BCC) and 2.0-3.8 (FCC) times
+the thesis model from phi = 0.3 to touching.
 
 *Conductance.* :math:`g = 1/(R_P + R_Q)`. Throats inside one merged pore body get a
 conductance ``internal_factor`` (1e6) times the largest conduit conductance of the call, so
