@@ -181,7 +181,9 @@ def solve_pressure(A, b, *, tol: float = 1e-10, maxiter: int = 500,
     Notes
     -----
     With :math:`D = \mathrm{diag}(A)`, CG runs on :math:`\tilde A = D^{-1/2} A D^{-1/2}`,
-    :math:`\tilde b = D^{-1/2} b`, preconditioned by ``smoothed_aggregation_solver(Ã,
+    :math:`\tilde b = D^{-1/2} b`, with near-null-space candidate :math:`D^{1/2}\mathbf 1` (the
+    scaled constant pressure: with the default constant candidate the 20 000-sphere case needs
+    57 instead of 39 iterations), preconditioned by ``smoothed_aggregation_solver(Ã,
     symmetry='symmetric', coarse_solver='splu').aspreconditioner()``
     (run with single-threaded OpenBLAS, see :mod:`network._blas`), and :math:`x = D^{-1/2} \tilde x`. If CG has
     not converged after 150 iterations (random contrast over many decades defeats the classical
@@ -216,6 +218,8 @@ def solve_pressure(A, b, *, tol: float = 1e-10, maxiter: int = 500,
     S = sp.diags_array(s)
     As = sp.csr_matrix(S @ A @ S)
     bs = s * b
+    # near-null space of the scaled Laplacian: D^(1/2) 1 (the constant pressure, scaled)
+    B = np.sqrt(d)[:, None]
     hist: list[float] = []
     bsn = np.linalg.norm(bs)
     # plain SA first; strong random contrast (log-uniform over many decades) defeats its
@@ -225,8 +229,9 @@ def solve_pressure(A, b, *, tol: float = 1e-10, maxiter: int = 500,
     for strength, limit in (("symmetric", min(maxiter, 150)), ("evolution", maxiter)):
         with single_threaded_blas():
             t0 = time.perf_counter()
-            ml = pyamg.smoothed_aggregation_solver(As, symmetry="symmetric", strength=strength,
-                                                   max_coarse=500, coarse_solver="splu")
+            ml = pyamg.smoothed_aggregation_solver(As, B=B, symmetry="symmetric",
+                                                   strength=strength, max_coarse=500,
+                                                   coarse_solver="splu")
             t1 = time.perf_counter()
             res_abs: list[float] = []
             y = ml.solve(bs, x0=y, tol=tol, maxiter=limit, accel="cg", residuals=res_abs)

@@ -88,7 +88,7 @@ def _packing_file(n: int, workdir: Path, seed: int) -> Path:
     return path
 
 
-def run_one(path: Path, policy: str, db, repeats: int) -> dict:
+def run_one(path: Path, policy: str, db, repeats: int, trace: bool = True) -> dict:
     """One scaling case in this process: stage times, iterations, memory."""
     best = None
     for _ in range(repeats):
@@ -107,9 +107,11 @@ def run_one(path: Path, policy: str, db, repeats: int) -> dict:
                     "qstar_sources": res.qstar_stats.get("sources", {})}
     walls_rss = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024.0
     # one more pass with tracemalloc for per-stage traced peaks (slower; not timed)
-    pk = read_packing(path)
-    res = solve_network(pk, axis="z", policy=policy, db=db, porosity_points=0, trace_memory=True)
-    best["traced_peak_mb"] = res.timings_s.get("peak_memory_mb", {})
+    if trace:
+        pk = read_packing(path)
+        res = solve_network(pk, axis="z", policy=policy, db=db, porosity_points=0,
+                            trace_memory=True)
+        best["traced_peak_mb"] = res.timings_s.get("peak_memory_mb", {})
     best["max_rss_mb"] = max(walls_rss, resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024.0)
     best["n_spheres"] = pk.n
     best["policy"] = policy
@@ -123,6 +125,8 @@ def _scaling(sizes, workdir, policy, db, seed, repeats, timeout):
         path = _packing_file(n, workdir, seed)
         cmd = [sys.executable, "-m", "network.bench", "--one", str(path), "--policy", policy,
                "--repeats", str(repeats if n <= 100_000 else 1)]
+        if n > 100_000:
+            cmd.append("--no-trace")   # the tracemalloc pass would double a 500k run
         if db:
             cmd += ["--db", str(db)]
         load0 = os.getloadavg()[0]
@@ -226,10 +230,11 @@ def main(argv=None) -> int:
     ap.add_argument("--timeout", type=float, default=1800.0, help="per-size limit, s")
     ap.add_argument("--json", dest="json_out", default="network_bench.json")
     ap.add_argument("--one", default=None, help=argparse.SUPPRESS)
+    ap.add_argument("--no-trace", action="store_true", help=argparse.SUPPRESS)
     args = ap.parse_args(argv)
 
     if args.one:  # child process of the scaling part
-        row = run_one(Path(args.one), args.policy, args.db, args.repeats)
+        row = run_one(Path(args.one), args.policy, args.db, args.repeats, trace=not args.no_trace)
         print(json.dumps(row))
         return 0
 
