@@ -217,7 +217,11 @@ class GridTable:
         self.estimated = np.zeros(shape, dtype=bool)
         if estimate:
             dnode = self._coarse_difference(v)
-            order = 3.0 if self.curvature else 2.0
+            # third order when the coarse sub-grid has its curvature terms in every direction
+            # (>= 3 nodes); else it is partly multilinear and its error shrinks only as h^2
+            cs = self.coarse_spec().shape
+            third = self.curvature and all(c >= 3 for c, f in zip(cs, shape) if f > 1)
+            order = 3.0 if third else 2.0
             e_cell = safety * _cell_max(np.where(np.isfinite(dnode), dnode, np.inf)) / 2**order
             self.estimated = np.isfinite(e_cell)
             e_cell = np.where(self.estimated, e_cell, k_size) + _cell_max(fe)

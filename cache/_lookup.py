@@ -128,44 +128,57 @@ def export_grid(store, name, path, *, solver_version):
 
 
 def load_grid_table(db=None, *, grid=None, solver_version=None):
-    """The interpolation table for ``db`` (its own grid if it has one, else the shipped one).
+    """The interpolation table for ``db``: its own grid when complete, else the shipped one.
 
-    Returns None when neither exists for the current solver version.
+    Order of preference: a complete grid stored in ``db`` (the newest, or ``grid``), the grid
+    shipped in ``cache/data`` if it was built with the current solver version, an incomplete
+    grid of ``db`` (cells with unsolved corners are never served).  Returns None when there
+    is none for the current solver version.
     """
     if solver_version is None:
         solver_version = _build.default_solver()[1]
+    partial = None
     path = Path(db) if db is not None else default_db_path()
     if path.exists() and path.stat().st_size > 0:
         key = (str(path.resolve()), grid, solver_version)
         cached = _TABLES.get(key)
         mtime = path.stat().st_mtime_ns
         if cached is not None and (cached[0] == mtime or cached[1]):
-            return cached[2]  # unchanged file, or a complete grid (FE rows never alter nodes)
-        with open_store(path, create=False) as store:
-            names = store.grid_names()
-            name = grid if grid is not None else (names[-1] if names else None)
-            table = _grid_from_store(store, name, solver_version) if name in names else None
-        if table is not None:
-            complete = table.n_missing == 0
-            _TABLES[key] = (mtime, complete, table)
+            table = cached[2]  # unchanged file, or a complete grid (FE rows never alter nodes)
+        else:
+            with open_store(path, create=False) as store:
+                names = store.grid_names()
+                name = grid if grid is not None else (names[-1] if names else None)
+                table = _grid_from_store(store, name, solver_version) if name in names else None
+            if table is not None:
+                _TABLES[key] = (mtime, table.n_missing == 0, table)
+        if table is not None and table.n_missing == 0:
             return table
-    name = grid or DEFAULT_GRID
-    shipped = shipped_grid_path(name)
-    if shipped.exists():
-        key = (str(shipped), name, solver_version, shipped.stat().st_mtime_ns)
-        if key not in _TABLES:
-            _TABLES[key] = None
-            import json
+        partial = table
+    shipped = _shipped_table(grid or DEFAULT_GRID, solver_version)
+    return shipped if shipped is not None else partial
 
-            z = np.load(shipped, allow_pickle=False)
-            if str(z["solver_version"]) != str(solver_version):
-                logger.warning("shipped grid %s was built with solver %s, current is %s: not used",
-                               shipped, z["solver_version"], solver_version)
-                return None
-            _TABLES[key] = GridTable(GridSpec.from_dict(json.loads(str(z["spec"]))), z["qstar"],
-                                     z["fe_error"])
-        return _TABLES[key]
-    return None
+
+def _shipped_table(name, solver_version):
+    import json
+
+    path = shipped_grid_path(name)
+    if not path.exists():
+        return None
+    key = (str(path), name, solver_version, path.stat().st_mtime_ns)
+    if key not in _TABLES:
+        z = np.load(path, allow_pickle=False)
+        if str(z["solver_version"]) != str(solver_version):
+            logger.warning("shipped grid %s was built with solver %s, the current one is %s: not "
+                           "used (rebuild: python -m cache.precompute --grid %s --export ...)",
+                           path, z["solver_version"], solver_version, name)
+            _TABLES[key] = None
+        else:
+            table = GridTable(GridSpec.from_dict(json.loads(str(z["spec"]))), z["qstar"],
+                              z["fe_error"])
+            table.n_missing = 0
+            _TABLES[key] = table
+    return _TABLES[key]
 
 
 def _quick_valid(r, s):

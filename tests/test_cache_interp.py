@@ -78,25 +78,24 @@ def test_lookup_is_permutation_and_scale_invariant(tmp_path):
 
 
 def test_error_estimate_bounds_heldout_fe_solves(tmp_path):
-    # real solver: the 'tiny' grid (310 FE solves), 24 held-out random throats inside it
-    pytest.importorskip("gmsh")
+    # real solver: a 3 x 3 x 3 x 3 x 3 grid (gaps 0, 0.15, 0.3 r̄; rho -0.1, 0, 0.1; about 60
+    # distinct FE solves) and 16 held-out random throats inside it, solved directly by FE
     from throats import solve_fem
 
-    spec = GRIDS["tiny"]
+    spec = GridSpec("fe-test", [0.0, 0.15, 0.3], 0.1, 3)
     db = tmp_path / "fe.sqlite"
     with open_store(db) as st:
         summ = cache.precompute_grid(st, spec, rtol=1e-3, batch_size=64)
-    assert summ.failed == 0 and summ.solved == summ.n_unique
+    assert summ.failed == 0 and summ.solved == summ.n_unique < 100
     rng = np.random.default_rng(12)
-    x = np.c_[rng.uniform(0.0, 0.3, (24, 3)), rng.uniform(-0.07, 0.07, (24, 2))]
+    x = np.c_[rng.uniform(0.0, 0.3, (16, 3)), rng.uniform(-0.05, 0.05, (16, 2))]
     r, s = _shapes(x)
     fe = solve_fem(r, s, rtol=1e-3).qstar
     res = lookup_qstar(r, s, db=db, policy="table-only")
     err = np.abs(res.qstar / fe - 1)
-    covered = np.isfinite(res.error_estimate)
-    assert covered.mean() >= 0.9
-    assert np.all(err[covered] <= res.error_estimate[covered])
-    assert np.median(err) < 0.02  # a coarse grid: 0.1-0.3 r̄ gap spacing
+    assert np.all(np.isfinite(res.error_estimate)) and set(res.source) == {"interp"}
+    assert np.all(err <= res.error_estimate)
+    assert np.median(err) < 0.02  # a very coarse grid: 0.15 r̄ gap spacing
 
 
 def test_lookup_policies_with_injected_solver(tmp_path):
