@@ -37,7 +37,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from ._geometry import _as_throats, _region_boundary, triangle_vertices
+from ._geometry import _as_throats, _closed_forms, _exact_area_perimeter, open_area_perimeter
 
 __all__ = ["FIT", "open_area_perimeter", "shape_factor_qstar"]
 
@@ -55,67 +55,6 @@ FIT = {
                  "d": (0.035, 0.116)},   # (median, p95) of |Q_sf / Q_FE - 1|
     "holdout": "fit on even rows, tested on odd rows: median 0.204, p95 0.521",
 }
-
-
-def _exact_area_perimeter(r, s):
-    """Exact A and arc perimeter from the boundary engine (units of r̄ in, out)."""
-    v = triangle_vertices(s)
-    res = _region_boundary(v, v, r)
-    cu, con = res["cu"], res["con"]
-    dth = 2 * np.pi * (np.nan_to_num(cu[..., 1:]) - np.nan_to_num(cu[..., :-1]))
-    per = np.sum(np.where(con, dth * r[:, :, None], 0.0), axis=(1, 2))
-    return res["area"], per
-
-
-def open_area_perimeter(radii_star, sides_star):
-    """Open area A* and no-slip (arc) perimeter P* of throats in units of r̄, (N,) each.
-
-    Closed forms for the usual case, the exact engine for disks that reach the opposite
-    edge or share a triple overlap (module docstring).  Inputs must be valid throats.
-    """
-    r = np.ascontiguousarray(np.asarray(radii_star, dtype=float).T)   # (3, N) rows
-    s = np.ascontiguousarray(np.asarray(sides_star, dtype=float).T)
-    area, per, hard = _closed_forms(r, s)
-    if hard.any():
-        area[hard], per[hard] = _exact_area_perimeter(r[:, hard].T, s[:, hard].T)
-    return np.maximum(area, 0.0), per
-
-
-def _closed_forms(r, s):
-    """Closed-form A, P and the mask of rows that need the exact engine; r, s are (3, N)."""
-    l12, l13, l23 = s
-    q12, q13, q23 = l12 * l12, l13 * l13, l23 * l23
-    th = np.arccos(np.clip(np.array([(q12 + q13 - q23) / (2 * l12 * l13),
-                                     (q12 + q23 - q13) / (2 * l12 * l23),
-                                     (q13 + q23 - q12) / (2 * l13 * l23)]), -1.0, 1.0))
-    sp = 0.5 * (l12 + l13 + l23)
-    a_tri = np.sqrt(np.maximum(sp * (sp - l12) * (sp - l13) * (sp - l23), 0.0))
-    rth = th * r
-    area = a_tri - 0.5 * (rth[0] * r[0] + rth[1] * r[1] + rth[2] * r[2])
-    per = rth[0] + rth[1] + rth[2]
-    # altitudes h_i = 2 A / (opposite side); a disk reaching its opposite edge -> exact path
-    two_a = 2 * a_tri
-    hard = (r[0] * l23 >= two_a) | (r[1] * l13 >= two_a) | (r[2] * l12 >= two_a)
-    for i, j, k, l, lik in ((0, 1, 2, l12, l13), (0, 2, 1, l13, l12), (1, 2, 0, l23, l12)):
-        ri, rj = r[i], r[j]
-        ov = l < ri + rj
-        if not ov.any():
-            continue
-        idx = np.flatnonzero(ov)
-        ri, rj, l, lik = ri[idx], rj[idx], l[idx], lik[idx]
-        ci = np.clip((l * l + ri * ri - rj * rj) / (2 * l * ri), -1.0, 1.0)
-        cj = np.clip((l * l + rj * rj - ri * ri) / (2 * l * rj), -1.0, 1.0)
-        ai, aj = np.arccos(ci), np.arccos(cj)
-        lens = ri * ri * (ai - np.sqrt(1 - ci * ci) * ci) \
-            + rj * rj * (aj - np.sqrt(1 - cj * cj) * cj)
-        area[idx] += 0.5 * lens
-        per[idx] -= ai * ri + aj * rj
-        # lens outside the angular sectors, or its corner (on the triangle side of edge ij)
-        # inside the third disk -> exact path; distance from vertex k by the law of cosines
-        # with the angle theta_i - alpha_i between the directions i->k and i->corner
-        d2 = ri * ri + lik * lik - 2 * ri * lik * np.cos(th[i, idx] - ai)
-        hard[idx] |= (ai > th[i, idx]) | (aj > th[j, idx]) | (d2 <= r[k, idx] ** 2)
-    return area, per, hard
 
 
 def shape_factor_qstar(radii, sides):
