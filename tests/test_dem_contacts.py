@@ -128,3 +128,39 @@ def test_cylinder_wall_contact_force_is_radial():
     sim = Simulation(x, [R], [wall], mat, gravity_m_s2=0.0)
     f, _ = sim.forces()
     np.testing.assert_allclose(f[:, 0], [-mat.kn_pw * 1e-5, 0, 0], rtol=1e-9, atol=1e-12)
+
+
+def test_shear_history_survives_neighbour_list_rebuilds():
+    # remap by sorted pair keys i*N+j: a pair present before and after keeps its spring,
+    # a new pair starts at zero
+    from dem._neighbors import remap_history
+
+    old_keys = np.array([1, 5, 9])
+    old = np.array([[1.0, 0, 0], [2.0, 0, 0], [3.0, 0, 0]])
+    new = remap_history(old_keys, old, np.array([0, 5, 9, 12]))
+    np.testing.assert_array_equal(new[:, 0], [0.0, 2.0, 3.0, 0.0])
+
+
+def test_verlet_list_rebuilds_only_after_half_skin():
+    from dem._neighbors import VerletList
+
+    x = np.array([[0.0, 0, 0], [0.0066, 0, 0]])
+    r = np.array([R, R])
+    vl = VerletList(skin=0.0004)
+    vl.build(x, r)
+    assert vl.pairs.tolist() == [[0, 1]]  # gap 0.1 mm < skin
+    assert not vl.needs_rebuild(x + [0.00019, 0, 0], r)
+    assert vl.needs_rebuild(x + [[0.00021, 0, 0], [0, 0, 0]], r)
+
+
+def test_instability_and_escape_stop_with_clear_messages():
+    from dem import DemInstabilityError
+
+    sim = Simulation([[0, 0, 0.01]], [R], [], Material(), gravity_m_s2=0.0,
+                     bounds_m=[[-0.05, -0.05, 0.0], [0.05, 0.05, 0.05]])
+    sim.velocities[:] = [[0, 0, 50.0]]  # energy blow-up signature
+    with pytest.raises(DemInstabilityError, match="energy blow-up"):
+        sim.run(max_steps=10, check_every=5)
+    sim.velocities[:] = [[0, 0, 5.0]]
+    with pytest.raises(DemInstabilityError, match="left the container"):
+        sim.run(duration_s=0.02, check_every=100)
