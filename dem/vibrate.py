@@ -40,6 +40,7 @@ def _parser():
     p.add_argument("--mass-scale", type=float, default=100.0)
     p.add_argument("--record-every", type=float, default=None, help="s (default a quarter period)")
     p.add_argument("--snapshots", type=float, nargs="*", default=(), help="times (s) to save packings")
+    p.add_argument("--settle-steps", type=int, default=100000, help="step limit of the settling after vibration")
     p.add_argument("--scene", choices=sorted(SCENES), help="container if the packing has no JSON")
     p.add_argument("--out", default="vibration_out", help="output folder")
     p.add_argument("--quiet", action="store_true")
@@ -85,7 +86,8 @@ def main(argv=None) -> int:
         try:
             res = vibrate(centers, radii, container, freq_hz=args.freq, amplitude_m=amp, duration_s=args.duration,
                           material=material, mass_scale=args.mass_scale, record_every_s=args.record_every,
-                          snapshot_times_s=args.snapshots, progress=progress)
+                          snapshot_times_s=args.snapshots, max_settle_steps=args.settle_steps,
+                          progress=progress)
         except ValueError as e:
             print(f"error: {e}", file=sys.stderr)
             return 2

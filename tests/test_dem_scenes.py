@@ -134,3 +134,20 @@ def test_vibration_records_histories(tiny_bed):
     assert res.summary["intensity_g"] == 0.0
     with pytest.raises(ValueError, match="freq_hz"):
         vibrate(tiny_bed.centers, tiny_bed.radii, TINY, freq_hz=0.0, amplitude_m=0.001, duration_s=0.1)
+
+
+def test_clis_refuse_bad_arguments_and_vibrate_runs(tmp_path, tiny_bed, capsys):
+    import importlib  # dem.pack is also the name of the packing function
+
+    pack_main = importlib.import_module("dem.pack").main
+    vib_main = importlib.import_module("dem.vibrate").main
+    assert pack_main(["--scene", "box", "--out", str(tmp_path / "x.csv")]) == 2
+    assert pack_main(["--scene", "rect-bin", "--kn", "0", "--out", str(tmp_path / "x.csv")]) == 2
+    assert not (tmp_path / "x.csv").exists()
+    p = tmp_path / "bed.csv"
+    write_packing(p, tiny_bed.centers, tiny_bed.radii, tiny_bed.summary)
+    out = tmp_path / "vib"
+    assert vib_main([str(p), "--amplitude", "0.001", "0.002", "--duration", "0.01", "--out", str(out), "--quiet",
+                     "--settle-steps", "200"]) == 0
+    assert (out / "vib_1mm.csv").exists() and (out / "series.json").exists()
+    assert "1.81 g" in capsys.readouterr().out
