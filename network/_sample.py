@@ -102,7 +102,9 @@ def default_region(packing, *, margin: float | None = None, cylinder: bool = Fal
     margin : float, optional, m
         Distance kept from the outer sphere surfaces on every side. Default: 1.5 mean
         diameters, the thickness over which wall ordering raises the local porosity of random
-        sphere packings (thesis 4.2.3 kept ~1.4 d from its bin walls).
+        sphere packings. (The thesis's box, |x|, |y| < 0.051 m in a 0.15 m cylinder, stayed
+        3.7 d from the wall at mid-faces but came within 0.5 d of it at the corners; pass
+        ``--sample`` to reproduce it.)
     cylinder : bool
         Return the largest cylinder (axis set later by the flow axis) inside that box.
     """
