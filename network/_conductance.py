@@ -115,7 +115,7 @@ def _check_policy(policy):
         raise ValueError(f"unknown Q* policy {policy!r}; choose one of {', '.join(POLICIES)}")
 
 
-def throat_qstar(radii, sides, *, policy: str = "table+fe", rtol: float = 1e-3, db=None,
+def throat_qstar(radii, sides, *, policy: str = "table-only", rtol: float = 1e-3, db=None,
                  workers: int = 1, progress: bool = False,
                  on_failed: str = "shape-factor") -> QstarResult:
     """Dimensionless flow rate Q* (r̄ units) of N throats under a policy.
@@ -223,7 +223,7 @@ def throat_qstar(radii, sides, *, policy: str = "table+fe", rtol: float = 1e-3, 
 
 
 def throat_conductance(tessellation, throats_idx, *, model: str = "thesis",
-                       policy: str = "table+fe", viscosity_pa_s: float = MU_AIR_PA_S,
+                       policy: str = "table-only", viscosity_pa_s: float = MU_AIR_PA_S,
                        rtol: float = 1e-3, db=None, workers: int = 1, progress: bool = False,
                        **model_options):
     """Conductance g (m³ Pa⁻¹ s⁻¹) of selected throats of a tessellation under a model.

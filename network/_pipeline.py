@@ -146,7 +146,7 @@ class FlowResult:
 
 def solve_network(packing: Packing, *, axis="z", region: Region | None = None,
                   margin: float | None = None, cylinder: bool = False,
-                  conductance_model: str = "thesis", policy: str = "table+fe",
+                  conductance_model: str = "thesis", policy: str = "table-only",
                   viscosity_pa_s: float = MU_AIR_PA_S,
                   velocity_m_s: float = DEFAULT_VELOCITY_M_S, depth_m: float = DEFAULT_DEPTH_M,
                   rtol: float = 1e-3, db=None, workers: int = 1, progress: bool = False,
@@ -170,7 +170,8 @@ def solve_network(packing: Packing, *, axis="z", region: Region | None = None,
         Use the inscribed cylinder of the default box.
     conductance_model : {'thesis', 'conduit'}
     policy : {'shape-factor', 'table-only', 'table+fe', 'fe-only'}
-        Q* source (see :mod:`network._conductance`).
+        Q* source (see :mod:`network._conductance`); default 'table-only' (the table, the
+        shape-factor estimate where it cannot answer, never FE).
     viscosity_pa_s, velocity_m_s, depth_m : float
         μ (1.932e-5 Pa·s), superficial velocity (0.013 m/s), bed depth (0.25 m).
     rtol, db, workers, progress

@@ -56,8 +56,11 @@ def build_parser() -> argparse.ArgumentParser:
                     help=f"superficial velocity, m/s (default {DEFAULT_VELOCITY_M_S})")
     ap.add_argument("--depth", type=float, default=DEFAULT_DEPTH_M,
                     help=f"bed depth for the pressure drop, m (default {DEFAULT_DEPTH_M})")
-    ap.add_argument("--policy", default="table+fe", choices=POLICIES,
-                    help="Q* source (default table+fe; shape-factor is the fast mode)")
+    ap.add_argument("--policy", default="table-only", choices=POLICIES,
+                    help="Q* source: table-only (default: the precomputed table, the "
+                         "shape-factor estimate where it cannot answer; never runs FE), "
+                         "table+fe (FE for rows the table cannot answer to --rtol), fe-only, "
+                         "shape-factor (fast closed form)")
     ap.add_argument("--conductance-model", default="thesis", choices=MODELS,
                     help="throat conductance model (default thesis, Eq. 3.41)")
     ap.add_argument("--rtol", type=float, default=1e-3, help="Q* relative tolerance (1e-3)")
@@ -91,6 +94,10 @@ def _print_result(res, out):
     print(f"    Ergun {c['ergun']['pressure_drop_pa']:.4g} Pa, Kozeny-Carman "
           f"{c['kozeny_carman']['pressure_drop_pa']:.4g} Pa, ASABE D272 (soybeans) "
           f"{c['asabe_d272']['pressure_drop_pa']:.4g} Pa", file=out)
+    src = s.get("qstar", {}).get("sources")
+    if src:
+        print("  Q* sources: " + ", ".join(f"{k} {v}" for k, v in src.items())
+              + f" ({s['qstar'].get('seconds', float('nan')):.2f} s)", file=out)
     sv, mb = s["solver"], s["mass_balance"]
     print(f"  solver {sv['method']}: {sv['iterations']} it, residual {sv['residual']:.1e}; "
           f"inlet/outlet mismatch {mb['balance_error']:.1e} ({'ok' if mb['ok'] else 'FAILED'})",
