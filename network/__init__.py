@@ -40,7 +40,7 @@ from ._empirical import (asabe_d272_gradient, darcy_permeability, ergun_gradient
 from ._flow import (SolveInfo, apply_pressure_bc, assemble_laplacian, solve_fixed_pressure,
                     solve_pressure, verify_solution)
 from ._generate import random_packing
-from ._io import Packing, default_packing_path, read_packing, write_packing_csv
+from ._io import Packing, default_packing_path, read_container, read_packing, write_packing_csv
 from ._lattices import lattice_packing, lattice_radius
 from ._paths import AirflowPath, trace_paths
 from ._pipeline import FlowResult, solve_network
@@ -51,7 +51,7 @@ from ._tessellation import QHULL_OPTIONS, Tessellation, tessellate, tie_groups
 from ._vtk import write_network_vtu
 
 __all__ = [
-    "Packing", "read_packing", "write_packing_csv", "default_packing_path",
+    "Packing", "read_packing", "write_packing_csv", "default_packing_path", "read_container",
     "Tessellation", "tessellate", "tie_groups", "QHULL_OPTIONS",
     "Region", "SampleNetwork", "default_region", "select_sample", "prune_disconnected",
     "MU_AIR_PA_S", "POLICIES", "MODELS", "QstarResult", "thesis_conductance", "throat_qstar",

@@ -14,7 +14,8 @@ from pathlib import Path
 
 import numpy as np
 
-__all__ = ["Packing", "read_packing", "write_packing_csv", "MIN_SPHERES", "default_packing_path"]
+__all__ = ["Packing", "read_packing", "write_packing_csv", "MIN_SPHERES", "default_packing_path",
+           "read_container"]
 
 log = logging.getLogger(__name__)
 
@@ -262,6 +263,38 @@ def read_packing(path: str | os.PathLike) -> Packing:
             pk = _read_csv(p)
     log.info("read %d spheres from %s", pk.n, p)
     return pk
+
+
+def read_container(path: str | os.PathLike) -> dict | None:
+    """The container of a packing from its companion JSON (same name, ``.json``), if any.
+
+    The DEM writes ``{"container": {"kind": "cylinder" | "box", "size_m": [...], ...}}`` beside
+    its CSV (DESIGN: containers are described in the companion JSON or on the command line).
+
+    Returns
+    -------
+    dict or None
+        ``{"kind": ..., "size_m": [...], "center_xy": [x, y] (if known)}``; None when there is
+        no companion JSON or it has no usable ``container`` entry (logged).
+    """
+    import json
+
+    p = Path(path).with_suffix(".json")
+    if not p.is_file():
+        return None
+    try:
+        meta = json.loads(p.read_text())
+        cont = dict(meta["container"])
+        kind = str(cont["kind"]).lower()
+        size = [float(v) for v in np.atleast_1d(cont["size_m"])]
+    except (ValueError, KeyError, TypeError) as e:
+        log.warning("companion JSON %s has no usable 'container' entry (%s): ignored", p, e)
+        return None
+    out = {"kind": kind, "size_m": size, "source": str(p)}
+    centre = cont.get("center_xy") or (meta.get("interior_region") or {}).get("center_xy")
+    if centre is not None:
+        out["center_xy"] = [float(v) for v in centre][:2]
+    return out
 
 
 def write_packing_csv(packing: Packing, path: str | os.PathLike, *, digits: int = 7) -> None:

@@ -153,7 +153,7 @@ def solve_network(packing: Packing, *, axis="z", region: Region | None = None,
                   tessellation: Tessellation | None = None, solver: Callable | None = None,
                   porosity_points: int = 200_000, conductance: Callable | None = None,
                   trace_memory: bool = False, merge_ties: bool = True,
-                  porosity: tuple | None = None) -> FlowResult:
+                  porosity: tuple | None = None, container: dict | None = None) -> FlowResult:
     """Permeability and pressure drop of a packing by the Delaunay network model.
 
     Parameters
@@ -168,6 +168,8 @@ def solve_network(packing: Packing, *, axis="z", region: Region | None = None,
         Wall margin of the default region (default 1.5 mean diameters).
     cylinder : bool
         Use the inscribed cylinder of the default box.
+    container : dict, optional
+        The packing's container (:func:`network.read_container`), for the default region.
     conductance_model : {'thesis', 'conduit'}
     policy : {'shape-factor', 'table-only', 'table+fe', 'fe-only'}
         Q* source (see :mod:`network._conductance`); default 'table-only' (the table, the
@@ -213,7 +215,8 @@ def solve_network(packing: Packing, *, axis="z", region: Region | None = None,
     with stage("tessellate"):
         tess = tessellate(packing) if tessellation is None else tessellation
     with stage("sample"):
-        reg = default_region(packing, margin=margin, cylinder=cylinder) if region is None else region
+        reg = (default_region(packing, margin=margin, cylinder=cylinder, container=container,
+                              axis=axis) if region is None else region)
         labels, model_opts = None, {}
         if conductance is None and conductance_model == "conduit" and merge_ties:
             # the conduit model's pore bodies (near-co-spherical groups, slivers) are

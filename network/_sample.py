@@ -93,20 +93,29 @@ class Region:
         return float(np.prod(self.hi[lat] - self.lo[lat]))
 
 
-def default_region(packing, *, margin: float | None = None, cylinder: bool = False) -> Region:
-    r"""Interior box (or inscribed cylinder) of a packing, ``margin`` inside its sphere surfaces.
+def default_region(packing, *, margin: float | None = None, cylinder: bool = False,
+                   container: dict | None = None, axis="z") -> Region:
+    r"""Interior box (or cylinder) of a packing, ``margin`` inside its container or its spheres.
 
     Parameters
     ----------
     packing : Packing
     margin : float, optional, m
-        Distance kept from the outer sphere surfaces on every side. Default: 1.5 mean
-        diameters, the thickness over which wall ordering raises the local porosity of random
-        sphere packings. (The thesis's box, |x|, |y| < 0.051 m in a 0.15 m cylinder, stayed
-        3.7 d from the wall at mid-faces but came within 0.5 d of it at the corners; pass
-        ``--sample`` to reproduce it.)
+        Distance kept from the walls (or from the outer sphere surfaces) on every side.
+        Default: 1.5 mean diameters, the thickness over which wall ordering raises the local
+        porosity of random sphere packings. (The thesis's box, |x|, |y| < 0.051 m in a 0.15 m
+        cylinder, stayed 3.7 d from the wall at mid-faces but came within 0.5 d of it at the
+        corners; pass ``--sample`` to reproduce it.)
     cylinder : bool
-        Return the largest cylinder (axis set later by the flow axis) inside that box.
+        Return the largest cylinder (axis = flow axis) inside the interior box.
+    container : dict, optional
+        From :func:`network.read_container`. A vertical ``'cylinder'`` (``size_m = [D]``,
+        axis z, centre ``center_xy`` or the middle of the packing) gives a cylinder of radius
+        D/2 − margin for flow along z, and the square inscribed in it for flow along x or y:
+        the bounding box of a cylindrical bed would reach past the wall, where the convex
+        hull's large outer tetrahedra make a spurious high-conductance channel.
+    axis : {'x', 'y', 'z'}
+        Flow axis (matters for a cylindrical container only).
     """
     lo = (packing.centers - packing.radii[:, None]).min(axis=0)
     hi = (packing.centers + packing.radii[:, None]).max(axis=0)
@@ -116,9 +125,20 @@ def default_region(packing, *, margin: float | None = None, cylinder: bool = Fal
     if np.any(hi - lo <= 2 * m):
         raise ValueError(f"margin {m:g} leaves no interior in a packing of extent {hi - lo}")
     lo, hi = lo + m, hi - m
+    if container is not None and container.get("kind") == "cylinder":
+        c = np.asarray(container.get("center_xy", 0.5 * (lo[:2] + hi[:2])), dtype=float)
+        r_in = 0.5 * float(container["size_m"][0]) - m
+        if r_in <= 0:
+            raise ValueError(f"margin {m:g} leaves no interior in a cylinder of diameter "
+                             f"{container['size_m'][0]:g}")
+        if _axis_index(axis) == 2:
+            return Region([c[0] - r_in, c[1] - r_in, lo[2]], [c[0] + r_in, c[1] + r_in, hi[2]],
+                          r_in)
+        h = r_in / np.sqrt(2.0)
+        return Region([c[0] - h, c[1] - h, lo[2]], [c[0] + h, c[1] + h, hi[2]])
     radius = None
     if cylinder:
-        radius = 0.5 * float(np.min(hi - lo))
+        radius = 0.5 * float(np.min(np.delete(hi - lo, _axis_index(axis))))
     return Region(lo, hi, radius)
 
 
@@ -250,6 +270,16 @@ def select_sample(tessellation, region: Region, *, axis="z", groups=None) -> Sam
     throats = np.flatnonzero(internal)
     conns = np.column_stack([a[throats], b[throats]])
     xyz = xyz_all[pores]
+    # tetrahedra whose empty sphere is wider than 2 mean diameters lie outside the packed bed
+    # (convex-hull artefacts next to curved or open surfaces)
+    in_tet = inside[lab]
+    circ_r = np.linalg.norm(t.pore_circumcenter[in_tet]
+                            - t.packing.centers[t.pore_vertices[in_tet, 0]], axis=1)
+    n_big = int(np.sum(circ_r > 2.0 * t.packing.mean_diameter))
+    if n_big:
+        log.warning("%d sample tetrahedra have an empty sphere wider than 2 mean diameters: the "
+                    "sample region probably reaches outside the packed bed (give --sample, or a "
+                    "companion JSON with the container)", n_big)
     length = _length(xyz, inlet, outlet, ax)
     log.info("sample along %s: %d pores (%d inlet, %d outlet), %d throats, H = %.4g, A = %.4g",
              "xyz"[ax], pores.size, inlet.size, outlet.size, throats.size, length,

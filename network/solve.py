@@ -22,9 +22,9 @@ from pathlib import Path
 import numpy as np
 
 from ._conductance import MODELS, MU_AIR_PA_S, POLICIES
-from ._io import default_packing_path, read_packing
+from ._io import default_packing_path, read_container, read_packing
 from ._pipeline import DEFAULT_DEPTH_M, DEFAULT_VELOCITY_M_S, solve_network
-from ._sample import Region, default_region
+from ._sample import AXES, Region, default_region
 from ._tessellation import tessellate
 from ._vtk import write_network_vtu
 
@@ -119,34 +119,34 @@ def main(argv=None) -> int:
         print(f"error: {e}", file=sys.stderr)
         return 2
     t_read = time.perf_counter() - t0
-    if args.sample:
-        s = args.sample
-        region = Region([s[0], s[2], s[4]], [s[1], s[3], s[5]])
-        if args.cylinder:
-            region = Region(region.lo, region.hi, 0.5 * float(np.min(region.hi - region.lo)))
-    else:
-        try:
-            region = default_region(packing, margin=args.margin, cylinder=args.cylinder)
-        except ValueError as e:
-            print(f"error: {e}", file=sys.stderr)
-            return 2
+    container = None if args.sample else read_container(path)
+    if container is not None:
+        print(f"container from {container['source']}: {container['kind']} {container['size_m']}")
     axes = ["x", "y", "z"] if args.axis == "all" else [args.axis]
     t1 = time.perf_counter()
     tess = tessellate(packing) if len(axes) > 1 else None   # one tessellation for three axes
     t_tess = time.perf_counter() - t1
     results = []
     for ax in axes:
-        reg = region
-        if args.cylinder and args.sample is None:
-            reg = default_region(packing, margin=args.margin, cylinder=True)
         try:
+            if args.sample:
+                s = args.sample
+                reg = Region([s[0], s[2], s[4]], [s[1], s[3], s[5]])
+                if args.cylinder:
+                    lat = np.delete(reg.hi - reg.lo, AXES[ax])
+                    reg = Region(reg.lo, reg.hi, 0.5 * float(np.min(lat)))
+            else:
+                reg = default_region(packing, margin=args.margin, cylinder=args.cylinder,
+                                     container=container, axis=ax)
+            same = (results and np.array_equal(results[0].region_lo, reg.lo)
+                    and np.array_equal(results[0].region_hi, reg.hi)
+                    and results[0].region_radius == reg.radius)
             res = solve_network(
                 packing, axis=ax, region=reg, conductance_model=args.conductance_model,
                 policy=args.policy, viscosity_pa_s=args.viscosity, velocity_m_s=args.velocity,
                 depth_m=args.depth, rtol=args.rtol, db=args.db, workers=args.workers,
                 progress=not args.quiet, tessellation=tess,
-                porosity=(results[0].porosity, results[0].porosity_std)
-                if results and reg.radius is None else None)
+                porosity=(results[0].porosity, results[0].porosity_std) if same else None)
         except (ValueError, RuntimeError, NotImplementedError) as e:
             print(f"error: {e}", file=sys.stderr)
             return 1

@@ -174,3 +174,36 @@ def test_cylinder_sample(small_bed):
     lat = rc.pore_xyz[:, :2] - 0.5 * (cyl.lo[:2] + cyl.hi[:2])
     assert np.all(np.hypot(lat[:, 0], lat[:, 1]) <= cyl.radius)
     assert 0.7 < rc.permeability_m2 / rb.permeability_m2 < 1.3
+
+
+def test_cylindrical_container_from_companion_json(tmp_path, caplog):
+    """A cylindrical bed: the bounding box would reach past the wall, into the convex hull's
+    large outer tetrahedra (warned); the companion JSON's container gives the right cylinder."""
+    import json
+
+    from network import read_container, write_packing_csv
+
+    pk = random_packing(1500, rng=8, periodic=True, solid_fraction=0.6, aspect=(1, 1, 1.5))
+    mid = 0.5 * (pk.centers.min(0) + pk.centers.max(0))
+    big_r = 0.5 * float(np.ptp(pk.centers[:, 0]))
+    keep = np.hypot(*(pk.centers[:, :2] - mid[:2]).T) + pk.radii <= big_r
+    cyl = Packing(pk.centers[keep], pk.radii[keep])
+    path = tmp_path / "bed.csv"
+    write_packing_csv(cyl, path)
+    (tmp_path / "bed.json").write_text(json.dumps(
+        {"container": {"kind": "cylinder", "size_m": [2 * big_r]},
+         "interior_region": {"center_xy": mid[:2].tolist()}}))
+    cont = read_container(path)
+    assert cont["kind"] == "cylinder" and np.allclose(cont["center_xy"], mid[:2])
+    m = 1.5 * cyl.mean_diameter
+    reg = default_region(cyl, container=cont, axis="z")
+    np.testing.assert_allclose(reg.radius, big_r - m)
+    good = run(cyl, axis="z", region=reg)
+    with caplog.at_level("WARNING", logger="network._sample"):
+        bad = run(cyl, axis="z")                       # bounding box, no container
+    assert "outside the packed bed" in caplog.text
+    # the box counts the empty corners as cross-section and picks up hull channels
+    assert abs(bad.permeability_m2 / good.permeability_m2 - 1) > 0.2
+    # across the cylinder: the inscribed square
+    sq = default_region(cyl, container=cont, axis="x")
+    np.testing.assert_allclose(sq.hi[1] - sq.lo[1], np.sqrt(2) * (big_r - m))
