@@ -43,7 +43,14 @@ DEFAULT_DEPTH_M = 0.25
 
 @dataclasses.dataclass(frozen=True)
 class FlowResult:
-    """Network-model result along one axis (all SI). See :meth:`summary` for the JSON keys."""
+    """Network-model result along one axis (all SI). See :meth:`summary` for the JSON keys.
+
+    Per-pore arrays (``pressure_pa`` in Pa for the flow-imposed problem, ``pore_xyz`` in m) are
+    indexed like ``pore_ids``; per-throat arrays (``throat_flow_m3_s``, ``throat_conductance``,
+    ``conns`` in local pore indices) like ``throat_ids`` (tessellation throats). When
+    tetrahedra were joined into pore bodies, ``pore_groups`` (Np,) gives every tetrahedron's
+    body and ``pore_ids`` are body ids; otherwise it is None and ``pore_ids`` are tetrahedra.
+    """
 
     axis: str
     conductance_model: str
@@ -78,6 +85,7 @@ class FlowResult:
     throat_ids: np.ndarray = dataclasses.field(repr=False)
     conns: np.ndarray = dataclasses.field(repr=False)
     pore_xyz: np.ndarray = dataclasses.field(repr=False)
+    pore_groups: np.ndarray | None = dataclasses.field(default=None, repr=False)
 
     @property
     def k_over_d2(self) -> float:
@@ -291,7 +299,7 @@ def solve_network(packing: Packing, *, axis="z", region: Region | None = None,
         porosity_std=eps_err, solver=solver_info, check=chk, qstar_stats=qstats,
         timings_s=times, pressure_pa=p * scale, throat_flow_m3_s=check["throat_flow"] * scale,
         throat_conductance=g, pore_ids=sample.pores, throat_ids=sample.throats,
-        conns=sample.conns, pore_xyz=sample.pore_xyz)
+        conns=sample.conns, pore_xyz=sample.pore_xyz, pore_groups=sample.groups)
 
 
 class _Stage:
