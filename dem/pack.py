@@ -15,6 +15,8 @@ import argparse
 import sys
 import time
 
+import numpy as np
+
 from ._integrate import DemInstabilityError, Material
 from ._io import summary_path, write_packing
 from ._scenes import SCENES, Container, pack
@@ -43,6 +45,9 @@ def _parser():
                           ("wall-kn", 1.8e7), ("wall-ks", 0.9e7), ("wall-friction", 0.3), ("damping", 0.1),
                           ("r-min", 0.00275), ("r-max", 0.00375)]:
         p.add_argument(f"--{name}", type=float, default=default)
+    p.add_argument("--measure", type=float, nargs=3, action="append", metavar=("X", "Y", "Z"),
+                   help="centre of a measurement sphere (m); repeat for several (default: thesis B1-B5)")
+    p.add_argument("--measure-radius", type=float, default=None, help="m (default: width/14 as in Appendix C)")
     p.add_argument("--quiet", action="store_true")
     return p
 
@@ -66,6 +71,12 @@ def main(argv=None) -> int:
     except ValueError as e:
         print(f"error: {e}", file=sys.stderr)
         return 2
+    measure = None
+    if args.measure:
+        from ._scenes import default_measure_spheres
+
+        r = args.measure_radius or default_measure_spheres(container)[1]
+        measure = (np.array(args.measure, dtype=float), r)
     t0 = time.perf_counter()
 
     def progress(stage, sim, force):
@@ -80,7 +91,7 @@ def main(argv=None) -> int:
         res = pack(container, material=material, porosity=args.porosity, n_particles=args.n_particles,
                    rng=args.seed, mass_scale=args.mass_scale, packing_friction=args.packing_friction,
                    lid_headroom=args.lid_headroom, open_top=not args.keep_lid, tol=args.tol, max_steps=args.max_steps,
-                   dt_safety=args.dt_safety, progress=progress)
+                   dt_safety=args.dt_safety, measure_spheres=measure, progress=progress)
     except ValueError as e:
         print(f"error: {e}", file=sys.stderr)
         return 2
