@@ -136,3 +136,19 @@ def test_bad_arguments():
         conduit_conductance(tess, viscosity_pa_s=-1, qstar_fn=_cheap_qstar)
     with pytest.raises(ValueError, match="n_sections"):
         side_resistance([[0.4] * 3], [[1.0] * 3], [0.3], [1.0], n_sections=1)
+
+
+@pytest.mark.parametrize("kind, phi, measured", [("bcc", 0.5, 0.860), ("fcc", 0.55, 0.857)])
+def test_bcc_fcc_against_computed_stokes(kind, phi, measured):
+    # BCC/FCC have no literature table here; network._references.computed_lattice_permeability
+    # (Taylor-Hood FE in the symmetry cell, checked on SC against Zick & Homsy) is the
+    # reference. The conduit model MISSES the 10 % target on these tetrahedral pores: it is
+    # 9-20 % too resistive (this pins the measured value so a change shows up); the thesis
+    # model is 0.31 / 0.30 of exact here.
+    from network._references import computed_lattice_permeability
+    fe = _fe_memo()
+    k, _ = lattice_sample_permeability(kind, phi, qstar_fn=fe)
+    ratio = k / computed_lattice_permeability(kind, phi)
+    assert ratio == pytest.approx(measured, abs=0.01)
+    kt, _ = lattice_sample_permeability(kind, phi, model="thesis", qstar_fn=fe)
+    assert kt / computed_lattice_permeability(kind, phi) < 0.35
