@@ -123,6 +123,8 @@ class FlowResult:
             "policy": self.policy,
             "permeability_m2": self.permeability_m2,
             "k_over_d2": self.k_over_d2,
+            "k_over_d2_note": "d = Sauter mean diameter d32 = 2 sum(r^3)/sum(r^2) (also used in "
+                              "Ergun and Kozeny-Carman)",
             "pressure_gradient_pa_per_m": self.pressure_gradient_pa_per_m,
             "pressure_drop_pa": self.pressure_drop_pa,
             "velocity_m_s": self.velocity_m_s,
