@@ -156,7 +156,7 @@ class FlowResult:
 
 def solve_network(packing: Packing, *, axis="z", region: Region | None = None,
                   margin: float | None = None, cylinder: bool = False,
-                  conductance_model: str = "thesis", policy: str = "table-only",
+                  conductance_model: str = "conduit", policy: str = "table-only",
                   viscosity_pa_s: float = MU_AIR_PA_S,
                   velocity_m_s: float = DEFAULT_VELOCITY_M_S, depth_m: float = DEFAULT_DEPTH_M,
                   rtol: float = 1e-3, db=None, workers: int = 1, progress: bool = False,
@@ -180,7 +180,9 @@ def solve_network(packing: Packing, *, axis="z", region: Region | None = None,
         Use the inscribed cylinder of the default box.
     container : dict, optional
         The packing's container (:func:`network.read_container`), for the default region.
-    conductance_model : {'thesis', 'conduit'}
+    conductance_model : {'conduit', 'thesis'}
+        Throat conductance model (default 'conduit', :mod:`network._conduit`; 'thesis' is
+        Eq. 3.41 with L = 2r̄, kept to reproduce the thesis).
     policy : {'shape-factor', 'table-only', 'table+fe', 'fe-only'}
         Q* source (see :mod:`network._conductance`); default 'table-only' (the table, the
         shape-factor estimate where it cannot answer, never FE).

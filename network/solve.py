@@ -61,8 +61,8 @@ def build_parser() -> argparse.ArgumentParser:
                          "shape-factor estimate where it cannot answer; never runs FE), "
                          "table+fe (FE for rows the table cannot answer to --rtol), fe-only, "
                          "shape-factor (fast closed form)")
-    ap.add_argument("--conductance-model", default="thesis", choices=MODELS,
-                    help="throat conductance model (default thesis, Eq. 3.41)")
+    ap.add_argument("--conductance-model", default="conduit", choices=MODELS,
+                    help="throat conductance model (default conduit; thesis = Eq. 3.41, L = 2 r̄)")
     ap.add_argument("--rtol", type=float, default=1e-3, help="Q* relative tolerance (1e-3)")
     ap.add_argument("--db", default=None, help="throat table (default: the cache's default)")
     ap.add_argument("--workers", type=int, default=1, help="processes for FE solves")

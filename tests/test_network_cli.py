@@ -35,7 +35,7 @@ def test_solve_default_scene(default_run, capsys):
     assert rc == 0
     for k in KEYS:
         assert k in out, k
-    assert out["conductance_model"] == "thesis" and out["policy"] == "shape-factor"
+    assert out["conductance_model"] == "conduit" and out["policy"] == "shape-factor"
     # porosity of the interior box of the bundled scene (data/README.md: 0.399 +- 0.001)
     assert abs(out["porosity"] - 0.399) < 0.004
     assert out["mass_balance"]["ok"] and out["mass_balance"]["balance_error"] < 1e-8
