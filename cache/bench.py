@@ -87,16 +87,18 @@ def main(argv=None) -> int:
     ref_path = Path(args.reference) if args.reference else None
     if ref_path and ref_path.exists():
         z = np.load(ref_path)
-        r, s, q_ref, q_fe, t_fe = z["radii"], z["sides"], z["q_ref"], z["q_fe"], float(z["t_fe"])
+        r, s, q_ref, q_fe = z["radii"], z["sides"], z["q_ref"], z["q_fe"]
+        t_fe, c_fe = float(z["t_fe"]), float(z["c_fe"])
     else:
         r, s = _sample_throats(args.n_fe, rng=args.seed)
         ref = throats.solve_fem(r, s, rtol=1e-4)
-        t0 = time.perf_counter()
+        c0, t0 = time.process_time(), time.perf_counter()
         fe = throats.solve_fem(r, s, rtol=1e-3)
         t_fe = (time.perf_counter() - t0) / len(r)
+        c_fe = (time.process_time() - c0) / len(r)
         q_ref, q_fe = ref.qstar, fe.qstar
         if ref_path:
-            np.savez(ref_path, radii=r, sides=s, q_ref=q_ref, q_fe=q_fe, t_fe=t_fe)
+            np.savez(ref_path, radii=r, sides=s, q_ref=q_ref, q_fe=q_fe, t_fe=t_fe, c_fe=c_fe)
     good = np.isfinite(q_ref) & (q_ref > 0)
     r, s, q_ref, q_fe = r[good], s[good], q_ref[good], q_fe[good]
     n = len(r)
@@ -142,8 +144,8 @@ def main(argv=None) -> int:
                 "estimate_bounds_error": float(np.mean(err[fin] <= e[fin])) if fin.any() else None,
                 "estimate_median": float(np.median(e[fin])) if fin.any() else None}
     # 3. policies ---------------------------------------------------------------------------
-    sf, w, _ = _timed(lambda: throats.shape_factor_qstar(r, s), 1)
-    rows.append(("shape-factor", _pct(rel(sf)), w[0] / n, 0.0))
+    sf, w, c = _timed(lambda: throats.shape_factor_qstar(r, s), 1)
+    rows.append(("shape-factor", _pct(rel(sf)), w[0] / n, c[0] / n, 0.0))
     best = None
     for name in tables:
         if name.startswith("g1"):
@@ -153,8 +155,8 @@ def main(argv=None) -> int:
         best = next(iter(tables))
     if best is not None:
         t = tables[best]
-        lk, w, _ = _timed(lambda: cache.lookup_qstar(r, s, db=db, policy="table-only", table=t), 1)
-        rows.append((f"table-only [{best}]", _pct(rel(lk.qstar)), w[0] / n,
+        lk, w, c = _timed(lambda: cache.lookup_qstar(r, s, db=db, policy="table-only", table=t), 1)
+        rows.append((f"table-only [{best}]", _pct(rel(lk.qstar)), w[0] / n, c[0] / n,
                      float(np.mean(lk.source == "shape-factor"))))
         for rt in [float(v) for v in args.rtols.split(",") if v]:
             with tempfile.TemporaryDirectory() as tmp:
@@ -163,13 +165,14 @@ def main(argv=None) -> int:
                     with cache.open_store(db, create=False) as st:  # consistent copy (WAL)
                         st.conn.execute("PRAGMA wal_checkpoint(FULL)")
                     shutil.copy(db, scratch)
-                lk, w, _ = _timed(lambda: cache.lookup_qstar(r, s, db=scratch, policy="table+fe",
+                lk, w, c = _timed(lambda: cache.lookup_qstar(r, s, db=scratch, policy="table+fe",
                                                              rtol=rt, table=t), 1)
             rows.append((f"table+fe rtol={rt:g} [{best}]", _pct(rel(lk.qstar)), w[0] / n,
-                         lk.stats["n_fe"] / n))
-    rows.append(("fe-only (FE rtol=1e-3)", _pct(rel(q_fe)), t_fe, 1.0))
-    res["policies"] = [{"method": m, "error": e, "seconds_per_throat": sec, "fraction_fe_or_sf": f}
-                       for m, e, sec, f in rows]
+                         c[0] / n, lk.stats["n_fe"] / n))
+    rows.append(("fe-only (FE rtol=1e-3)", _pct(rel(q_fe)), t_fe, c_fe, 1.0))
+    res["policies"] = [{"method": m, "error": e, "wall_seconds_per_throat": sec,
+                        "cpu_seconds_per_throat": cpu, "fraction_fe_or_sf": f}
+                       for m, e, sec, cpu, f in rows]
 
     # 4. throughput --------------------------------------------------------------------------
     if best is not None:
@@ -201,9 +204,11 @@ def main(argv=None) -> int:
         e = v["error_all"]
         print(f"{k:34s} {v['nodes']:7d} {v['coverage']:6.3f} {e['median']:8.2e} {e['p90']:8.2e} "
               f"{e['p99']:8.2e} {e['max']:8.2e} {v['estimate_bounds_error'] or float('nan'):8.3f}")
-    print(f"\n{'method':40s} {'s/throat':>9s} {'med err':>9s} {'p99 err':>9s} {'max err':>9s} {'FE/SF':>6s}")
-    for m, e, sec, f in rows:
-        print(f"{m:40s} {sec:9.2e} {e['median']:9.2e} {e['p99']:9.2e} {e['max']:9.2e} {f:6.3f}")
+    print(f"\n{'method':40s} {'wall s/th':>9s} {'cpu s/th':>9s} {'med err':>9s} {'p99 err':>9s} "
+          f"{'max err':>9s} {'FE/SF':>6s}")
+    for m, e, sec, cpu, f in rows:
+        print(f"{m:40s} {sec:9.2e} {cpu:9.2e} {e['median']:9.2e} {e['p99']:9.2e} {e['max']:9.2e} "
+              f"{f:6.3f}")
     for key in ("throughput_table_only", "throughput_interp_kernel", "throughput_shape_factor"):
         if key in res:
             v = res[key]
