@@ -21,8 +21,6 @@ import json
 import logging
 import sys
 
-import numpy as np
-
 from ._build import _resolve_solver, precompute_grid, precompute_throats
 from ._csvio import read_throat_csv
 from ._interp import GRIDS
