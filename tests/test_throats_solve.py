@@ -216,3 +216,18 @@ def test_region_narrower_than_closing_width_is_closed():
     assert 0 < sol.open_area[0] < 2e-4
     assert sol.status[0] == "closed" and sol.qstar[0] == 0.0
     assert "narrower than the closing width" in sol.message[0]
+
+
+def test_other_gmsh_users_in_the_process_do_not_change_q():
+    # gmsh options are process-global: a 3-D user (network's Stokes reference test) that sets
+    # first-order elements and a tiny size cap, then finalizes, must not change our answer
+    import gmsh
+
+    q0 = _solve_geometry(disk_geometry(1.0), 1e-4)[0]
+    gmsh.option.setNumber("Mesh.ElementOrder", 1)
+    gmsh.option.setNumber("Mesh.MeshSizeMax", 1e-3)
+    q1 = _solve_geometry(disk_geometry(1.0), 1e-4)[0]
+    gmsh.finalize()
+    q2 = _solve_geometry(disk_geometry(1.0), 1e-4)[0]
+    assert abs(q0 - np.pi / 8) < 1e-4 * np.pi / 8
+    assert q1 == q0 and q2 == q0

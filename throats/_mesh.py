@@ -295,29 +295,35 @@ def _local_feature_size(pts, curves):
 # gmsh
 # ----------------------------------------------------------------------------------------
 
-_GMSH_READY = False
+#: gmsh options of every throat mesh; gmsh options are process-global, so they are set again
+#: on each call (microseconds): another gmsh user in the process cannot change our meshes
+_GMSH_OPTIONS = {
+    "General.Terminal": 0,
+    "General.Verbosity": 0,
+    "General.NumThreads": 1,
+    "Mesh.ElementOrder": 2,
+    "Mesh.SecondOrderLinear": 0,
+    "Mesh.HighOrderOptimize": 0,
+    "Mesh.RecombineAll": 0,
+    "Mesh.MeshSizeFromPoints": 1,
+    "Mesh.MeshSizeExtendFromBoundary": 1,
+    "Mesh.MeshSizeFromCurvature": 0,
+    "Mesh.MeshSizeMin": 0.0,
+    "Mesh.MeshSizeMax": 1e22,
+    "Mesh.MeshSizeFactor": 1.0,
+    "Mesh.Algorithm": 6,
+    # default 1e-9 makes 1D size integration dominate the run time (17 of 19 ms)
+    "Mesh.LcIntegrationPrecision": 1e-3,
+}
 
 
 def _gmsh():
-    """Import and initialise gmsh once per process."""
-    global _GMSH_READY
+    """Import gmsh, initialise it if needed (also after someone else's ``finalize``), set our options."""
     import gmsh
-    if not _GMSH_READY:
-        if not gmsh.isInitialized():
-            gmsh.initialize(interruptible=False)
-        gmsh.option.setNumber("General.Terminal", 0)
-        gmsh.option.setNumber("General.Verbosity", 0)
-        gmsh.option.setNumber("Mesh.ElementOrder", 2)
-        gmsh.option.setNumber("Mesh.SecondOrderLinear", 0)
-        gmsh.option.setNumber("Mesh.HighOrderOptimize", 0)
-        gmsh.option.setNumber("Mesh.MeshSizeFromPoints", 1)
-        gmsh.option.setNumber("Mesh.MeshSizeExtendFromBoundary", 1)
-        gmsh.option.setNumber("Mesh.MeshSizeFromCurvature", 0)
-        gmsh.option.setNumber("Mesh.Algorithm", 6)
-        # default 1e-9 makes 1D size integration dominate the run time (17 of 19 ms)
-        gmsh.option.setNumber("Mesh.LcIntegrationPrecision", 1e-3)
-        gmsh.option.setNumber("General.NumThreads", 1)
-        _GMSH_READY = True
+    if not gmsh.isInitialized():
+        gmsh.initialize(interruptible=False)
+    for name, value in _GMSH_OPTIONS.items():
+        gmsh.option.setNumber(name, value)
     return gmsh
 
 
