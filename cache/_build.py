@@ -22,7 +22,9 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ._signature import _throats_attr, as_throats, shape_keys, signature
+import throats
+
+from ._signature import as_throats, shape_keys, signature
 
 logger = logging.getLogger(__name__)
 
@@ -52,7 +54,7 @@ class PrecomputeSummary:
 
 def default_solver():
     """``(throats.solve_fem, throats.SOLVER_VERSION)``."""
-    return _throats_attr("solve_fem"), _throats_attr("SOLVER_VERSION")
+    return throats.solve_fem, throats.SOLVER_VERSION
 
 
 def _resolve_solver(solver, solver_version):
@@ -138,7 +140,7 @@ def precompute_throats(store, radii, sides, *, rtol=1e-3, solver=None, solver_ve
     solver, solver_version = _resolve_solver(solver, solver_version)
     summary = PrecomputeSummary(n_input=len(r))
 
-    validate = _throats_attr("validate_throats")
+    validate = throats.validate_throats
     ok_rows, messages = validate(r, s)
     sig = np.full((len(r), 5), np.nan)
     if ok_rows.any():

@@ -30,10 +30,12 @@ from pathlib import Path
 
 import numpy as np
 
+import throats
+
 from . import _build
 from ._build import _resolve_solver, precompute_throats
 from ._interp import GridSpec, GridTable, grid_coordinates
-from ._signature import _throats_attr, as_throats, match_keys, shape_keys, signature
+from ._signature import as_throats, match_keys, shape_keys, signature
 from ._store import open_store
 
 logger = logging.getLogger(__name__)
@@ -105,7 +107,7 @@ def _grid_from_store(store, name, solver_version):
     qq = rows["qstar"][same][idx[hit]]
     q[hit] = np.where(st == "closed", 0.0, np.where(st == "ok", qq, np.nan))
     fe[hit] = rows["error_estimate"][same][idx[hit]]
-    valid, _ = _throats_attr("validate_throats")(nr, ns)
+    valid, _ = throats.validate_throats(nr, ns)
     n_missing = int(np.sum(valid & ~hit))
     logger.info("grid %r from %s: %d of %d nodes solved, %d valid nodes missing", name, store.path,
                 int(np.isfinite(q).sum()), len(q), n_missing)
@@ -242,7 +244,7 @@ def lookup_qstar(radii, sides, *, db=None, policy="table+fe", rtol=1e-3, workers
     ok = _quick_valid(r, s)
     pending = np.flatnonzero(ok)
     if policy == "shape-factor":
-        sf = _throats_attr("shape_factor_qstar")
+        sf = throats.shape_factor_qstar
         q[pending] = sf(r[pending], s[pending])
         src[pending] = "shape-factor"
     else:
@@ -270,7 +272,7 @@ def lookup_qstar(radii, sides, *, db=None, policy="table+fe", rtol=1e-3, workers
                     solver_version=solver_version)
     bad = np.flatnonzero(~ok)
     if len(bad):
-        _, m = _throats_attr("validate_throats")(r[bad], s[bad])
+        _, m = throats.validate_throats(r[bad], s[bad])
         msg[bad] = [mm or "invalid throat" for mm in m]
         q[bad], err[bad], src[bad] = np.nan, np.nan, "failed"
     for name in ("exact", "interp", "fe", "shape-factor", "closed", "failed"):
@@ -284,7 +286,7 @@ def lookup_qstar(radii, sides, *, db=None, policy="table+fe", rtol=1e-3, workers
 def _settle(r, s, rows, q, err, src, msg, stats, *, db, policy, rtol, workers, progress, solver,
             solver_version):
     """Exact hits / FE / shape-factor for ``rows`` (in place)."""
-    ok, m = _throats_attr("validate_throats")(r[rows], s[rows])
+    ok, m = throats.validate_throats(r[rows], s[rows])
     bad = rows[~ok]
     msg[bad] = m[~ok]
     q[bad], err[bad], src[bad] = np.nan, np.nan, "failed"
@@ -338,7 +340,7 @@ def _shape_factor_rows(r, s, rows, q, err, src):
     if not len(rows):
         return
     try:
-        sf = _throats_attr("shape_factor_qstar")
+        sf = throats.shape_factor_qstar
     except ImportError:
         logger.warning("throats.shape_factor_qstar unavailable: %d rows keep their clamped "
                        "interpolation with an infinite error estimate", len(rows))

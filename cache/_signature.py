@@ -18,37 +18,13 @@ from __future__ import annotations
 
 import numpy as np
 
+import throats
+from throats import as_throats
+
 __all__ = ["signature", "shape_keys", "QUANTUM"]
 
 #: quantum of the integer key, in units of the mean radius
 QUANTUM = 1e-9
-
-
-def _throats_attr(name):
-    """``throats.<name>``, imported lazily (throats imports nothing heavy at import time)."""
-    import throats
-
-    try:
-        return getattr(throats, name)
-    except AttributeError:
-        from throats import _geometry  # fall back to the topic module while __all__ grows
-
-        try:
-            return getattr(_geometry, name)
-        except AttributeError as e:
-            raise ImportError(f"throats does not provide {name!r} (see the throats issue)") from e
-
-
-def as_throats(radii, sides):
-    """Validate the shapes at the door: two float (N, 3) arrays (a (3,) row means N = 1)."""
-    try:
-        r = np.atleast_2d(np.asarray(radii, dtype=float))
-        s = np.atleast_2d(np.asarray(sides, dtype=float))
-    except (TypeError, ValueError) as e:
-        raise TypeError(f"radii and sides must be numeric arrays: {e}") from e
-    if r.ndim != 2 or r.shape[1] != 3 or s.shape != r.shape:
-        raise ValueError(f"expected radii and sides of shape (N, 3), got {r.shape} and {s.shape}")
-    return r, s
 
 
 def signature(radii, sides):
@@ -73,8 +49,7 @@ def signature(radii, sides):
     True
     """
     r, s = as_throats(radii, sides)
-    canonical_form = _throats_attr("canonical_form")
-    rs, ss = canonical_form(r, s)
+    rs, ss = throats.canonical_form(r, s)
     return np.concatenate([rs[:, :2], ss], axis=1)
 
 

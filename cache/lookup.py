@@ -18,9 +18,10 @@ import sys
 
 import numpy as np
 
+import throats
+
 from ._csvio import read_throat_csv, write_csv
 from ._lookup import POLICIES, lookup_qstar
-from ._signature import _throats_attr
 from ._store import CacheFileError
 
 
@@ -52,8 +53,8 @@ def main(argv=None) -> int:
     ctype = np.full(len(rows), "", dtype=object)
     if ok.any():
         rbar = radii[ok].mean(axis=1)
-        area[ok] = _throats_attr("open_area")(radii[ok], sides[ok]) / rbar**2
-        ctype[ok] = _throats_attr("contact_type")(radii[ok], sides[ok])
+        area[ok] = throats.open_area(radii[ok], sides[ok]) / rbar**2
+        ctype[ok] = throats.contact_type(radii[ok], sides[ok])
     for i in np.flatnonzero(~ok):
         print(f"row {i + 2}: {res.message[i]}", file=sys.stderr)  # +2: header, 1-based
     write_csv(args.out, header, rows, {"qstar": res.qstar, "open_area": area,

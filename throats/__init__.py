@@ -17,6 +17,8 @@ open_area
     Exact open area, also for overlapping disks and disks covering the triangle.
 validate_throats
     Row checks: ``(ok_mask, messages)``.
+as_throats
+    Shape check at the door: two float (N, 3) arrays.
 triangle_vertices
     Planar vertex coordinates of the triangles.
 shape_factor_qstar
@@ -40,10 +42,10 @@ are closed by short no-slip cuts (:mod:`throats._mesh`, error < 2e-5 measured); 
 uses curved quadratic gmsh triangles and Lagrange P3/P4 (:mod:`throats._solve`).
 """
 
-from ._geometry import (canonical_form, contact_type, open_area, triangle_vertices,
+from ._geometry import (as_throats, canonical_form, contact_type, open_area, triangle_vertices,
                         validate_throats)
 from ._shape_factor import shape_factor_qstar
 from ._solve import SOLVER_VERSION, ThroatSolution, solve_fem
 
-__all__ = ["SOLVER_VERSION", "ThroatSolution", "canonical_form", "contact_type", "open_area",
+__all__ = ["SOLVER_VERSION", "as_throats", "ThroatSolution", "canonical_form", "contact_type", "open_area",
            "shape_factor_qstar", "solve_fem", "triangle_vertices", "validate_throats"]

@@ -24,7 +24,7 @@ import logging
 
 import numpy as np
 
-__all__ = ["canonical_form", "contact_type", "open_area", "validate_throats",
+__all__ = ["as_throats", "canonical_form", "contact_type", "open_area", "validate_throats",
            "triangle_vertices"]
 
 logger = logging.getLogger(__name__)
@@ -39,8 +39,11 @@ _PERMS = ((0, 1, 2), (0, 2, 1), (1, 0, 2), (1, 2, 0), (2, 0, 1), (2, 1, 0))
 _TOL = 1e-11
 
 
-def _as_throats(radii, sides):
-    """Convert to two float (N, 3) arrays (a single (3,) row is accepted as N = 1)."""
+def as_throats(radii, sides):
+    """Convert to two float (N, 3) arrays (a single (3,) row is accepted as N = 1).
+
+    Raises ``TypeError`` for non-numeric input and ``ValueError`` for other shapes.
+    """
     try:
         r = np.atleast_2d(np.asarray(radii, dtype=float))
         s = np.atleast_2d(np.asarray(sides, dtype=float))
@@ -119,7 +122,7 @@ def canonical_form(radii, sides):
     >>> r.round(3).tolist(), s.round(3).tolist()
     ([[0.5, 1.0, 1.5]], [[1.75, 2.25, 2.5]])
     """
-    r, s = _as_throats(radii, sides)
+    r, s = as_throats(radii, sides)
     rbar = mean_radius(r)[:, None]
     r = r / rbar
     s = s / rbar
@@ -162,7 +165,7 @@ def contact_type(radii, sides, *, gap_tol=1e-9):
     >>> contact_type([[1, 1, 1], [1, 1, 1]], [[2, 2, 2], [2, 2.5, 2.5]]).tolist()
     ['d', 'b']
     """
-    r, s = _as_throats(radii, sides)
+    r, s = as_throats(radii, sides)
     rbar = mean_radius(r)
     gaps = np.stack([s[:, _PAIR_COL[i, j]] - r[:, i] - r[:, j] for i, j in _PAIRS], axis=1)
     n = np.sum(gaps <= gap_tol * rbar[:, None], axis=1)
@@ -190,7 +193,7 @@ def validate_throats(radii, sides):
     ValueError
         If the arrays are not both of shape (N, 3) (a programming error, not a bad row).
     """
-    return _validate(*_as_throats(radii, sides), deep_overlap=True)
+    return _validate(*as_throats(radii, sides), deep_overlap=True)
 
 
 def _validate(r, s, *, deep_overlap):
@@ -498,7 +501,7 @@ def open_area(radii, sides):
     >>> open_area([[1, 1, 1], [0.5, 0.5, 0.5]], [[2, 2, 2], [3, 4, 5]]).round(12).tolist()
     [0.161254480774, 5.607300918301]
     """
-    r, s = _as_throats(radii, sides)
+    r, s = as_throats(radii, sides)
     ok, _ = _validate(r, s, deep_overlap=False)
     out = np.full(r.shape[0], np.nan)
     if not ok.any():

@@ -37,7 +37,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from ._geometry import _as_throats, _closed_forms, _exact_area_perimeter, open_area_perimeter
+from ._geometry import as_throats, _closed_forms, _exact_area_perimeter, open_area_perimeter
 
 __all__ = ["FIT", "open_area_perimeter", "shape_factor_qstar"]
 
@@ -81,7 +81,7 @@ def shape_factor_qstar(radii, sides):
     >>> bool(0 < q[0] < 1e-3)
     True
     """
-    r, s = _as_throats(radii, sides)
+    r, s = as_throats(radii, sides)
     r = np.ascontiguousarray(r.T)
     s = np.ascontiguousarray(s.T)
     with np.errstate(invalid="ignore"):

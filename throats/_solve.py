@@ -35,7 +35,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ._geometry import (_as_throats, canonical_form, contact_type, mean_radius, open_area,
+from ._geometry import (as_throats, canonical_form, contact_type, mean_radius, open_area,
                         validate_throats)
 from ._mesh import DELTA_DEFAULT, ThroatGeometry, TriMesh, build_geometries, mesh_geometry
 
@@ -356,7 +356,7 @@ def solve_fem(radii, sides, *, rtol=1e-3, workers=1, progress=False, delta=DELTA
     >>> round(float(sol.qstar[0]), 6)
     0.000523
     """
-    r, s = _as_throats(radii, sides)
+    r, s = as_throats(radii, sides)
     if not (np.isfinite(rtol) and 0 < rtol < 1):
         raise ValueError(f"rtol must be in (0, 1), got {rtol}")
     if int(workers) < 1:
