@@ -348,6 +348,8 @@ def _jsonable(d):
             # long per-throat arrays are not summary material: left out
         elif isinstance(v, (list, tuple)):
             out[str(k)] = [x.item() if hasattr(x, "item") else x for x in v]
+        elif dataclasses.is_dataclass(v):   # e.g. the conduit's PoreMerge: its scalar fields
+            out[str(k)] = _jsonable({f.name: getattr(v, f.name) for f in dataclasses.fields(v)})
         else:
             out[str(k)] = str(v)
     return out
