@@ -19,6 +19,43 @@ is then φ by construction, but in a bin only three grains thick the spheres can
 (1 − φ) of the box without being pressed into each other (large overlaps, reported as
 ``max_overlap_fraction``). With headroom the bed finds its own height and porosity.
 
+What Appendix A actually does (thesis PFC3D script for the 0.25 × 0.02 m bin): friction 0.47
+(walls 0.3) is set right after ``generate``, so it is active during expansion and cycling; the
+radii are multiplied in one go (``ini rad mul``) inside the closed box (lid at the fill height),
+gravity on, ``cycle 3000``, ``solve`` (PFC's default: mean unbalanced-force ratio 1e-2); the
+walls are then replaced by taller ones with a lid at 0.275 m and nothing is cycled after that.
+The thesis's packing is therefore the compressed closed-box one, global porosity 0.408 by
+construction. Here that is ``procedure='lid', lid_headroom=0, open_top=False``; measured on
+rect-bin (previous maintainer): 0.408 with overlaps up to 26 % of a radius.
+
+Procedure ``'sediment'`` (default of ``--scene rect-bin``, :data:`SCENE_DEFAULTS`)
+-----------------------------------------------------------------------------------
+A bin three grains thick with friction 0.47 locks a loose structure (``'lid'``: interior
+porosity 0.452), so the dense structure is built without friction and friction is restored
+only for the last settle (it can only add stability to a frictionless static bed):
+
+1. Generate at r/m₀ in the whole box up to the lid at (1 + ``lid_headroom``) H (0.3), expand to
+   the Eq. 3.7 radii with particle and wall friction 0 (``packing_friction``): a dilute
+   suspension, no forced overlaps.
+2. ``sediment_steps`` of frictionless settling under gravity.
+3. Taps: the container moves as :math:`z = A(t)\sin 2\pi f t` for a whole number of periods;
+   with ``tap_decay`` the amplitude falls linearly from A₀ to 0 (annealed tapping, which ends
+   denser than constant amplitude), then ``tap_settle_steps`` more.
+4. Table 3.1 friction restored, lid removed, settle to ``tol``.
+
+Measured on rect-bin, seed 1, mass scale 100, this machine (2 cores shared, load ≈ 2), interior
+porosity / max overlap (% of a radius) / wall time:
+
+* ``'lid'`` (headroom 0.2, friction 0.47 throughout): 0.452 / 0.6 % / 66 s.
+* frictionless sedimentation only (no taps): 0.424 / 0.7 % / 31 s.
+* + constant taps 30 Hz, 0.4 mm (1.45 g), 0.6 s: 0.418 / 0.4 % / 102 s; 0.3 mm (1.09 g): 0.419.
+* + annealed taps 30 Hz, A₀ = 0.6 mm (2.17 g → 0), 0.6 s: 0.417 / 0.9 % / 109 s.
+* RESULT_PLACEHOLDER
+
+Random packings of frictionless spheres in this slab plateau near 0.42 (the walls, 3.1 grain
+diameters apart, keep the structure layered and loose); only the taps push it into the
+0.408 ± 0.01 band, and only just. The thesis's 0.408 is a closed-box value with forced overlaps.
+
 Equilibrium criterion: mean unbalanced-force ratio (:meth:`Simulation.unbalanced_force_ratio`)
 below ``tol``. All stages use density scaling S (``mass_scale``; see :mod:`dem._integrate`);
 the physical parameters are otherwise those of Table 3.1.
@@ -40,6 +77,8 @@ from ._walls import CylinderWall, PlaneWall
 __all__ = [
     "Container",
     "SCENES",
+    "SCENE_DEFAULTS",
+    "PROCEDURES",
     "scene_container",
     "default_measure_spheres",
     "thesis_particle_count",
@@ -160,6 +199,15 @@ class Container:
 SCENES = {
     "rect-bin": Container("box", (0.25, 0.02), 0.25),
     "cyl-bin": Container("cylinder", (0.15,), 0.25),
+}
+
+
+#: Packing options each named scene uses by default (``python -m dem.pack --scene NAME``); see the
+#: module notes for the measurements behind the rect-bin choice.
+SCENE_DEFAULTS = {
+    "rect-bin": dict(procedure="sediment", lid_headroom=0.3, sediment_steps=3000, tap_freq_hz=30.0,
+                     tap_amplitude_m=8e-4, tap_duration_s=0.6, tap_decay=True),
+    "cyl-bin": dict(procedure="lid", lid_headroom=0.2),
 }
 
 
@@ -347,11 +395,15 @@ def _surface_height(centers, radii, container, cell=None):
     return float(np.median(top[order][last]))
 
 
+PROCEDURES = ("lid", "sediment")
+
+
 def pack(container, *, material=SOYBEAN, porosity=0.408, n_particles=None, rng=None, initial_multiplier=1.4,
          mass_scale=100.0, dt_safety=0.25, grow_steps=3000, tol=2e-3, max_steps=200000, check_every=200,
          open_top=True, packing_friction=None, lid_headroom=0.2, settle_time_s=None, measure_spheres=None,
-         progress=None):
-    """Make a settled packing in ``container`` by the thesis procedure (module notes).
+         progress=None, procedure="lid", sediment_steps=3000, tap_freq_hz=30.0, tap_amplitude_m=8e-4,
+         tap_duration_s=0.6, tap_settle_steps=3000, tap_decay=True):
+    """Make a settled packing in ``container`` (procedures in the module notes).
 
     Parameters
     ----------
@@ -387,6 +439,21 @@ def pack(container, *, material=SOYBEAN, porosity=0.408, n_particles=None, rng=N
         Remove the lid and settle again (thesis Appendix A) before measuring.
     progress : callable(stage, sim, force) | None
         Called every ``check_every`` steps.
+    procedure : {'lid', 'sediment'}
+        'lid': expansion and closed stage under the lid with the material's friction (or
+        ``packing_friction``), then settling (Appendices A–B). 'sediment': frictionless
+        sedimentation and taps, friction restored for the last settle (module notes; the
+        default of ``--scene rect-bin``). ``packing_friction`` (default 0 here) applies to
+        particle and wall contacts.
+    sediment_steps : int
+        'sediment': steps of frictionless settling after the expansion.
+    tap_freq_hz, tap_amplitude_m, tap_duration_s : float
+        'sediment': container motion :math:`z = A \\sin 2\\pi f t` (Hz, m, s), run for
+        round(f · duration) whole periods (at least one); A = 0 or duration 0 skips it.
+    tap_decay : bool
+        'sediment': amplitude falls linearly from ``tap_amplitude_m`` to 0 over the taps.
+    tap_settle_steps : int
+        'sediment': frictionless steps after the taps.
 
     Returns
     -------
@@ -401,17 +468,30 @@ def pack(container, *, material=SOYBEAN, porosity=0.408, n_particles=None, rng=N
     n = thesis_particle_count(container, porosity, material) if n_particles is None else int(n_particles)
     if n < 1:
         raise ValueError(f"no sphere fits: n_particles = {n}")
+    if procedure not in PROCEDURES:
+        raise ValueError(f"procedure must be one of {PROCEDURES}, got {procedure!r}")
+    if procedure == "sediment" and not (lid_headroom > 0 and sediment_steps >= 0 and tap_duration_s >= 0
+                                        and tap_amplitude_m >= 0 and tap_freq_hz > 0 and tap_settle_steps >= 0):
+        raise ValueError("procedure 'sediment' needs lid_headroom > 0, tap_freq_hz > 0 and non-negative "
+                         "sediment_steps, tap_duration_s, tap_amplitude_m, tap_settle_steps")
     t_wall = time.perf_counter()
     r_lo = material.radius_min_m / initial_multiplier
     r_hi = material.radius_max_m / initial_multiplier
-    centers, r0 = generate_spheres(container, n, r_lo, r_hi, rng)
+    lid_height = container.fill_height_m * (1 + lid_headroom)
+    # 'lid' generates below the fill height (Appendices A-B); 'sediment' in the whole box under the lid,
+    # so that the expanded spheres are a dilute suspension that settles without being forced together
+    gen_box = container if procedure == "lid" else replace(container, fill_height_m=lid_height)
+    centers, r0 = generate_spheres(gen_box, n, r_lo, r_hi, rng)
     phi0 = 1.0 - sphere_volume(r0).sum() / container.volume_m3
     mult = ((1.0 - porosity) / (1.0 - phi0)) ** (1.0 / 3.0)  # thesis Eq. 3.7
     log.info("generated %d spheres, porosity %.4f, radius multiplier %.4f", n, phi0, mult)
-    mat_pack = material if packing_friction is None else replace(material, friction=float(packing_friction))
-    sim = make_simulation(container, centers, r0, material=mat_pack, lid=True,
-                          lid_height_m=container.fill_height_m * (1 + lid_headroom), mass_scale=mass_scale,
-                          dt_safety=dt_safety)
+    if procedure == "lid":
+        mat_pack = material if packing_friction is None else replace(material, friction=float(packing_friction))
+    else:
+        mu = 0.0 if packing_friction is None else float(packing_friction)
+        mat_pack = replace(material, friction=mu, wall_friction=mu)
+    sim = make_simulation(container, centers, r0, material=mat_pack, lid=True, lid_height_m=lid_height,
+                          mass_scale=mass_scale, dt_safety=dt_safety)
     stages = {}
 
     def cb(stage):
@@ -419,12 +499,27 @@ def pack(container, *, material=SOYBEAN, porosity=0.408, n_particles=None, rng=N
 
     stages["expand"] = sim.run(max_steps=grow_steps, grow_from=r0, grow_to=r0 * mult, check_every=check_every,
                                callback=cb("expand"))
-    # closed stage: relax the expanded assembly under the lid before opening the top, so that
-    # elastic energy stored by the expansion cannot launch spheres out of the bin. Appendix A's
-    # closed box (lid_headroom = 0) is cycled to the full criterion, otherwise to 1e-2.
-    tol_closed = tol if (lid_headroom == 0 and packing_friction is None) else max(tol, 1e-2)
-    stages["closed"] = sim.run(max_steps=max_steps, tol=tol_closed, check_every=check_every, callback=cb("closed"))
-    stages["closed"]["max_overlap_fraction"] = _max_overlap_fraction(sim)
+    if procedure == "lid":
+        # closed stage: relax the expanded assembly under the lid before opening the top, so that
+        # elastic energy stored by the expansion cannot launch spheres out of the bin. Appendix A's
+        # closed box (lid_headroom = 0) is cycled to the full criterion, otherwise to 1e-2.
+        tol_closed = tol if (lid_headroom == 0 and packing_friction is None) else max(tol, 1e-2)
+        stages["closed"] = sim.run(max_steps=max_steps, tol=tol_closed, check_every=check_every,
+                                   callback=cb("closed"))
+        stages["closed"]["max_overlap_fraction"] = _max_overlap_fraction(sim)
+    else:
+        # frictionless sedimentation for a fixed number of steps (a frictionless bed under
+        # viscous damping alone creeps towards the force criterion very slowly), then taps
+        stages["sediment"] = sim.run(max_steps=sediment_steps, check_every=check_every, callback=cb("sediment"))
+        stages["sediment"]["porosity_interior"] = _interior_porosity(sim, container)
+        stages["tap"] = _tap(sim, tap_freq_hz, tap_amplitude_m, tap_duration_s, check_every, cb("tap"),
+                             decay=tap_decay)
+        stages["tap_settle"] = sim.run(max_steps=tap_settle_steps, check_every=check_every,
+                                       callback=cb("tap_settle"))
+        stages["tap_settle"]["porosity_interior"] = _interior_porosity(sim, container)
+        stages["tap_settle"]["max_overlap_fraction"] = _max_overlap_fraction(sim)
+        for name in ("sediment", "tap", "tap_settle"):
+            stages[name]["converged"] = True  # fixed-length stages
     sim.set_material(material)
     if open_top:
         sim.set_walls(container.walls(lid=False))
@@ -454,9 +549,53 @@ def pack(container, *, material=SOYBEAN, porosity=0.408, n_particles=None, rng=N
         "particle_steps_per_s": steps * n / wall_s,
         "neighbour_rebuilds": int(sim.stats["rebuilds"]),
         "max_overlap_fraction": _max_overlap_fraction(sim),
+        "mean_overlap_fraction": _mean_overlap_fraction(sim),
+        "procedure": procedure,
+        "final_friction": {"particle": sim.material.friction, "wall": sim.material.wall_friction},
         "material": {k: getattr(material, k) for k in material.__dataclass_fields__},
     })
     return PackResult(sim.centers.copy(), sim.radii.copy(), container, summary)
+
+
+def _tap(sim, freq_hz, amplitude_m, duration_s, check_every, callback, decay=False):
+    r"""Vertical sinusoidal motion of the container, :math:`z_w = A\sin(2\pi f t)`, for a whole
+    number of periods (at least one when A·duration > 0) so the floor ends where it started."""
+    t0 = time.perf_counter()
+    n_cycles = int(round(duration_s * freq_hz))
+    if amplitude_m == 0 or duration_s == 0:
+        n_cycles = 0
+    elif n_cycles == 0:
+        n_cycles = 1
+    period = 1.0 / freq_hz
+    omega = 2 * np.pi * freq_hz
+    start = sim.time_s
+    k = 0
+    t_end = n_cycles * period
+    while n_cycles and sim.time_s - start < t_end:
+        t = sim.time_s - start
+        if decay:  # amplitude falling linearly to zero (annealed tapping)
+            a, da = amplitude_m * (1 - t / t_end), -amplitude_m / t_end
+        else:
+            a, da = amplitude_m, 0.0
+        sim.z_offset_m = a * np.sin(omega * t)
+        sim.wall_vz_m_s = a * omega * np.cos(omega * t) + da * np.sin(omega * t)
+        force = sim.step()
+        k += 1
+        if k % check_every == 0:
+            sim.check_stability()
+            if callback is not None:
+                callback(sim, force)
+    sim.z_offset_m = 0.0
+    sim.wall_vz_m_s = 0.0
+    return {"steps": k, "time_s": sim.time_s, "cycles": n_cycles, "freq_hz": float(freq_hz),
+            "duration_s": sim.time_s - start, "amplitude_m": float(amplitude_m), "decay": bool(decay),
+            "intensity_g": float(amplitude_m * omega**2 / 9.81), "wall_s": time.perf_counter() - t0}
+
+
+def _interior_porosity(sim, container):
+    c, r = sim.centers, sim.radii
+    region = container.interior(4 * float(r.mean()), _surface_height(c, r, container))
+    return porosity_in_region(c, r, region)
 
 
 def _max_overlap_fraction(sim):
@@ -466,3 +605,13 @@ def _max_overlap_fraction(sim):
     i, j = pairs[:, 0], pairs[:, 1]
     d = np.linalg.norm(sim.centers[j] - sim.centers[i], axis=1)
     return float(np.max((sim.radii[i] + sim.radii[j] - d) / np.minimum(sim.radii[i], sim.radii[j])))
+
+
+def _mean_overlap_fraction(sim):
+    """Mean particle-particle overlap over the touching pairs, as a fraction of the smaller radius."""
+    pairs = sim.touching_pairs
+    if len(pairs) == 0:
+        return 0.0
+    i, j = pairs[:, 0], pairs[:, 1]
+    d = np.linalg.norm(sim.centers[j] - sim.centers[i], axis=1)
+    return float(np.mean((sim.radii[i] + sim.radii[j] - d) / np.minimum(sim.radii[i], sim.radii[j])))

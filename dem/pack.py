@@ -1,6 +1,7 @@
 """CLI: make a settled sphere packing.
 
-    python -m dem.pack --scene rect-bin --out rect.csv --seed 1
+    python -m dem.pack --scene rect-bin --out rect.csv --seed 1     # procedure 'sediment'
+    python -m dem.pack --scene rect-bin --procedure lid --out rect_lid.csv
     python -m dem.pack --scene cyl-bin --out cyl.csv
     python -m dem.pack --scene box --size 0.1 0.05 --height 0.1 --out box.csv
     python -m dem.pack --scene cylinder --size 0.08 --height 0.1 --out cyl_small.csv
@@ -19,7 +20,7 @@ import numpy as np
 
 from ._integrate import DemInstabilityError, Material
 from ._io import summary_path, write_packing
-from ._scenes import SCENES, Container, pack
+from ._scenes import PROCEDURES, SCENE_DEFAULTS, SCENES, Container, pack
 from ._perf import tune_malloc
 
 
@@ -35,8 +36,19 @@ def _parser():
     p.add_argument("--mass-scale", type=float, default=100.0, help="density scaling during packing (1 = none)")
     p.add_argument("--packing-friction", type=float, default=None,
                    help="particle friction during expansion/closed stage (default: the material's)")
-    p.add_argument("--lid-headroom", type=float, default=0.2,
-                   help="lid height above the fill height during expansion, as a fraction (0: Appendix A closed box)")
+    p.add_argument("--procedure", choices=list(PROCEDURES), default=None,
+                   help="'lid': expand under a lid, then settle (Appendix B style; Appendix A closed box with "
+                        "--lid-headroom 0 --keep-lid); 'sediment': frictionless sedimentation and taps, then friction "
+                        "restored and settled (default for rect-bin, see dem._scenes.SCENE_DEFAULTS)")
+    p.add_argument("--lid-headroom", type=float, default=None,
+                   help="lid height above the fill height during expansion, as a fraction (0: Appendix A closed box; "
+                        "default 0.2 for 'lid', 0.3 for 'sediment')")
+    p.add_argument("--sediment-steps", type=int, default=None, help="'sediment': frictionless settling steps")
+    p.add_argument("--tap-freq", type=float, default=None, help="'sediment': tap frequency, Hz")
+    p.add_argument("--tap-amplitude", type=float, default=None, help="'sediment': tap amplitude, m")
+    p.add_argument("--tap-duration", type=float, default=None, help="'sediment': tapping time, s (whole periods)")
+    p.add_argument("--tap-decay", action=argparse.BooleanOptionalAction, default=None,
+                   help="'sediment': amplitude falls linearly to 0 over the taps (annealed)")
     p.add_argument("--keep-lid", action="store_true", help="do not remove the lid before the last settling")
     p.add_argument("--tol", type=float, default=2e-3, help="mean unbalanced-force ratio at equilibrium")
     p.add_argument("--max-steps", type=int, default=200000)
@@ -87,11 +99,21 @@ def main(argv=None) -> int:
               f"ratio = {sim.unbalanced_force_ratio(force):8.2e}  {rate:9.3e} particle-steps/s", file=sys.stderr,
               flush=True)
 
+    opts = dict(SCENE_DEFAULTS.get(args.scene, {}))
+    if args.procedure is not None and args.procedure != opts.get("procedure", "lid"):
+        opts = {"procedure": args.procedure}
+    for key, val in [("lid_headroom", args.lid_headroom), ("sediment_steps", args.sediment_steps),
+                     ("tap_freq_hz", args.tap_freq), ("tap_amplitude_m", args.tap_amplitude),
+                     ("tap_duration_s", args.tap_duration), ("tap_decay", args.tap_decay)]:
+        if val is not None:
+            opts[key] = val
+    if opts.get("procedure", "lid") == "lid" and "lid_headroom" not in opts:
+        opts["lid_headroom"] = 0.2
     try:
         res = pack(container, material=material, porosity=args.porosity, n_particles=args.n_particles,
                    rng=args.seed, mass_scale=args.mass_scale, packing_friction=args.packing_friction,
-                   lid_headroom=args.lid_headroom, open_top=not args.keep_lid, tol=args.tol, max_steps=args.max_steps,
-                   dt_safety=args.dt_safety, measure_spheres=measure, progress=progress)
+                   open_top=not args.keep_lid, tol=args.tol, max_steps=args.max_steps,
+                   dt_safety=args.dt_safety, measure_spheres=measure, progress=progress, **opts)
     except ValueError as e:
         print(f"error: {e}", file=sys.stderr)
         return 2
@@ -100,6 +122,7 @@ def main(argv=None) -> int:
         return 3
     s = res.summary
     s["scene"] = args.scene
+    s["procedure_options"] = opts
     s["seed"] = args.seed
     write_packing(args.out, res.centers, res.radii, s)
     print(f"{s['n_spheres']} spheres -> {args.out} (+ {summary_path(args.out).name})")
