@@ -86,3 +86,28 @@ def test_radius_units_and_bad_input():
         lattice_packing("sc", 0.3, jitter=-1.0)
     with pytest.raises(TypeError):
         lattice_radius(3, 0.3)
+
+
+def test_core_estimator_arguments():
+    from network._lattices import core_permeability, lattice_sample_permeability
+    with pytest.raises(ValueError, match="estimator"):
+        lattice_sample_permeability("sc", 0.3, estimator="bogus")
+    # SC with 6 cells: the core (one lattice constant in from each face) holds one pore plane
+    with pytest.raises(ValueError, match="two distinct pore positions"):
+        lattice_sample_permeability("sc", 0.3, n_cells=6, qstar_fn=lambda r, s: np.ones(len(r)))
+
+    class _S:  # a chain of 4 pores along x, spacing 0.8/3, in the region [0, 1]^3
+        axis = 0
+        region = type("R", (), {"lo": np.zeros(3), "hi": np.ones(3)})()
+        pore_xyz = np.column_stack([0.1 + np.arange(4) * 0.8 / 3, np.full(4, 0.5),
+                                    np.full(4, 0.5)])
+        conns = np.array([[0, 1], [1, 2], [2, 3]])
+    g, p = np.ones(3), np.array([3.0, 2.0, 1.0, 0.0])
+    with pytest.raises(ValueError, match="margin_m"):
+        core_permeability(_S(), g, p, margin_m=0.0)
+    with pytest.raises(ValueError, match="no core"):
+        core_permeability(_S(), g, p, margin_m=0.6)
+    # unit flow through every plane, gradient 1/(0.8/3) from the two core pores, core
+    # 0.6 x 0.6: k = mu Q / (A G) = 1 / (0.36 * 3.75) (Darcy's law, exact for this chain)
+    k = core_permeability(_S(), g, p, margin_m=0.2)
+    assert k == pytest.approx(1.0 / (0.36 * 3.75), rel=1e-12)
