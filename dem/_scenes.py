@@ -477,7 +477,8 @@ def pack(container, *, material=SOYBEAN, porosity=0.408, n_particles=None, rng=N
     if procedure == "sediment" and not (lid_headroom > 0 and sediment_steps >= 0 and tap_duration_s >= 0
                                         and tap_amplitude_m >= 0 and tap_freq_hz > 0 and tap_settle_steps >= 0):
         raise ValueError("procedure 'sediment' needs lid_headroom > 0, tap_freq_hz > 0 and non-negative "
-                         "sediment_steps, tap_duration_s, tap_amplitude_m, tap_settle_steps")
+                         "sediment_steps, tap_duration_s, tap_amplitude_m, tap_settle_steps (Appendix A's closed box is "
+                         "procedure 'lid' with lid_headroom 0)")
     t_wall = time.perf_counter()
     r_lo = material.radius_min_m / initial_multiplier
     r_hi = material.radius_max_m / initial_multiplier
