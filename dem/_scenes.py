@@ -26,7 +26,8 @@ gravity on, ``cycle 3000``, ``solve`` (PFC's default: mean unbalanced-force rati
 walls are then replaced by taller ones with a lid at 0.275 m and nothing is cycled after that.
 The thesis's packing is therefore the compressed closed-box one, global porosity 0.408 by
 construction. Here that is ``procedure='lid', lid_headroom=0, open_top=False``; measured on
-rect-bin (previous maintainer): 0.408 with overlaps up to 26 % of a radius.
+rect-bin (seed 1, 4.6 s): global 0.408, interior 0.4026, but particle overlaps max 25.6 % and
+mean 6.5 % of a radius (5.5 true contacts per sphere): a compressed bed, not a settled one.
 
 Procedure ``'sediment'`` (default of ``--scene rect-bin``, :data:`SCENE_DEFAULTS`)
 -----------------------------------------------------------------------------------
@@ -54,7 +55,7 @@ porosity / max overlap (% of a radius) / wall time:
   rect-bin default): interior 0.4168 / max 0.78 %, mean 0.08 % (walls: max 0.52 %) / 87 s at
   load 1.7 (55 224 steps, 3.3e6 particle-steps/s); global porosity to the bed surface 0.421,
   closed-volume 0.408, 4.8 true contacts per sphere (8.5 within 1.05 d_max). Seeds 2 and 3:
-  0.4164 and 0.4172, 85 s each.
+  0.4164 and 0.4172, 85 s each. Tapping 1.0 s instead of 0.6 s: 0.4151 in 128 s.
 
 Random packings of frictionless spheres in this slab plateau near 0.42 (the walls, 3.1 grain
 diameters apart, keep the structure layered and loose); only the taps push it into the
