@@ -10,7 +10,7 @@ pack(container, *, porosity=0.408, rng=None, procedure='lid'|'sediment', ...) ->
     Generate at reduced radius, expand (Eqs. 3.1–3.10), settle to equilibrium; 'sediment'
     (frictionless sedimentation + annealed taps, friction restored for the last settle) is the
     rect-bin default (``SCENE_DEFAULTS``), the only way found to its 0.408 ± 0.01 target with
-    overlaps below 1 % of a radius (numbers in :mod:`dem._scenes`).
+    overlaps below 1 % of a radius (0.415 interior; numbers in :mod:`dem._scenes`).
 vibrate(centers, radii, container, *, freq_hz, amplitude_m, duration_s, ...) -> VibrationResult
     Sinusoidal vertical motion of the bin (Eq. 3.11) with porosity histories.
 Simulation, DemInstabilityError
