@@ -6,12 +6,12 @@ Material, SOYBEAN
     Grain and wall properties (thesis Table 3.1 defaults).
 Container, SCENES, scene_container
     Box / cylinder bins; ``'rect-bin'`` (Appendix A) and ``'cyl-bin'`` (Appendices B–C).
-pack(container, *, porosity=0.408, rng=None, procedure='lid'|'sediment', ...) -> PackResult
+pack_bed(container, *, porosity=0.408, rng=None, procedure='lid'|'sediment', ...) -> PackResult
     Generate at reduced radius, expand (Eqs. 3.1–3.10), settle to equilibrium; 'sediment'
     (frictionless sedimentation + annealed taps, friction restored for the last settle) is the
     rect-bin default (``SCENE_DEFAULTS``), the only way found to its 0.408 ± 0.01 target with
     overlaps below 1 % of a radius (0.415 interior; numbers in :mod:`dem._scenes`).
-vibrate(centers, radii, container, *, freq_hz, amplitude_m, duration_s, ...) -> VibrationResult
+vibrate_bed(centers, radii, container, *, freq_hz, amplitude_m, duration_s, ...) -> VibrationResult
     Sinusoidal vertical motion of the bin (Eq. 3.11) with porosity histories.
 Simulation, DemInstabilityError
     The time integrator (Verlet list, linear spring–dashpot–Coulomb contacts, walls).
@@ -41,14 +41,14 @@ from ._contacts import damping_coefficient, linear_contact_forces, restitution_c
 from ._integrate import SOYBEAN, DemInstabilityError, Material, Simulation
 from ._io import read_packing, write_packing
 from ._measure import Region, coordination_numbers, porosity_in_region, porosity_in_spheres
-from ._scenes import PROCEDURES, SCENE_DEFAULTS, SCENES, Container, PackResult, pack, scene_container, summarize, thesis_particle_count
-from ._vibrate import VibrationResult, vibrate
+from ._scenes import PROCEDURES, SCENE_DEFAULTS, SCENES, Container, PackResult, pack_bed, scene_container, summarize, thesis_particle_count
+from ._vibrate import VibrationResult, vibrate_bed
 
 __all__ = [
     "Material", "SOYBEAN", "Simulation", "DemInstabilityError",
     "linear_contact_forces", "series_stiffness", "damping_coefficient", "restitution_coefficient",
-    "Container", "SCENES", "SCENE_DEFAULTS", "PROCEDURES", "scene_container", "pack", "PackResult", "summarize", "thesis_particle_count",
-    "vibrate", "VibrationResult",
+    "Container", "SCENES", "SCENE_DEFAULTS", "PROCEDURES", "scene_container", "pack_bed", "PackResult", "summarize", "thesis_particle_count",
+    "vibrate_bed", "VibrationResult",
     "Region", "porosity_in_spheres", "porosity_in_region", "coordination_numbers",
     "read_packing", "write_packing",
 ]

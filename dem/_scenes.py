@@ -93,7 +93,7 @@ __all__ = [
     "thesis_particle_count",
     "generate_spheres",
     "make_simulation",
-    "pack",
+    "pack_bed",
     "PackResult",
     "summarize",
 ]
@@ -407,7 +407,7 @@ def _surface_height(centers, radii, container, cell=None):
 PROCEDURES = ("lid", "sediment")
 
 
-def pack(container, *, material=SOYBEAN, porosity=0.408, n_particles=None, rng=None, initial_multiplier=1.4,
+def pack_bed(container, *, material=SOYBEAN, porosity=0.408, n_particles=None, rng=None, initial_multiplier=1.4,
          mass_scale=100.0, dt_safety=0.25, grow_steps=3000, tol=2e-3, max_steps=200000, check_every=200,
          open_top=True, packing_friction=None, lid_headroom=0.2, settle_time_s=None, measure_spheres=None,
          progress=None, procedure="lid", sediment_steps=3000, tap_freq_hz=30.0, tap_amplitude_m=1.6e-3,

@@ -23,7 +23,7 @@ from ._integrate import SOYBEAN
 from ._measure import Region, porosity_in_region, porosity_in_spheres, sphere_volume
 from ._scenes import _surface_height, default_measure_spheres, make_simulation, summarize
 
-__all__ = ["vibrate", "VibrationResult", "intensity_g"]
+__all__ = ["vibrate_bed", "VibrationResult", "intensity_g"]
 
 log = logging.getLogger(__name__)
 G = 9.81
@@ -58,7 +58,7 @@ def _shifted(region, dz):
     return Region(region.kind, lo, hi, region.radius, region.center_xy)
 
 
-def vibrate(centers, radii, container, *, freq_hz=15.0, amplitude_m=0.002, duration_s=1.0, material=SOYBEAN,
+def vibrate_bed(centers, radii, container, *, freq_hz=15.0, amplitude_m=0.002, duration_s=1.0, material=SOYBEAN,
             mass_scale=100.0, dt_safety=0.25, record_every_s=None, snapshot_times_s=(), measure_spheres=None,
             tol=1e-3, max_settle_steps=100000, progress=None, check_every=200):
     """Vibrate a packing vertically and record its porosity.

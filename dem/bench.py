@@ -21,7 +21,7 @@ import time
 
 import numpy as np
 
-from ._scenes import Container, make_simulation, pack
+from ._scenes import Container, make_simulation, pack_bed
 from ._perf import tune_malloc
 
 
@@ -71,7 +71,7 @@ def mass_scale_study(scales=(1.0, 10.0, 100.0), *, seed=1, settle_time_s=0.3, gr
     out = []
     for s in scales:
         dt = 0.25 * np.sqrt(s * 1285 * 4 / 3 * np.pi * (0.00275 / 1.4) ** 3 / 4e6)  # first-step dt
-        res = pack(c, rng=seed, mass_scale=s, grow_steps=int(grow_time_s / dt), settle_time_s=settle_time_s,
+        res = pack_bed(c, rng=seed, mass_scale=s, grow_steps=int(grow_time_s / dt), settle_time_s=settle_time_s,
                    lid_headroom=0.5)
         m = res.summary
         out.append({"mass_scale": s, "n": m["n_spheres"], "porosity_interior": m["porosity_interior"],

@@ -20,7 +20,7 @@ import numpy as np
 
 from ._integrate import DemInstabilityError, Material
 from ._io import summary_path, write_packing
-from ._scenes import PROCEDURES, SCENE_DEFAULTS, SCENES, Container, pack
+from ._scenes import PROCEDURES, SCENE_DEFAULTS, SCENES, Container, pack_bed
 from ._perf import tune_malloc
 
 
@@ -110,7 +110,7 @@ def main(argv=None) -> int:
     if opts.get("procedure", "lid") == "lid" and "lid_headroom" not in opts:
         opts["lid_headroom"] = 0.2
     try:
-        res = pack(container, material=material, porosity=args.porosity, n_particles=args.n_particles,
+        res = pack_bed(container, material=material, porosity=args.porosity, n_particles=args.n_particles,
                    rng=args.seed, mass_scale=args.mass_scale, packing_friction=args.packing_friction,
                    open_top=not args.keep_lid, tol=args.tol, max_steps=args.max_steps,
                    dt_safety=args.dt_safety, measure_spheres=measure, progress=progress, **opts)

@@ -23,7 +23,7 @@ import numpy as np
 from ._integrate import DemInstabilityError, Material
 from ._io import read_packing, write_packing
 from ._scenes import SCENES, Container
-from ._vibrate import intensity_g, vibrate
+from ._vibrate import intensity_g, vibrate_bed
 from ._perf import tune_malloc
 
 THESIS_AMPLITUDES_M = (0.0005, 0.001, 0.002, 0.003, 0.004)
@@ -84,7 +84,7 @@ def main(argv=None) -> int:
                   f"{rate:9.3e} particle-steps/s", file=sys.stderr, flush=True)
 
         try:
-            res = vibrate(centers, radii, container, freq_hz=args.freq, amplitude_m=amp, duration_s=args.duration,
+            res = vibrate_bed(centers, radii, container, freq_hz=args.freq, amplitude_m=amp, duration_s=args.duration,
                           material=material, mass_scale=args.mass_scale, record_every_s=args.record_every,
                           snapshot_times_s=args.snapshots, max_settle_steps=args.settle_steps,
                           progress=progress)

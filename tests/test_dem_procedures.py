@@ -8,7 +8,7 @@ grains) checks that the 'sediment' procedure does what it says, with short stage
 import numpy as np
 import pytest
 
-from dem import Container, pack
+from dem import Container, pack_bed
 from dem._scenes import SCENE_DEFAULTS
 
 SLAB = Container("box", (0.06, 0.02), 0.06)
@@ -19,7 +19,7 @@ SED = dict(procedure="sediment", lid_headroom=0.3, sediment_steps=1500, tap_freq
 
 @pytest.fixture(scope="module")
 def slabs():
-    return pack(SLAB, **SED), pack(SLAB, procedure="lid", lid_headroom=0.2, **SHORT)
+    return pack_bed(SLAB, **SED), pack_bed(SLAB, procedure="lid", lid_headroom=0.2, **SHORT)
 
 
 def test_sediment_is_denser_than_frictional_lid_with_sane_contacts(slabs):
@@ -50,7 +50,7 @@ def test_sediment_restores_friction_and_taps_whole_periods(slabs):
 
 def test_procedure_arguments_are_checked():
     with pytest.raises(ValueError, match="procedure must be one of"):
-        pack(SLAB, procedure="appendix-z")
+        pack_bed(SLAB, procedure="appendix-z")
     with pytest.raises(ValueError, match="lid_headroom > 0"):
-        pack(SLAB, procedure="sediment", lid_headroom=0.0)
+        pack_bed(SLAB, procedure="sediment", lid_headroom=0.0)
     assert SCENE_DEFAULTS["rect-bin"]["procedure"] == "sediment"

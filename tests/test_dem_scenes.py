@@ -3,7 +3,7 @@
 import numpy as np
 import pytest
 
-from dem import (Container, Material, Region, SCENES, pack, porosity_in_region, porosity_in_spheres,
+from dem import (Container, Material, Region, SCENES, pack_bed, porosity_in_region, porosity_in_spheres,
                  read_packing, thesis_particle_count, write_packing)
 from dem._measure import coordination_numbers, lens_volume, sphere_volume
 from dem._scenes import generate_spheres
@@ -72,12 +72,12 @@ def test_generated_spheres_do_not_overlap_and_stay_inside():
 ])
 def test_impossible_porosity_is_refused(kwargs, match):
     with pytest.raises(ValueError, match=match):
-        pack(TINY, **kwargs)
+        pack_bed(TINY, **kwargs)
 
 
 def test_container_smaller_than_grain_is_refused():
     with pytest.raises(ValueError, match="smaller than a grain"):
-        pack(Container("box", (0.005, 0.02), 0.05))
+        pack_bed(Container("box", (0.005, 0.02), 0.05))
 
 
 @pytest.mark.parametrize("field", ["kn_n_m", "ks_n_m", "wall_kn_n_m", "density_kg_m3"])
@@ -94,12 +94,12 @@ KW = dict(rng=7, tol=2e-2, grow_steps=500, max_steps=2500, lid_headroom=1.0)
 @pytest.fixture(scope="module")
 def tiny_bed():
     # short stages (the tests check reproducibility and bookkeeping, not convergence)
-    return pack(TINY, **KW)
+    return pack_bed(TINY, **KW)
 
 
 def test_same_seed_same_packing_and_io_roundtrip(tmp_path, tiny_bed):
     a = tiny_bed
-    b = pack(TINY, **KW)
+    b = pack_bed(TINY, **KW)
     np.testing.assert_array_equal(a.centers, b.centers)
     np.testing.assert_array_equal(a.radii, b.radii)
     x7, _ = generate_spheres(TINY, 50, 0.002, 0.0027, np.random.default_rng(7))
@@ -121,9 +121,9 @@ def test_same_seed_same_packing_and_io_roundtrip(tmp_path, tiny_bed):
 
 
 def test_vibration_records_histories(tiny_bed):
-    from dem import vibrate
+    from dem import vibrate_bed
 
-    res = vibrate(tiny_bed.centers, tiny_bed.radii, TINY, freq_hz=15, amplitude_m=0.0, duration_s=0.02,
+    res = vibrate_bed(tiny_bed.centers, tiny_bed.radii, TINY, freq_hz=15, amplitude_m=0.0, duration_s=0.02,
                   record_every_s=0.005, snapshot_times_s=[0.01], max_settle_steps=200)
     # 0.02 s recorded every 0.005 s, plus the initial and the post-settling records
     assert len(res.times_s) == 6 and res.porosity_spheres.shape == (6, 5)
@@ -133,7 +133,7 @@ def test_vibration_records_histories(tiny_bed):
     assert np.all(res.centers[:, 2] - res.radii > -1e-4)  # nobody fell through the floor
     assert res.summary["intensity_g"] == 0.0
     with pytest.raises(ValueError, match="freq_hz"):
-        vibrate(tiny_bed.centers, tiny_bed.radii, TINY, freq_hz=0.0, amplitude_m=0.001, duration_s=0.1)
+        vibrate_bed(tiny_bed.centers, tiny_bed.radii, TINY, freq_hz=0.0, amplitude_m=0.001, duration_s=0.1)
 
 
 def test_clis_refuse_bad_arguments_and_vibrate_runs(tmp_path, tiny_bed, capsys):
@@ -151,3 +151,17 @@ def test_clis_refuse_bad_arguments_and_vibrate_runs(tmp_path, tiny_bed, capsys):
                      "--settle-steps", "200"]) == 0
     assert (out / "vib_1mm.csv").exists() and (out / "series.json").exists()
     assert "1.81 g" in capsys.readouterr().out
+
+
+def test_cli_modules_do_not_shadow_the_library_functions():
+    # `import dem.pack` binds the submodule to the attribute dem.pack: the library functions
+    # therefore have other names (pack_bed, vibrate_bed) than the CLI modules
+    import importlib
+
+    import dem
+
+    importlib.import_module("dem.pack")
+    importlib.import_module("dem.vibrate")
+    assert callable(dem.pack_bed) and callable(dem.vibrate_bed)
+    assert dem.pack_bed.__module__ == "dem._scenes"
+    assert dem.vibrate_bed.__module__ == "dem._vibrate"
