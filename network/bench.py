@@ -2,9 +2,9 @@
 
 Two parts (issue 4, item 10):
 
-1. **Policies** — the same packing solved with each Q* policy (shape-factor, table-only,
-   table+fe, fe-only): permeability, its difference from the fe-only answer (the reference) and
-   the wall time. Each policy runs against its own fresh copy of the table (``--db``, default
+1. **Policies** — the same packing solved with each conductance model (``--models``: conduit,
+   thesis) and each Q* policy (shape-factor, table-only, table+fe, fe-only): permeability, its
+   difference from the same model's fe-only answer (the reference) and the wall time. Each policy runs against its own fresh copy of the table (``--db``, default
    the cache's default table), so FE cost is really paid and no policy reuses another's solves.
 2. **Scaling** — packings of 5 000, 20 000, 100 000 and 500 000 spheres (``random_packing``,
    periodic box, solid fraction 0.60, d = 5.5–7.5 mm; above 100 000 spheres a crop of periodic
@@ -38,7 +38,7 @@ from pathlib import Path
 
 import numpy as np
 
-from ._conductance import POLICIES
+from ._conductance import MODELS, POLICIES
 from ._generate import random_packing
 from ._io import read_packing, write_packing_csv
 from ._pipeline import solve_network
@@ -88,7 +88,13 @@ def _packing_file(n: int, workdir: Path, seed: int) -> Path:
     return path
 
 
-def run_one(path: Path, policy: str, db, repeats: int, trace: bool = True) -> dict:
+def _sources(stats: dict) -> dict:
+    """Q* sources of a run (the conduit model nests the lookup statistics one level down)."""
+    return stats.get("sources") or stats.get("qstar_stats", {}).get("sources", {})
+
+
+def run_one(path: Path, policy: str, db, repeats: int, trace: bool = True,
+            model: str = "conduit") -> dict:
     """One scaling case in this process: stage times, iterations, memory."""
     best = None
     for _ in range(repeats):
@@ -96,7 +102,7 @@ def run_one(path: Path, policy: str, db, repeats: int, trace: bool = True) -> di
         pk = read_packing(path)
         t_read = time.perf_counter() - t0
         res = solve_network(pk, axis="z", policy=policy, db=db, porosity_points=0,
-                            trace_memory=False)
+                            trace_memory=False, conductance_model=model)
         wall = time.perf_counter() - t0
         if best is None or wall < best["wall_s"]:
             best = {"wall_s": wall, "read_s": t_read, "stages_s": dict(res.timings_s),
@@ -104,27 +110,28 @@ def run_one(path: Path, policy: str, db, repeats: int, trace: bool = True) -> di
                     "solver_setup_s": res.solver["setup_s"], "solver_solve_s": res.solver["solve_s"],
                     "n_pores": res.n_pores, "n_throats": res.n_throats,
                     "permeability_m2": res.permeability_m2, "mass_balance_ok": res.check["ok"],
-                    "qstar_sources": res.qstar_stats.get("sources", {})}
+                    "qstar_sources": _sources(res.qstar_stats)}
     walls_rss = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024.0
     # one more pass with tracemalloc for per-stage traced peaks (slower; not timed)
     if trace:
         pk = read_packing(path)
         res = solve_network(pk, axis="z", policy=policy, db=db, porosity_points=0,
-                            trace_memory=True)
+                            trace_memory=True, conductance_model=model)
         best["traced_peak_mb"] = res.timings_s.get("peak_memory_mb", {})
     best["max_rss_mb"] = max(walls_rss, resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024.0)
     best["n_spheres"] = pk.n
     best["policy"] = policy
+    best["conductance_model"] = model
     best["repeats"] = repeats
     return best
 
 
-def _scaling(sizes, workdir, policy, db, seed, repeats, timeout):
+def _scaling(sizes, workdir, policy, db, seed, repeats, timeout, model="conduit"):
     rows = []
     for n in sizes:
         path = _packing_file(n, workdir, seed)
         cmd = [sys.executable, "-m", "network.bench", "--one", str(path), "--policy", policy,
-               "--repeats", str(repeats if n <= 100_000 else 1)]
+               "--model", model, "--repeats", str(repeats if n <= 100_000 else 1)]
         if n > 100_000:
             cmd.append("--no-trace")   # the tracemalloc pass would double a 500k run
         if db:
@@ -171,7 +178,7 @@ def _copy_db(src: Path | None, dst: Path) -> None:
         a.backup(b)
 
 
-def _policies(n, policy_list, db, seed, workers):
+def _policies(n, policy_list, db, seed, workers, models=("conduit", "thesis")):
     """Every policy on the same packing, each against its own fresh copy of the table, so that
     no policy profits from FE solves stored by another."""
     pk = random_packing(n, rng=seed, periodic=True, solid_fraction=0.60)
@@ -184,26 +191,28 @@ def _policies(n, policy_list, db, seed, workers):
             base = None
     tmp = Path(tempfile.mkdtemp(prefix="grainflow-bench-"))
     rows = []
-    for pol in policy_list:
-        db_used = tmp / f"{pol}.sqlite"
+    for model, pol in [(m, p) for m in models for p in policy_list]:
+        db_used = tmp / f"{model}-{pol}.sqlite"
         _copy_db(base, db_used)
         t0 = time.perf_counter()
         try:
             res = solve_network(pk, axis="z", policy=pol, db=db_used, workers=workers,
-                                porosity_points=0)
-            rows.append({"policy": pol, "permeability_m2": res.permeability_m2,
+                                porosity_points=0, conductance_model=model)
+            rows.append({"conductance_model": model, "policy": pol,
+                         "permeability_m2": res.permeability_m2,
                          "seconds": time.perf_counter() - t0,
                          "conductance_s": res.timings_s["conductance"],
-                         "sources": res.qstar_stats.get("sources", {}),
+                         "sources": _sources(res.qstar_stats),
                          "n_throats": res.n_throats})
         except Exception as e:  # noqa: BLE001 - report every policy
-            rows.append({"policy": pol, "error": f"{type(e).__name__}: {e}",
+            rows.append({"conductance_model": model, "policy": pol,
+                         "error": f"{type(e).__name__}: {e}",
                          "seconds": time.perf_counter() - t0})
-    ref = next((r["permeability_m2"] for r in rows
-                if r["policy"] == "fe-only" and "permeability_m2" in r), None)
-    for r in rows:
-        if ref and "permeability_m2" in r:
-            r["rel_diff_vs_fe_only"] = r["permeability_m2"] / ref - 1.0
+    ref = {r["conductance_model"]: r["permeability_m2"] for r in rows
+           if r["policy"] == "fe-only" and "permeability_m2" in r}
+    for r in rows:   # each model against its own FE answer
+        if ref.get(r["conductance_model"]) and "permeability_m2" in r:
+            r["rel_diff_vs_fe_only"] = r["permeability_m2"] / ref[r["conductance_model"]] - 1.0
     shutil.rmtree(tmp, ignore_errors=True)
     return {"n_spheres": n, "seed": seed, "table": str(base) if base else None, "rows": rows}
 
@@ -216,6 +225,10 @@ def main(argv=None) -> int:
     ap.add_argument("--policy", default="table-only", choices=POLICIES,
                     help="Q* policy of the scaling part (default table-only: a precomputed table)")
     ap.add_argument("--policies", nargs="*", default=list(POLICIES), choices=POLICIES)
+    ap.add_argument("--models", nargs="*", default=["conduit", "thesis"], choices=MODELS,
+                    help="conductance models of the policy comparison (default both)")
+    ap.add_argument("--model", default="conduit", choices=MODELS,
+                    help="conductance model of the scaling part (default conduit)")
     ap.add_argument("--policy-spheres", type=int, default=600,
                     help="packing size of the policy comparison (FE cost grows with it)")
     ap.add_argument("--skip-policies", action="store_true")
@@ -234,7 +247,8 @@ def main(argv=None) -> int:
     args = ap.parse_args(argv)
 
     if args.one:  # child process of the scaling part
-        row = run_one(Path(args.one), args.policy, args.db, args.repeats, trace=not args.no_trace)
+        row = run_one(Path(args.one), args.policy, args.db, args.repeats, trace=not args.no_trace,
+                      model=args.model)
         print(json.dumps(row))
         return 0
 
@@ -243,14 +257,16 @@ def main(argv=None) -> int:
     report = {"machine_start": _machine()}
     if not args.skip_policies:
         print(f"policies on a {args.policy_spheres}-sphere packing:", flush=True)
-        pol = _policies(args.policy_spheres, args.policies, args.db, args.seed, args.workers)
+        pol = _policies(args.policy_spheres, args.policies, args.db, args.seed, args.workers,
+                        models=args.models)
         report["policies"] = pol
         for r in pol["rows"]:
             if "error" in r:
-                print(f"  {r['policy']:>13s}: {r['error']}")
+                print(f"  {r['conductance_model']:>8s} {r['policy']:>13s}: {r['error']}")
             else:
                 d = r.get("rel_diff_vs_fe_only")
-                print(f"  {r['policy']:>13s}: k = {r['permeability_m2']:.4e} m²"
+                print(f"  {r['conductance_model']:>8s} {r['policy']:>13s}: "
+                      f"k = {r['permeability_m2']:.4e} m²"
                       + (f" ({d:+.2%} vs fe-only)" if d is not None else "")
                       + f", {r['seconds']:.2f} s (Q* {r['conductance_s']:.2f} s) {r['sources']}")
     if args.sizes:
@@ -261,9 +277,10 @@ def main(argv=None) -> int:
             print(f"  note: {report['scaling_policy_note']}")
             policy = "shape-factor"
         report["scaling_policy"] = policy
-        print(f"scaling ({policy}):", flush=True)
+        report["scaling_model"] = args.model
+        print(f"scaling ({args.model} model, {policy}):", flush=True)
         report["scaling"] = _scaling(args.sizes, workdir, policy, args.db, args.seed,
-                                     args.repeats, args.timeout)
+                                     args.repeats, args.timeout, model=args.model)
         ok = [r for r in report["scaling"] if "wall_s" in r]
         if len(ok) >= 2:
             n = np.array([r["n_spheres"] for r in ok], dtype=float)
