@@ -608,20 +608,20 @@ def _interior_porosity(sim, container):
     return porosity_in_region(c, r, region)
 
 
-def _max_overlap_fraction(sim):
+def _overlap_fractions(sim):
+    """Particle-particle overlaps of the touching pairs, as fractions of the smaller radius."""
     pairs = sim.touching_pairs
     if len(pairs) == 0:
-        return 0.0
+        return np.zeros(1)
     i, j = pairs[:, 0], pairs[:, 1]
     d = np.linalg.norm(sim.centers[j] - sim.centers[i], axis=1)
-    return float(np.max((sim.radii[i] + sim.radii[j] - d) / np.minimum(sim.radii[i], sim.radii[j])))
+    return (sim.radii[i] + sim.radii[j] - d) / np.minimum(sim.radii[i], sim.radii[j])
+
+
+def _max_overlap_fraction(sim):
+    return float(np.max(_overlap_fractions(sim)))
 
 
 def _mean_overlap_fraction(sim):
     """Mean particle-particle overlap over the touching pairs, as a fraction of the smaller radius."""
-    pairs = sim.touching_pairs
-    if len(pairs) == 0:
-        return 0.0
-    i, j = pairs[:, 0], pairs[:, 1]
-    d = np.linalg.norm(sim.centers[j] - sim.centers[i], axis=1)
-    return float(np.mean((sim.radii[i] + sim.radii[j] - d) / np.minimum(sim.radii[i], sim.radii[j])))
+    return float(np.mean(_overlap_fractions(sim)))
