@@ -179,17 +179,8 @@ class ThroatStore:
 
         Rows for the same shape with several tolerances all come back; callers choose.
         """
-        where, args = [], []
-        if solver_version is not None:
-            where.append("solver_version = ?")
-            args.append(str(solver_version))
-        if max_rtol is not None:
-            where.append("rtol <= ?")
-            args.append(float(max_rtol) * (1 + 1e-12))
-        if statuses is not None:
-            statuses = list(statuses)
-            where.append(f"status IN ({', '.join('?' * len(statuses))})")
-            args += statuses
+        where, args = _row_filters("", solver_version=solver_version, max_rtol=max_rtol,
+                                   statuses=statuses)
         sql = ("SELECT k1, k2, k3, k4, k5, r1, r2, r3, l12, l13, l23, rtol, qstar, open_area, "
                "contact_type, error_estimate, n_elements, seconds, status, message FROM throats")
         if where:
@@ -236,17 +227,8 @@ class ThroatStore:
                "message": np.full(m, "", dtype=object)}
         if m == 0:
             return out
-        where, args = ["t.solver_version = ?"], [str(solver_version)]
-        if rtol is not None:
-            where.append("t.rtol = ?")
-            args.append(float(rtol))
-        if max_rtol is not None:
-            where.append("t.rtol <= ?")
-            args.append(float(max_rtol) * (1 + 1e-12))
-        if statuses is not None:
-            statuses = list(statuses)
-            where.append(f"t.status IN ({', '.join('?' * len(statuses))})")
-            args += statuses
+        where, args = _row_filters("t.", solver_version=solver_version, rtol=rtol,
+                                   max_rtol=max_rtol, statuses=statuses)
         try:
             c = self.conn
             c.execute("CREATE TEMP TABLE IF NOT EXISTS _q "
@@ -403,3 +385,22 @@ def _init_schema(conn, path):
         if conn.in_transaction:
             conn.execute("ROLLBACK")
         raise
+
+
+def _row_filters(prefix, *, solver_version=None, rtol=None, max_rtol=None, statuses=None):
+    """SQL WHERE terms and their arguments for the throat-table filters (column ``prefix``)."""
+    where, args = [], []
+    if solver_version is not None:
+        where.append(f"{prefix}solver_version = ?")
+        args.append(str(solver_version))
+    if rtol is not None:
+        where.append(f"{prefix}rtol = ?")
+        args.append(float(rtol))
+    if max_rtol is not None:
+        where.append(f"{prefix}rtol <= ?")
+        args.append(float(max_rtol) * (1 + 1e-12))
+    if statuses is not None:
+        statuses = list(statuses)
+        where.append(f"{prefix}status IN ({', '.join('?' * len(statuses))})")
+        args += statuses
+    return where, args
