@@ -26,9 +26,9 @@ import time
 from typing import Callable
 
 import numpy as np
+from threadpoolctl import threadpool_limits
 import scipy.sparse as sp
 
-from ._blas import single_threaded_blas
 
 __all__ = [
     "assemble_laplacian",
@@ -185,7 +185,8 @@ def solve_pressure(A, b, *, tol: float = 1e-10, maxiter: int = 500,
     scaled constant pressure: with the default constant candidate the 20 000-sphere case needs
     57 instead of 39 iterations), preconditioned by ``smoothed_aggregation_solver(Ã,
     symmetry='symmetric', coarse_solver='splu').aspreconditioner()``
-    (run with single-threaded OpenBLAS, see :mod:`network._blas`), and :math:`x = D^{-1/2} \tilde x`. If CG has
+    (run with BLAS limited to one thread by threadpoolctl: spinning OpenBLAS threads slowed
+    pyamg 10-30x on a shared 2-core machine), and :math:`x = D^{-1/2} \tilde x`. If CG has
     not converged after 150 iterations (random contrast over many decades defeats the classical
     strength measure), the hierarchy is rebuilt with ``strength='evolution'`` and CG continues
     from its last iterate (a 14³ grid with log-uniform conductances over 12 decades then
@@ -227,7 +228,7 @@ def solve_pressure(A, b, *, tol: float = 1e-10, maxiter: int = 500,
     y = np.zeros(n)
     flag, levels, setup, solve_t, method = 1, 0, 0.0, 0.0, "pyamg-sa-pcg"
     for strength, limit in (("symmetric", min(maxiter, 150)), ("evolution", maxiter)):
-        with single_threaded_blas():
+        with threadpool_limits(limits=1, user_api="blas"):
             t0 = time.perf_counter()
             ml = pyamg.smoothed_aggregation_solver(As, B=B, symmetry="symmetric",
                                                    strength=strength, max_coarse=500,
