@@ -266,7 +266,12 @@ class GridTable:
         for lo in range(0, n, chunk):
             hi = min(lo + chunk, n)
             v[lo:hi], err[lo:hi] = self._eval(x[lo:hi])
-        return (v if _log else np.exp(v)), err
+        if _log:
+            return v, err
+        # only clamped extrapolation outside the grid (rel_error = inf, never served) can
+        # overflow: inside the box ln Q* stays within the tabulated values and their curvature
+        with np.errstate(over="ignore"):
+            return np.exp(v), err
 
     def _prepare(self):
         """float32 copies of the tables and offset views (built on first use)."""
