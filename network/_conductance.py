@@ -254,17 +254,11 @@ def throat_conductance(tessellation, throats_idx, *, model: str = "thesis",
     _check_policy(policy)
     idx = np.asarray(throats_idx, dtype=np.int64)
     if model == "conduit":
-        try:
-            from . import _conduit
-            fn = _conduit.conduit_conductance
-        except (ImportError, AttributeError) as e:
-            raise NotImplementedError(
-                "conductance model 'conduit' is not available yet: it needs "
-                "network._conduit.conduit_conductance(tessellation, throats_idx, *, "
-                "viscosity_pa_s, policy, rtol, db, workers, progress) -> (g, info)") from e
-        out = fn(tessellation, idx, viscosity_pa_s=viscosity_pa_s, policy=policy, rtol=rtol,
-                 db=db, workers=workers, progress=progress, **model_options)
-        g, info = out if isinstance(out, tuple) else (out, None)
+        from ._conduit import conduit_conductance   # here: _conduit imports this module
+
+        g, info = conduit_conductance(tessellation, idx, viscosity_pa_s=viscosity_pa_s,
+                                      policy=policy, rtol=rtol, db=db, workers=workers,
+                                      progress=progress, **model_options)
         return np.asarray(g, dtype=float), info
     if model_options:
         raise TypeError(f"options {sorted(model_options)} apply to the conduit model only")

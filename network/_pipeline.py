@@ -27,6 +27,7 @@ from ._empirical import (asabe_d272_gradient, darcy_permeability, ergun_gradient
                          kozeny_carman_gradient)
 from ._flow import solve_fixed_pressure
 from ._io import Packing
+from ._merge import merge_pores
 from ._porosity import region_porosity
 from ._sample import AXES, Region, default_region, prune_disconnected, select_sample
 from ._tessellation import Tessellation, tessellate, tie_groups
@@ -233,14 +234,9 @@ def solve_network(packing: Packing, *, axis="z", region: Region | None = None,
         if conductance is None and conductance_model == "conduit" and merge_ties:
             # the conduit model's pore bodies (near-co-spherical groups, slivers) are
             # contracted here, so its near-infinite internal conductances never reach the solver
-            try:
-                from ._merge import merge_pores
-            except ImportError:
-                merge_pores = None
-            if merge_pores is not None:
-                merge = merge_pores(tess)
-                labels = np.asarray(merge.labels)
-                model_opts = {"merge": merge}
+            merge = merge_pores(tess)
+            labels = np.asarray(merge.labels)
+            model_opts = {"merge": merge}
         if labels is None and merge_ties:
             labels, n_groups = tie_groups(tess)
             if n_groups == tess.n_pores:
