@@ -339,12 +339,6 @@ def _assign_exact(dest, rows, sel, q, err, src, msg, label):
 def _shape_factor_rows(r, s, rows, q, err, src):
     if not len(rows):
         return
-    try:
-        sf = throats.shape_factor_qstar
-    except ImportError:
-        logger.warning("throats.shape_factor_qstar unavailable: %d rows keep their clamped "
-                       "interpolation with an infinite error estimate", len(rows))
-        return
-    q[rows] = sf(r[rows], s[rows])
+    q[rows] = throats.shape_factor_qstar(r[rows], s[rows])
     err[rows] = np.nan
     src[rows] = "shape-factor"

@@ -13,8 +13,8 @@ Conductance models
     Eq. 3.41 as above: the window's narrowest cross-section taken to run the whole pore
     length :math:`2\bar r`.
 ``'conduit'``
-    Delegated to ``network._conduit.conduit_conductance`` (the conduit-model issue); this module
-    only dispatches to it and raises a clear ``NotImplementedError`` until it exists.
+    Delegated to ``network._conduit.conduit_conductance`` (resistance integrated over
+    cross-sections between the pore centres; derivation in that module).
 
 Q* policies (the cache's names)
 -------------------------------
@@ -31,6 +31,8 @@ import logging
 import time
 
 import numpy as np
+
+from cache import lookup_qstar
 
 __all__ = [
     "MU_AIR_PA_S",
@@ -156,42 +158,16 @@ def throat_qstar(radii, sides, *, policy: str = "table-only", rtol: float = 1e-3
     sides = np.asarray(sides, dtype=float)
     n = radii.shape[0]
     t0 = time.perf_counter()
-    lookup = None
-    try:
-        from cache import lookup_qstar as lookup  # noqa: F401
-    except ImportError:
-        lookup = None
     if n == 0:
         return QstarResult(np.zeros(0), np.zeros(0, dtype="<U12"), np.zeros(0),
                            {"policy": policy, "backend": "none", "seconds": 0.0})
-    if lookup is not None:
-        res = lookup(radii, sides, db=db, policy=policy, rtol=rtol, workers=workers,
-                     progress=progress)
-        q = np.asarray(res.qstar, dtype=float)
-        src = np.asarray(res.source).astype(str)
-        err = np.asarray(getattr(res, "error_estimate", np.full(n, np.nan)), dtype=float)
-        stats = dict(getattr(res, "stats", {}) or {})
-        backend = "cache.lookup_qstar"
-    else:
-        import throats
-
-        if policy == "shape-factor":
-            q = np.asarray(throats.shape_factor_qstar(radii, sides), dtype=float)
-            src = np.full(n, "shape-factor")
-            err = np.full(n, np.nan)
-            stats = {}
-            backend = "throats.shape_factor_qstar"
-        elif policy == "fe-only":
-            sol = throats.solve_fem(radii, sides, rtol=rtol, workers=workers, progress=progress)
-            q = np.asarray(sol.qstar, dtype=float)
-            st = np.asarray(sol.status).astype(str)
-            src = np.where(st == "ok", "fe", np.where(st == "closed", "closed", "failed"))
-            err = np.asarray(sol.error_estimate, dtype=float)
-            stats = {"n_fe": int(n)}
-            backend = "throats.solve_fem"
-        else:
-            raise ValueError(f"policy {policy!r} needs the throat table, but cache.lookup_qstar "
-                             "is not available; use 'shape-factor' or 'fe-only'")
+    res = lookup_qstar(radii, sides, db=db, policy=policy, rtol=rtol, workers=workers,
+                       progress=progress)
+    q = np.asarray(res.qstar, dtype=float)
+    src = np.asarray(res.source).astype(str)
+    err = np.asarray(res.error_estimate, dtype=float)
+    stats = dict(res.stats or {})
+    backend = "cache.lookup_qstar"
     bad = ~np.isfinite(q) | (q < 0)
     n_fallback = 0
     if bad.any() and on_failed == "shape-factor":
