@@ -114,19 +114,48 @@ def _fe_memo():
     return fe
 
 
-@pytest.mark.parametrize("phi, expected", [(0.45, 1.092), (np.pi / 6, 1.087)])
-def test_simple_cubic_against_zick_homsy(phi, expected):
-    # exact Q* (throats.solve_fem) of the few distinct sections of an exact SC array against
-    # Zick & Homsy (1982) Table 2: the conduit model within 10 % (measured +9.2 %, +8.7 % with
-    # the default 6 section intervals); the thesis model (L = 2 rbar) about half
-    from network._references import lattice_permeability
+#: Conduit model (default settings, exact Q* of every section) / exact Stokes permeability,
+#: read in the sample core, for every lattice case of issue 7: SC against Zick & Homsy (1982)
+#: Table 2, BCC/FCC against network._references.computed_lattice_permeability. Pinned so
+#: that a change of the model shows up in every case.
+LATTICE_CASES = [
+    ("sc", 0.3, 1.099), ("sc", 0.45, 1.092), ("sc", np.pi / 6, 1.087),
+    ("bcc", 0.3, 0.871), ("bcc", 0.4, 0.902), ("bcc", 0.5, 0.933), ("bcc", 0.6, 0.969),
+    ("bcc", 0.66, 0.989),
+    ("fcc", 0.3, 1.020), ("fcc", 0.45, 0.990), ("fcc", 0.55, 0.979), ("fcc", 0.65, 0.994),
+    ("fcc", 0.72, 0.997),
+]
+
+
+def _exact_lattice_k(kind, phi, r):
+    from network._references import computed_lattice_permeability, lattice_permeability
+    if kind == "sc":
+        return lattice_permeability("sc", phi, r)
+    return computed_lattice_permeability(kind, phi)
+
+
+def test_every_lattice_case_against_exact_stokes():
+    # issue 7 target: within 10 % from phi = 0.3 to touching. Met in 12 of 13 cases; BCC at
+    # phi = 0.3 is 12.9 % low (a known miss, analysed in network._conduit: no per-section
+    # correction brings SC and BCC at phi = 0.3 within 10 % together). Asserted as measured,
+    # not hidden: if a model change moves it, this test says so.
     fe = _fe_memo()
-    k, r = lattice_sample_permeability("sc", phi, qstar_fn=fe)
-    k_ref = lattice_permeability("sc", phi, r)
-    assert k / k_ref == pytest.approx(expected, abs=0.01)
-    assert abs(k / k_ref - 1) < 0.10
-    kt, _ = lattice_sample_permeability("sc", phi, model="thesis", qstar_fn=fe)
-    assert 0.45 < kt / k_ref < 0.55
+    got = {}
+    for kind, phi, expected in LATTICE_CASES:
+        k, r = lattice_sample_permeability(kind, phi, qstar_fn=fe)
+        got[(kind, phi)] = ratio = k / _exact_lattice_k(kind, phi, r)
+        assert ratio == pytest.approx(expected, abs=0.005), (kind, phi)
+    within = [c for c, v in got.items() if abs(v - 1) < 0.10]
+    assert len(within) == 12
+    assert ("bcc", 0.3) not in within
+
+
+@pytest.mark.parametrize("phi", [0.45, np.pi / 6])
+def test_thesis_model_is_about_half_of_zick_homsy(phi):
+    # the thesis model (L = 2 rbar) with the same exact Q*: about half the exact value
+    fe = _fe_memo()
+    kt, r = lattice_sample_permeability("sc", phi, model="thesis", qstar_fn=fe)
+    assert 0.45 < kt / _exact_lattice_k("sc", phi, r) < 0.55
 
 
 def test_bad_arguments():
@@ -140,25 +169,40 @@ def test_bad_arguments():
         side_resistance([[0.4] * 3], [[1.0] * 3], [0.3], [1.0], n_sections=1)
 
 
-@pytest.mark.parametrize("kind, phi, measured, box", [("bcc", 0.5, 0.933, 0.860),
-                                                      ("fcc", 0.55, 0.979, 0.857)])
-def test_bcc_fcc_against_computed_stokes(kind, phi, measured, box):
+@pytest.mark.parametrize("kind, phi, box", [("bcc", 0.5, 0.860), ("fcc", 0.55, 0.857)])
+def test_bcc_fcc_box_estimate_and_thesis_model(kind, phi, box):
     # BCC/FCC have no literature table here; network._references.computed_lattice_permeability
     # (Taylor-Hood FE in the symmetry cell, checked on SC against Zick & Homsy) is the
-    # reference. Read in the sample's core (network._lattices.core_permeability) the conduit
-    # model is within 10 % (measured 0.933, 0.979); the whole-box value is 7-14 % lower
-    # (0.860, 0.857 at 7 cells) only through the sample's boundary layer, which falls as 1/H.
-    # Pinned so that a change shows up. The thesis model is 0.34 of exact here.
-    from network._references import computed_lattice_permeability
+    # reference. The whole-box value is 7-14 % below the core value (0.860, 0.857 of exact at
+    # 7 cells, against 0.933, 0.979 in the core) only through the sample's boundary layer,
+    # which falls as 1/H. The thesis model is 0.34 of exact here.
     fe = _fe_memo()
-    k_ref = computed_lattice_permeability(kind, phi)
-    k, _ = lattice_sample_permeability(kind, phi, qstar_fn=fe)
-    assert k / k_ref == pytest.approx(measured, abs=0.01)
-    assert abs(k / k_ref - 1) < 0.10
+    k_ref = _exact_lattice_k(kind, phi, None)
     kb, _ = lattice_sample_permeability(kind, phi, qstar_fn=fe, estimator="box")
     assert kb / k_ref == pytest.approx(box, abs=0.01)
     kt, _ = lattice_sample_permeability(kind, phi, model="thesis", qstar_fn=fe)
     assert kt / k_ref < 0.36
+
+
+#: Conduit model (table Q*, the shipped g1 grid) / the LBM Stokes drag law of van der Hoef,
+#: Beetstra & Kuipers (2005), J. Fluid Mech. 528:233, in the sample core: periodic random
+#: packings of 800 monodisperse spheres (seed 1), copied 3x3x3.
+RANDOM_CASES = [(0.36, 1.054), (0.40, 1.014), (0.45, 1.043)]
+
+
+@pytest.mark.parametrize("porosity, expected", RANDOM_CASES)
+def test_random_packings_against_lbm_drag_law(porosity, expected):
+    # issue 7 target: within 10 % of the LBM law for random packings of porosity 0.36-0.45;
+    # the thesis model is about a third of it (measured 0.30-0.33)
+    from network._lattices import random_sample_permeability
+    from network._references import beetstra_permeability
+    k_ref = beetstra_permeability(1.0 - porosity, 1.0)
+    k = random_sample_permeability(porosity)
+    assert k / k_ref == pytest.approx(expected, abs=0.01)
+    assert abs(k / k_ref - 1) < 0.10
+    if porosity == 0.40:
+        kt = random_sample_permeability(porosity, model="thesis")
+        assert 0.25 < kt / k_ref < 0.40
 
 
 @pytest.mark.parametrize("kind", ["bcc", "fcc"])
