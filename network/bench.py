@@ -1,6 +1,6 @@
 """``python -m network.bench``: speed against error of the network model.
 
-Two parts (issue 4, item 10):
+Three parts (issue 4, item 10; issue 7, item 4):
 
 1. **Policies** — the same packing solved with each conductance model (``--models``: conduit,
    thesis) and each Q* policy (shape-factor, table-only, table+fe, fe-only): permeability, its
@@ -13,19 +13,53 @@ Two parts (issue 4, item 10):
    prune, assemble, solve), solver iterations, peak resident memory (``ru_maxrss``) and the peak
    memory traced per stage (``tracemalloc``: numpy and Python allocations; Qhull's own C
    allocations are only in ``ru_maxrss``).
+3. **References** — permeability error against published / computed Stokes values and wall
+   time, for every conductance model (``--models``) × Q* policy (``--policies``), on the same
+   packings: the issue-7 cases, SC at φ = 0.3, 0.45, π/6 against Zick & Homsy (1982)
+   (``network._references.lattice_permeability``), BCC at φ = 0.3, 0.4, 0.5, 0.6, 0.66 and FCC
+   at 0.3, 0.45, 0.55, 0.65, 0.72 against this project's Stokes FE of the unit cell
+   (``computed_lattice_permeability``), each through
+   ``network._lattices.lattice_sample_permeability`` (7³ cells, core estimate); random
+   monodisperse packings of porosity 0.36, 0.40, 0.45 (``--ref-spheres`` 800 spheres, seed
+   ``--ref-seed`` 1, periodic, copied 3×3×3, core estimate:
+   ``random_sample_permeability``) against the LBM drag law of van der Hoef et al. (2005)
+   (``beetstra_permeability``). One table: a row per case with its reference k (units of the
+   lattice constant² or the diameter²), a column per model × policy with k/k_ref and the wall
+   seconds (minimum of ``--ref-repeats``, each repeat against its own fresh copy of the table,
+   so FE solves are paid every time; modules are imported and the interpolation grid loaded
+   by an untimed warm-up first); summary rows with max |k/k_ref − 1| over the lattices and over
+   the random packings, total seconds and FE solves (rows the run added to its copy of the
+   table) per column. A random-packing cell includes generating the packing (its time is in the
+   JSON as ``packing_s``). FE policies (table+fe, fe-only) on random packings need 10 000
+   (thesis) to 69 000 (conduit) distinct FE solves per packing, about 1 and 6.5 minutes at
+   5–7 ms a solve (at rtol 1e-3 the table+fe policy sends ~98 % of the rows to FE), so they
+   run only at the porosities given by ``--fe-random`` (default 0.40; none with an empty
+   list) and once, not ``--ref-repeats`` times; cells not run print as ``-``.
+   Unlike part 1, every cell starts from an empty table (interpolation in the grid shipped in
+   ``cache/data``) unless ``--db`` names one to copy, so the numbers do not depend on what the
+   user's default table happens to hold: table-only answers rows the grid does not cover with
+   an exact hit when the table has one, else with the shape-factor estimate (on SC conduits the
+   two differ by 3 %). The helpers of ``network._lattices`` take no ``db`` argument, so the
+   references part points ``$GRAINFLOW_CACHE_DB`` (read by ``cache.default_db_path`` at each
+   lookup) at the cell's copy; FE solves run at their default tolerance, rtol = 1e-3.
 
 Prints a table and writes JSON with the load average, platform, CPU count and a timestamp.
+``--skip-references`` leaves part 3 out; ``--references-only`` runs part 3 alone.
 
 Examples
 --------
-    python -m network.bench --sizes 5000 20000 --policy-spheres 600
-    python -m network.bench --sizes 5000 20000 100000 500000 --skip-policies --json bench.json
+    python -m network.bench --sizes 5000 20000 --policy-spheres 600 --skip-references
+    python -m network.bench --sizes 5000 20000 100000 500000 --skip-policies --skip-references \
+        --json bench.json
+    python -m network.bench --references-only --json references.json
+    python -m network.bench --references-only --fe-random 0.36 0.40 0.45   # ~50 min of FE
 """
 
 from __future__ import annotations
 
 import argparse
 import json
+import math
 import os
 import platform
 import resource
@@ -217,6 +251,266 @@ def _policies(n, policy_list, db, seed, workers, models=("conduit", "thesis")):
     return {"n_spheres": n, "seed": seed, "table": str(base) if base else None, "rows": rows}
 
 
+# ---------------------------------------------------------------------------------------------
+# part 3: references (issue 7, item 4)
+
+#: Lattice cases of issue 7: (lattice, solid fraction); pi/6 is touching simple cubic.
+REF_LATTICE_CASES = (("sc", 0.3), ("sc", 0.45), ("sc", math.pi / 6),
+                     ("bcc", 0.3), ("bcc", 0.4), ("bcc", 0.5), ("bcc", 0.6), ("bcc", 0.66),
+                     ("fcc", 0.3), ("fcc", 0.45), ("fcc", 0.55), ("fcc", 0.65), ("fcc", 0.72))
+#: Porosities of the random-packing cases of issue 7.
+REF_RANDOM_POROSITIES = (0.36, 0.40, 0.45)
+#: Policies that run FE solves (opt-in per porosity on random packings, see --fe-random).
+_FE_POLICIES = ("table+fe", "fe-only")
+
+
+def _lattice_case(text: str):
+    """``kind:phi`` (``phi`` a number or ``touch``) -> (kind, phi), for argparse."""
+    from ._lattices import LATTICES, TOUCHING_FRACTION
+
+    kind, sep, phi = text.partition(":")
+    kind = kind.lower()
+    if not sep or kind not in LATTICES:
+        raise argparse.ArgumentTypeError(f"expected KIND:PHI with KIND in {LATTICES}, got {text!r}")
+    if phi.lower() == "touch":
+        return kind, TOUCHING_FRACTION[kind]
+    try:
+        value = float(phi)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"solid fraction of {text!r} is not a number") from None
+    if not 0.0 < value <= TOUCHING_FRACTION[kind] * (1 + 1e-4):
+        raise argparse.ArgumentTypeError(
+            f"solid fraction of {text!r} outside (0, {TOUCHING_FRACTION[kind]:.6f}]")
+    return kind, value
+
+
+def _lattice_reference(kind: str, phi: float, radius: float) -> float:
+    """Exact Stokes k of the array, lattice constant²: Zick & Homsy (SC), own FE (BCC/FCC)."""
+    from ._references import computed_lattice_permeability, lattice_permeability
+
+    if kind == "sc":
+        return float(lattice_permeability("sc", phi, radius))
+    return float(computed_lattice_permeability(kind, phi))
+
+
+class _CacheDb:
+    """Point ``cache.default_db_path()`` (``$GRAINFLOW_CACHE_DB``) at ``path`` for a block.
+
+    The validation helpers of ``network._lattices`` take no ``db`` argument; the Q* lookup
+    resolves ``db=None`` through the environment variable at call time.
+    """
+
+    _VAR = "GRAINFLOW_CACHE_DB"
+
+    def __init__(self, path: Path):
+        self.path = str(path)
+
+    def __enter__(self):
+        self.old = os.environ.get(self._VAR)
+        os.environ[self._VAR] = self.path
+        return self
+
+    def __exit__(self, *exc):
+        if self.old is None:
+            os.environ.pop(self._VAR, None)
+        else:
+            os.environ[self._VAR] = self.old
+        return False
+
+
+def _store_totals(path: Path) -> tuple[int, float]:
+    """(rows, summed FE seconds) of a throat table; (0, 0.0) when it does not exist."""
+    import sqlite3
+
+    if not Path(path).exists() or Path(path).stat().st_size == 0:
+        return 0, 0.0
+    with sqlite3.connect(f"file:{path}?mode=ro", uri=True) as con:
+        try:
+            n, sec = con.execute("SELECT count(*), coalesce(sum(seconds), 0) FROM throats"
+                                 ).fetchone()
+        except sqlite3.OperationalError:   # no throats table yet
+            return 0, 0.0
+    return int(n), float(sec)
+
+
+def _ref_cell(case: dict, model: str, policy: str, base: Path | None, tmp: Path,
+              repeats: int) -> dict:
+    """One case × model × policy: k, k/k_ref, minimum wall time over fresh-table repeats."""
+    from ._lattices import lattice_sample_permeability, random_sample_permeability
+
+    cell = {"conductance_model": model, "policy": policy, "repeats": repeats,
+            "seconds_all": [], "fe_solves": [], "fe_seconds": []}
+    for rep in range(repeats):
+        db = tmp / f"{case['name']}-{model}-{policy}-{rep}.sqlite".replace(":", "_")
+        _copy_db(base, db)
+        n0, s0 = _store_totals(db)
+        t0 = time.perf_counter()
+        try:
+            with _CacheDb(db):
+                if case["kind"] == "random":
+                    k = random_sample_permeability(case["porosity"], n_spheres=case["n_spheres"],
+                                                   rng=case["seed"], model=model, policy=policy)
+                else:
+                    k, r = lattice_sample_permeability(case["kind"], case["solid_fraction"],
+                                                       model=model, policy=policy)
+                    case.setdefault("radius", r)
+        except Exception as e:  # noqa: BLE001 - report every cell
+            cell["error"] = f"{type(e).__name__}: {e}"
+            cell["seconds_all"].append(time.perf_counter() - t0)
+            break
+        cell["seconds_all"].append(time.perf_counter() - t0)
+        n1, s1 = _store_totals(db)
+        cell["fe_solves"].append(n1 - n0)
+        cell["fe_seconds"].append(s1 - s0)
+        db.unlink(missing_ok=True)
+        for extra in ("-wal", "-shm"):
+            Path(f"{db}{extra}").unlink(missing_ok=True)
+        cell.setdefault("k_all", []).append(float(k))
+        cell["k"] = cell["k_all"][0]
+    cell["seconds"] = min(cell["seconds_all"])
+    if "k" in cell:
+        if case["kind"] != "random" and "k_ref" not in case:
+            case["k_ref"] = _lattice_reference(case["kind"], case["solid_fraction"],
+                                               case["radius"])
+        cell["ratio"] = cell["k"] / case["k_ref"]
+    return cell
+
+
+def _warm_up(base: Path | None, tmp: Path) -> float:
+    """Import the pipeline and load the interpolation grid (not timed in the cells)."""
+    from ._lattices import lattice_sample_permeability
+
+    db = tmp / "warm-up.sqlite"
+    _copy_db(base, db)
+    t0 = time.perf_counter()
+    with _CacheDb(db):
+        lattice_sample_permeability("sc", 0.45, model="conduit", policy="table-only")
+    return time.perf_counter() - t0
+
+
+def _references(lattice_cases, random_porosities, models, policies, db, *, fe_random=(0.40,),
+                repeats=2, n_spheres=800, seed=1) -> dict:
+    """Part 3: every case × model × policy, with summaries per model × policy column."""
+    from ._generate import random_packing
+    from ._references import beetstra_permeability
+
+    base = Path(db) if db else None   # None: every cell starts from an empty table
+    if base is not None and not base.exists():
+        raise FileNotFoundError(f"throat table {base} does not exist")
+    tmp = Path(tempfile.mkdtemp(prefix="grainflow-bench-ref-"))
+    fe_set = {round(float(e), 6) for e in fe_random}
+    cases = []
+    for kind, phi in lattice_cases:
+        cases.append({"name": f"{kind}:{phi:.4f}", "kind": kind, "solid_fraction": float(phi),
+                      "reference": ("Zick & Homsy (1982) Table 2" if kind == "sc" else
+                                    "network._references.computed_lattice_permeability "
+                                    "(own Stokes FE)"),
+                      "k_unit": "lattice constant^2"})
+    for eps in random_porosities:
+        t0 = time.perf_counter()   # the generation every random cell repeats, timed alone
+        random_packing(int(n_spheres), diameter_range_m=(1.0, 1.0), solid_fraction=1 - eps,
+                       periodic=True, rng=seed)
+        cases.append({"name": f"random:{eps:.2f}", "kind": "random", "porosity": float(eps),
+                      "n_spheres": int(n_spheres), "seed": seed,
+                      "packing_s": time.perf_counter() - t0,
+                      "k_ref": float(beetstra_permeability(1.0 - eps, 1.0)),
+                      "reference": "van der Hoef et al. (2005) LBM drag law (beetstra_permeability)",
+                      "k_unit": "diameter^2"})
+    warm = _warm_up(base, tmp)
+    columns = [(m, p) for m in models for p in policies]
+    for case in cases:
+        case["cells"] = {}
+        for model, pol in columns:
+            key = f"{model}/{pol}"
+            rnd = case["kind"] == "random"
+            if rnd and pol in _FE_POLICIES and round(case["porosity"], 6) not in fe_set:
+                case["cells"][key] = {"conductance_model": model, "policy": pol,
+                                      "skipped": "FE policy on a random packing not requested "
+                                                 "(--fe-random)"}
+                continue
+            reps = 1 if (rnd and pol in _FE_POLICIES) else repeats
+            cell = _ref_cell(case, model, pol, base, tmp, reps)
+            case["cells"][key] = cell
+            print(f"  {case['name']:>12s} {key:>22s}: "
+                  + (f"k/k_ref = {cell['ratio']:.4f}" if "ratio" in cell else cell.get("error"))
+                  + f", {cell['seconds']:.2f} s"
+                  + (f", {cell['fe_solves'][0]} FE solves" if cell["fe_solves"] else ""),
+                  flush=True)
+    summary = {}
+    for model, pol in columns:
+        key = f"{model}/{pol}"
+        cells = [c["cells"][key] for c in cases]
+        lat = [c["cells"][key] for c in cases if c["kind"] != "random"]
+        rnd = [c["cells"][key] for c in cases if c["kind"] == "random"]
+        run = [c for c in cells if "seconds" in c]
+        entry = {"total_seconds": float(sum(c["seconds"] for c in run)),
+                 "fe_solves": int(sum(c["fe_solves"][0] for c in run if c["fe_solves"])),
+                 "n_cases_run": len(run), "n_cases": len(cells),
+                 "n_errors": sum("error" in c for c in cells)}
+        for name, group in (("lattices", lat), ("random", rnd)):
+            err = [abs(c["ratio"] - 1.0) for c in group if "ratio" in c]
+            entry[f"max_abs_error_{name}"] = max(err) if err else None
+            entry[f"n_{name}"] = len(err)
+            entry[f"n_{name}_cases"] = len(group)
+        summary[key] = entry
+    shutil.rmtree(tmp, ignore_errors=True)
+    return {"models": list(models), "policies": list(policies), "columns":
+            [f"{m}/{p}" for m, p in columns], "repeats": repeats, "fe_random": sorted(fe_set),
+            "fe_rtol": 1e-3,
+            "table": str(base) if base else "empty (interpolation in the shipped grid)", "warm_up_s": warm,
+            "cases": cases, "summary": summary}
+
+
+def _references_table(ref: dict) -> list[str]:
+    """The printed table of part 3 (cells: k/k_ref and wall seconds; '-' not run)."""
+    cols = ref["columns"]
+    w = 15
+    abbrev = {"shape-factor": "shape-f", "table-only": "table", "table+fe": "table+fe",
+              "fe-only": "fe-only"}
+    head1 = f"{'case':<13s}{'k_ref':>10s} |" + "".join(f"{c.split('/')[0]:>{w}s}" for c in cols)
+    head2 = f"{'':<13s}{'':>10s} |" + "".join(
+        f"{abbrev.get(c.split('/')[1], c.split('/')[1]):>{w}s}" for c in cols)
+    lines = [head1, head2, "-" * len(head1)]
+    for case in ref["cases"]:
+        label = (f"{case['kind'].upper()} {case['solid_fraction']:.3f}" if case["kind"] != "random"
+                 else f"rand e={case['porosity']:.2f}")
+        k_ref = case.get("k_ref")
+        row = f"{label:<13s}{(f'{k_ref:.4g}' if k_ref else '?'):>10s} |"
+        for c in cols:
+            cell = case["cells"][c]
+            if "ratio" in cell:
+                row += f"{cell['ratio']:7.3f}{cell['seconds']:7.2f}s"
+            elif "error" in cell:
+                row += f"{'error':>{w}s}"
+            else:
+                row += f"{'-':>{w}s}"
+        lines.append(row)
+    lines.append("-" * len(head1))
+    summ = ref["summary"]
+
+    def srow(label, fmt):
+        return f"{label:<24s}|" + "".join(fmt(summ[c]) for c in cols)
+
+    def err(name):
+        def f(e):
+            v = e[f"max_abs_error_{name}"]
+            if v is None:
+                return f"{'-':>{w}s}"
+            part = "" if e[f"n_{name}"] == e[f"n_{name}_cases"] else f" ({e[f'n_{name}']})"
+            return f"{f'{v:.3f}{part}':>{w}s}"
+        return f
+    lines.append(srow("max|k/kref-1| lattices", err("lattices")))
+    lines.append(srow("max|k/kref-1| random", err("random")))
+    lines.append(srow("total wall s", lambda e: f"{e['total_seconds']:{w}.1f}"))
+    lines.append(srow("FE solves", lambda e: f"{e['fe_solves']:{w}d}"))
+    lines.append("cells: k/k_ref and wall seconds (min of "
+                 f"{ref['repeats']} repeats on fresh tables; FE cells on random packings once); "
+                 "'-' not run (FE on random packings only at --fe-random "
+                 f"{' '.join(f'{e:.2f}' for e in ref['fe_random']) or '(none)'}); "
+                 "(n): cases the maximum is over.")
+    return lines
+
+
 def main(argv=None) -> int:
     ap = argparse.ArgumentParser(prog="python -m network.bench", description=__doc__.split("\n")[0])
     ap.add_argument("--sizes", type=int, nargs="*", default=[5000, 20000, 100000],
@@ -232,6 +526,27 @@ def main(argv=None) -> int:
     ap.add_argument("--policy-spheres", type=int, default=600,
                     help="packing size of the policy comparison (FE cost grows with it)")
     ap.add_argument("--skip-policies", action="store_true")
+    ap.add_argument("--skip-references", action="store_true",
+                    help="leave out part 3 (permeability error against the references)")
+    ap.add_argument("--references-only", action="store_true",
+                    help="run part 3 alone (no policy comparison, no scaling)")
+    ap.add_argument("--ref-lattices", nargs="*", type=_lattice_case, default=None,
+                    metavar="KIND:PHI",
+                    help="lattice cases of part 3, e.g. sc:0.45 fcc:touch (default the 13 cases "
+                         "of issue 7)")
+    ap.add_argument("--ref-random", nargs="*", type=float, default=list(REF_RANDOM_POROSITIES),
+                    metavar="POROSITY",
+                    help="random-packing porosities of part 3 (default 0.36 0.40 0.45; none "
+                         "with an empty list)")
+    ap.add_argument("--fe-random", nargs="*", type=float, default=[0.40], metavar="POROSITY",
+                    help="porosities at which the FE policies (table+fe, fe-only) run on random "
+                         "packings (default 0.40: ~15 min of FE; all three: ~50 min)")
+    ap.add_argument("--ref-spheres", type=int, default=800,
+                    help="spheres in the periodic random packings of part 3 (default 800)")
+    ap.add_argument("--ref-seed", type=int, default=1, help="seed of those packings (default 1)")
+    ap.add_argument("--ref-repeats", type=int, default=2,
+                    help="repeats per part-3 cell, minimum wall time reported (default 2; FE "
+                         "cells on random packings run once)")
     ap.add_argument("--db", default=None,
                     help="throat table with the interpolation grid (default: the cache's default; "
                          "the policy part works on copies)")
@@ -245,6 +560,16 @@ def main(argv=None) -> int:
     ap.add_argument("--one", default=None, help=argparse.SUPPRESS)
     ap.add_argument("--no-trace", action="store_true", help=argparse.SUPPRESS)
     args = ap.parse_args(argv)
+    if args.references_only and args.skip_references:
+        ap.error("--references-only and --skip-references exclude each other")
+    if args.ref_repeats < 1 or args.ref_spheres < 1:
+        ap.error("--ref-repeats and --ref-spheres must be >= 1")
+    for eps in args.ref_random:
+        if not 0.36 <= eps < 1.0:
+            ap.error(f"--ref-random porosity {eps} outside [0.36, 1)")
+    if args.references_only:
+        args.skip_policies = True
+        args.sizes = []
 
     if args.one:  # child process of the scaling part
         row = run_one(Path(args.one), args.policy, args.db, args.repeats, trace=not args.no_trace,
@@ -288,6 +613,15 @@ def main(argv=None) -> int:
             slope = np.polyfit(np.log(n), np.log(w), 1)[0]
             report["scaling_exponent"] = float(slope)
             print(f"  wall time ~ N^{slope:.2f} over {int(n.min())}..{int(n.max())} spheres")
+    if not args.skip_references:
+        lat = REF_LATTICE_CASES if args.ref_lattices is None else args.ref_lattices
+        print(f"references ({len(lat)} lattices, {len(args.ref_random)} random packings; "
+              f"models {' '.join(args.models)}; policies {' '.join(args.policies)}):", flush=True)
+        ref = _references(lat, args.ref_random, args.models, args.policies, args.db,
+                          fe_random=args.fe_random, repeats=args.ref_repeats,
+                          n_spheres=args.ref_spheres, seed=args.ref_seed)
+        report["references"] = ref
+        print("\n".join(_references_table(ref)), flush=True)
     report["machine_end"] = _machine()
     with open(args.json_out, "w") as f:
         json.dump(report, f, indent=2, default=str)
