@@ -93,6 +93,13 @@ class Region:
         return float(np.prod(self.hi[lat] - self.lo[lat]))
 
 
+#: A tetrahedron whose empty sphere is wider than this many mean diameters is outside the bed.
+OUTSIDE_BED_DIAMETERS = 2.0
+
+#: Thinnest interior (in mean diameters) that :func:`default_region` accepts on any axis.
+MIN_INTERIOR_DIAMETERS = 2.0
+
+
 def default_region(packing, *, margin: float | None = None, cylinder: bool = False,
                    container: dict | None = None, axis="z") -> Region:
     r"""Interior box (or cylinder) of a packing, ``margin`` inside its container or its spheres.
@@ -124,6 +131,17 @@ def default_region(packing, *, margin: float | None = None, cylinder: bool = Fal
         raise ValueError(f"margin must be >= 0, got {m}")
     if np.any(hi - lo <= 2 * m):
         raise ValueError(f"margin {m:g} leaves no interior in a packing of extent {hi - lo}")
+    d = packing.mean_diameter
+    thin = np.flatnonzero(hi - lo - 2 * m < MIN_INTERIOR_DIAMETERS * d)
+    if thin.size:
+        k = int(thin[0])
+        w = float(hi[k] - lo[k] - 2 * m)
+        raise ValueError(
+            f"a margin of {m:.4g} (kept from the walls on every side) leaves an interior only "
+            f"{w:.3g} ({w / d:.2f} mean diameters) thick along {'xyz'[k]}, where the packing is "
+            f"{hi[k] - lo[k]:.4g} thick: too thin for a sample away from the walls (the "
+            f"tessellation has no walls). Give a smaller --margin (the wall layer then enters "
+            f"the sample) or an explicit --sample box")
     lo, hi = lo + m, hi - m
     if container is not None and container.get("kind") == "cylinder":
         c = np.asarray(container.get("center_xy", 0.5 * (lo[:2] + hi[:2])), dtype=float)
@@ -241,6 +259,22 @@ def select_sample(tessellation, region: Region, *, axis="z", groups=None) -> Sam
         xyz_all = np.column_stack([np.bincount(lab, w * t.pore_centroid[:, k], ng)
                                    for k in range(3)])
     inside = region.contains(xyz_all, ax)
+    # tetrahedra whose empty sphere is wider than 2 mean diameters lie outside the packed bed
+    # (convex-hull artefacts along walls, free surfaces and open sides: a bed has no void
+    # that wide); the tessellation has no walls, so their huge windows would make a
+    # spurious channel (measured: k 1e8 times too high with a sample reaching a bin wall).
+    # Pore bodies holding one are left out of the sample: no flow, as at a wall.
+    circ_r = np.linalg.norm(t.pore_circumcenter - t.packing.centers[t.pore_vertices[:, 0]],
+                            axis=1)
+    big = circ_r > OUTSIDE_BED_DIAMETERS * t.packing.mean_diameter
+    outside_bed = np.bincount(lab, big, xyz_all.shape[0]) > 0
+    n_big = int(np.sum(inside & outside_bed))
+    if n_big:
+        log.warning("%d pore bodies of the sample region have an empty sphere wider than 2 mean "
+                    "diameters: they lie outside the packed bed and are left out (no flow). If "
+                    "that is many, the region reaches past the bed (give --sample, --margin, "
+                    "or a companion JSON with the container)", n_big)
+        inside &= ~outside_bed
     pores = np.flatnonzero(inside)
     if pores.size == 0:
         raise ValueError(f"the sample region {region.lo}–{region.hi} contains no pore")
@@ -270,16 +304,6 @@ def select_sample(tessellation, region: Region, *, axis="z", groups=None) -> Sam
     throats = np.flatnonzero(internal)
     conns = np.column_stack([a[throats], b[throats]])
     xyz = xyz_all[pores]
-    # tetrahedra whose empty sphere is wider than 2 mean diameters lie outside the packed bed
-    # (convex-hull artefacts next to curved or open surfaces)
-    in_tet = inside[lab]
-    circ_r = np.linalg.norm(t.pore_circumcenter[in_tet]
-                            - t.packing.centers[t.pore_vertices[in_tet, 0]], axis=1)
-    n_big = int(np.sum(circ_r > 2.0 * t.packing.mean_diameter))
-    if n_big:
-        log.warning("%d sample tetrahedra have an empty sphere wider than 2 mean diameters: the "
-                    "sample region probably reaches outside the packed bed (give --sample, or a "
-                    "companion JSON with the container)", n_big)
     length = _length(xyz, inlet, outlet, ax)
     log.info("sample along %s: %d pores (%d inlet, %d outlet), %d throats, H = %.4g, A = %.4g",
              "xyz"[ax], pores.size, inlet.size, outlet.size, throats.size, length,

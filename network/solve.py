@@ -89,6 +89,11 @@ def _print_result(res, out):
           f"porosity {s['porosity']:.4f} ± {s['porosity_std']:.4f}", file=out)
     print(f"  permeability k = {s['permeability_m2']:.4e} m²   k/d32² = {s['k_over_d2']:.4e}",
           file=out)
+    if s["permeability_core_m2"] is not None:
+        print(f"  core ({s['core_margin_m']:.3g} m in from every face, no boundary layer): "
+              f"k = {s['permeability_core_m2']:.4e} m² "
+              f"({s['permeability_core_m2'] / s['permeability_m2']:.3f} of the whole sample)",
+              file=out)
     print(f"  at v = {s['velocity_m_s']:g} m/s: gradient {s['pressure_gradient_pa_per_m']:.4g} "
           f"Pa/m, drop over {s['depth_m']:g} m = {s['pressure_drop_pa']:.4g} Pa", file=out)
     print(f"    Ergun {c['ergun']['pressure_drop_pa']:.4g} Pa, Kozeny-Carman "
