@@ -30,11 +30,13 @@ Three parts (issue 4, item 10; issue 7, item 4):
    by an untimed warm-up first); summary rows with max |k/k_ref − 1| over the lattices and over
    the random packings, total seconds and FE solves (rows the run added to its copy of the
    table) per column. A random-packing cell includes generating the packing (its time is in the
-   JSON as ``packing_s``). FE policies (table+fe, fe-only) on random packings need 10 000
-   (thesis) to 69 000 (conduit) distinct FE solves per packing, about 1 and 6.5 minutes at
-   5–7 ms a solve (at rtol 1e-3 the table+fe policy sends ~98 % of the rows to FE), so they
-   run only at the porosities given by ``--fe-random`` (default 0.40; none with an empty
-   list) and once, not ``--ref-repeats`` times; cells not run print as ``-``.
+   JSON as ``packing_s``). FE policies on random packings are expensive: at porosity 0.40,
+   800 spheres, measured (2 shared cores) fe-only 69 000 distinct FE solves in 320 s with the
+   conduit model, 10 000 in 65 s with the thesis model; table+fe (rtol 1e-3) 30 000 in 160 s
+   and 9 900 in 60 s. All three porosities would take ~30 minutes, so the FE policies on random
+   packings run only at the porosities given by ``--fe-random`` (default 0.40, ~11 minutes for
+   the whole part; none with an empty list) and once, not ``--ref-repeats`` times; cells not
+   run print as ``-``, and a summary over fewer cases than the column has shows their count.
    Unlike part 1, every cell starts from an empty table (interpolation in the grid shipped in
    ``cache/data``) unless ``--db`` names one to copy, so the numbers do not depend on what the
    user's default table happens to hold: table-only answers rows the grid does not cover with
@@ -52,7 +54,7 @@ Examples
     python -m network.bench --sizes 5000 20000 100000 500000 --skip-policies --skip-references \
         --json bench.json
     python -m network.bench --references-only --json references.json
-    python -m network.bench --references-only --fe-random 0.36 0.40 0.45   # ~50 min of FE
+    python -m network.bench --references-only --fe-random 0.36 0.40 0.45   # ~30 min
 """
 
 from __future__ import annotations
@@ -540,7 +542,7 @@ def main(argv=None) -> int:
                          "with an empty list)")
     ap.add_argument("--fe-random", nargs="*", type=float, default=[0.40], metavar="POROSITY",
                     help="porosities at which the FE policies (table+fe, fe-only) run on random "
-                         "packings (default 0.40: ~15 min of FE; all three: ~50 min)")
+                         "packings (default 0.40: ~10 min of FE; all three: ~30 min)")
     ap.add_argument("--ref-spheres", type=int, default=800,
                     help="spheres in the periodic random packings of part 3 (default 800)")
     ap.add_argument("--ref-seed", type=int, default=1, help="seed of those packings (default 1)")
