@@ -51,7 +51,7 @@ Prints a table and writes JSON with the load average, platform, CPU count and a 
 Examples
 --------
     python -m network.bench --sizes 5000 20000 --policy-spheres 600 --skip-references
-    python -m network.bench --sizes 5000 20000 100000 500000 --skip-policies --skip-references \
+    python -m network.bench --sizes 5000 20000 100000 500000 --skip-policies --skip-references \\
         --json bench.json
     python -m network.bench --references-only --json references.json
     python -m network.bench --references-only --fe-random 0.36 0.40 0.45   # ~30 min
