@@ -337,7 +337,8 @@ def core_permeability(sample, g, p, *, margin_m: float, viscosity_pa_s: float = 
 def lattice_sample_permeability(kind: str, solid_fraction: float, *, model: str = "conduit",
                                 policy: str = "fe-only", qstar_fn=None, n_cells: int = 7,
                                 axis: int = 0, n_sections: int = 6, jitter: float = 0.0,
-                                rng=None, offset: float = 0.137, estimator: str = "core"):
+                                rng=None, offset: float = 0.137, estimator: str = "core",
+                                db=None, rtol: float = 1e-3, workers: int = 1):
     r"""Permeability of a lattice sample through the network pipeline (validation helper).
 
     Builds an ``n_cells``³ array of lattice constant 1 (:func:`lattice_packing`), tessellates
@@ -366,6 +367,9 @@ def lattice_sample_permeability(kind: str, solid_fraction: float, *, model: str 
         and its seed, region offset.
     estimator : {'core', 'box'}, keyword-only
         How k is read off the solved sample (see above).
+    db, rtol, workers : keyword-only
+        Q* table (default ``cache.default_db_path()``), FE tolerance and processes, as
+        ``network._conductance.throat_qstar``.
 
     Returns
     -------
@@ -385,7 +389,7 @@ def lattice_sample_permeability(kind: str, solid_fraction: float, *, model: str 
     region = Region(np.full(3, 1.0 + offset), np.full(3, n_cells - 2 + offset))
     k = _network_permeability(tess, region, model=model, policy=policy, qstar_fn=qstar_fn,
                               n_sections=n_sections, axis=axis, estimator=estimator,
-                              margin=1.0)
+                              margin=1.0, db=db, rtol=rtol, workers=workers)
     return k, float(r[0])
 
 
@@ -397,7 +401,7 @@ def _check_model_estimator(model, estimator):
 
 
 def _network_permeability(tess, region, *, model, policy, qstar_fn, n_sections, axis,
-                          estimator, margin):
+                          estimator, margin, db=None, rtol=1e-3, workers=1):
     """k of the sample ``region`` of ``tess`` with viscosity 1 and 1 Pa across (units²)."""
     from ._conduit import conduit_conductance
     from ._conductance import thesis_conductance, throat_qstar
@@ -410,12 +414,14 @@ def _network_permeability(tess, region, *, model, policy, qstar_fn, n_sections, 
         pm = merge_pores(tess)
         smp = select_sample(tess, region, axis=axis, groups=pm.labels)
         g, _ = conduit_conductance(tess, smp.throats, viscosity_pa_s=1.0, policy=policy,
-                                   qstar_fn=qstar_fn, merge=pm, n_sections=n_sections)
+                                   qstar_fn=qstar_fn, merge=pm, n_sections=n_sections,
+                                   db=db, rtol=rtol, workers=workers)
     else:
         labels, _ = tie_groups(tess)
         smp = select_sample(tess, region, axis=axis, groups=labels)
         rad, sid = tess.throat_radii[smp.throats], tess.throat_sides[smp.throats]
-        q = throat_qstar(rad, sid, policy=policy).qstar if qstar_fn is None else qstar_fn(rad, sid)
+        q = (throat_qstar(rad, sid, policy=policy, db=db, rtol=rtol, workers=workers).qstar
+             if qstar_fn is None else qstar_fn(rad, sid))
         g = thesis_conductance(q, rad, viscosity_pa_s=1.0)
     smp2, g2 = prune_disconnected(smp, tess, g)
     p, _, chk = solve_fixed_pressure(smp2.n_pores, smp2.conns, g2, smp2.inlet, smp2.outlet)
@@ -432,7 +438,8 @@ _RANDOM_COPIES = 3
 def random_sample_permeability(porosity: float, *, n_spheres: int = 800, rng=1,
                                model: str = "conduit", policy: str = "table-only",
                                qstar_fn=None, axis: int = 0, n_sections: int = 6,
-                               estimator: str = "core", margin_diameters: float = 2.0):
+                               estimator: str = "core", margin_diameters: float = 2.0,
+                               db=None, rtol: float = 1e-3, workers: int = 1):
     r"""Permeability of a random monodisperse sphere packing through the network pipeline.
 
     The validation case for the LBM drag law of random packings
@@ -454,7 +461,7 @@ def random_sample_permeability(porosity: float, *, n_spheres: int = 800, rng=1,
         Spheres in the periodic cube (default 800).
     rng : int or numpy.random.Generator, keyword-only
         Seed of the packing (default 1).
-    model, policy, qstar_fn, axis, n_sections, estimator : keyword-only
+    model, policy, qstar_fn, axis, n_sections, estimator, db, rtol, workers : keyword-only
         As :func:`lattice_sample_permeability`.
     margin_diameters : float, keyword-only
         Core margin for ``estimator='core'`` (default 2 diameters).
@@ -484,4 +491,5 @@ def random_sample_permeability(porosity: float, *, n_spheres: int = 800, rng=1,
     region = Region(np.full(3, 0.5 * side), np.full(3, (n - 0.5) * side))
     return _network_permeability(tess, region, model=model, policy=policy, qstar_fn=qstar_fn,
                                  n_sections=n_sections, axis=axis, estimator=estimator,
-                                 margin=float(margin_diameters))
+                                 margin=float(margin_diameters), db=db, rtol=rtol,
+                                 workers=workers)
