@@ -41,9 +41,8 @@ Three parts (issue 4, item 10; issue 7, item 4):
    ``cache/data``) unless ``--db`` names one to copy, so the numbers do not depend on what the
    user's default table happens to hold: table-only answers rows the grid does not cover with
    an exact hit when the table has one, else with the shape-factor estimate (on SC conduits the
-   two differ by 3 %). The helpers of ``network._lattices`` take no ``db`` argument, so the
-   references part points ``$GRAINFLOW_CACHE_DB`` (read by ``cache.default_db_path`` at each
-   lookup) at the cell's copy; FE solves run at their default tolerance, rtol = 1e-3.
+   two differ by 3 %). Each cell passes its copy as ``db`` to the validation helpers of
+   ``network._lattices``; FE solves run at their default tolerance, rtol = 1e-3.
 
 Prints a table and writes JSON with the load average, platform, CPU count and a timestamp.
 ``--skip-references`` leaves part 3 out; ``--references-only`` runs part 3 alone.
@@ -295,31 +294,6 @@ def _lattice_reference(kind: str, phi: float, radius: float) -> float:
     return float(computed_lattice_permeability(kind, phi))
 
 
-class _CacheDb:
-    """Point ``cache.default_db_path()`` (``$GRAINFLOW_CACHE_DB``) at ``path`` for a block.
-
-    The validation helpers of ``network._lattices`` take no ``db`` argument; the Q* lookup
-    resolves ``db=None`` through the environment variable at call time.
-    """
-
-    _VAR = "GRAINFLOW_CACHE_DB"
-
-    def __init__(self, path: Path):
-        self.path = str(path)
-
-    def __enter__(self):
-        self.old = os.environ.get(self._VAR)
-        os.environ[self._VAR] = self.path
-        return self
-
-    def __exit__(self, *exc):
-        if self.old is None:
-            os.environ.pop(self._VAR, None)
-        else:
-            os.environ[self._VAR] = self.old
-        return False
-
-
 def _store_totals(path: Path) -> tuple[int, float]:
     """(rows, summed FE seconds) of a throat table; (0, 0.0) when it does not exist."""
     import sqlite3
@@ -348,14 +322,14 @@ def _ref_cell(case: dict, model: str, policy: str, base: Path | None, tmp: Path,
         n0, s0 = _store_totals(db)
         t0 = time.perf_counter()
         try:
-            with _CacheDb(db):
-                if case["kind"] == "random":
-                    k = random_sample_permeability(case["porosity"], n_spheres=case["n_spheres"],
-                                                   rng=case["seed"], model=model, policy=policy)
-                else:
-                    k, r = lattice_sample_permeability(case["kind"], case["solid_fraction"],
-                                                       model=model, policy=policy)
-                    case.setdefault("radius", r)
+            if case["kind"] == "random":
+                k = random_sample_permeability(case["porosity"], n_spheres=case["n_spheres"],
+                                               rng=case["seed"], model=model, policy=policy,
+                                               db=db)
+            else:
+                k, r = lattice_sample_permeability(case["kind"], case["solid_fraction"],
+                                                   model=model, policy=policy, db=db)
+                case.setdefault("radius", r)
         except Exception as e:  # noqa: BLE001 - report every cell
             cell["error"] = f"{type(e).__name__}: {e}"
             cell["seconds_all"].append(time.perf_counter() - t0)
@@ -385,8 +359,7 @@ def _warm_up(base: Path | None, tmp: Path) -> float:
     db = tmp / "warm-up.sqlite"
     _copy_db(base, db)
     t0 = time.perf_counter()
-    with _CacheDb(db):
-        lattice_sample_permeability("sc", 0.45, model="conduit", policy="table-only")
+    lattice_sample_permeability("sc", 0.45, model="conduit", policy="table-only", db=db)
     return time.perf_counter() - t0
 
 
