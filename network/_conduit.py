@@ -85,16 +85,16 @@ correction: the ratio of the simple-cubic to the BCC result at phi = 0.3 (both n
 exact) stays above 1.1/0.9 = 1.222 for every per-section correction tried, so none can put
 both inside 10 % at once (lattices with FE Q*, random packings with the 800-sphere cases):
 
-========================================  ======  ======  ============  ==========
-correction of the section resistance      SC 0.3  BCC 0.3  SC/BCC 0.3   random
-========================================  ======  ======  ============  ==========
-none (first-order lubrication)            1.297   0.983   1.32          1.09-1.13
-this module (a_eq slope, 4/3, saturating) 1.099   0.871   1.26          1.01-1.05
-wall slope of the spheres, arc-weighted   1.109   0.897   1.24          1.03-1.08
-  same, 24 section intervals (converged)  1.097   0.896   1.22          --
-  same, coefficient 2                     1.069   0.869   1.23          --
-wall slope over the whole perimeter, x3   1.106   0.888   1.25          1.00-1.04
-========================================  ======  ======  ============  ==========
+=========================================  ======  =======  ==========  =========
+correction of the section resistance       SC 0.3  BCC 0.3  SC/BCC 0.3  random
+=========================================  ======  =======  ==========  =========
+none (first-order lubrication)             1.297   0.983    1.32        1.09-1.13
+this module (a_eq slope, 4/3, saturating)  1.099   0.871    1.26        1.01-1.05
+wall slope of the spheres, arc-weighted    1.109   0.897    1.24        1.03-1.08
+  same, 24 section intervals (converged)   1.097   0.896    1.22        --
+  same, coefficient 2                      1.069   0.869    1.23        --
+wall slope over the whole perimeter, x3    1.106   0.888    1.25        1.00-1.04
+=========================================  ======  =======  ==========  =========
 
 So the difference lies in the geometry the model sees, not in how it integrates it. In SC the
 flow crosses its windows head-on and the prism over a window is the exact cell; in BCC every
