@@ -35,6 +35,7 @@ import numpy as np
 from scipy import sparse
 from scipy.sparse import csgraph
 
+from ._sample import _axis_index
 from ._branched import (
     MU_AIR_PA_S,
     BranchedResult,
@@ -75,7 +76,6 @@ logger = logging.getLogger(__name__)
 
 #: Path kinds accepted by :func:`trace_paths`.
 PATH_KINDS = ("widest", "narrowest", "maximin", "shortest")
-_AXES = {"x": 0, "y": 1, "z": 2}
 #: Coefficients of the smoothing factor, Eq. 3.26 (thesis: omega_a = 0.1, omega_b = 90 deg).
 OMEGA_A = 0.1
 OMEGA_B_DEG = 90.0
@@ -234,13 +234,6 @@ def bed_depth(centers, radii, axis="z"):
     c = np.asarray(centers, dtype=float)
     ax = _axis_index(axis)
     return float(np.ptp(c[:, ax]) + 2.0 * np.mean(radii))
-
-
-def _axis_index(axis):
-    try:
-        return _AXES[axis]
-    except KeyError:
-        raise ValueError(f"unknown axis {axis!r}; expected one of {tuple(_AXES)}") from None
 
 
 def _plane_axes(ax):

@@ -12,11 +12,12 @@ import logging
 
 import numpy as np
 
+from ._sample import _axis_index
+
 __all__ = ["plot_paths"]
 
 logger = logging.getLogger(__name__)
 
-_AXES = {"x": 0, "y": 1, "z": 2}
 _COLOURS = {"widest": "tab:blue", "narrowest": "tab:red", "maximin": "tab:green",
             "shortest": "tab:purple"}
 
@@ -46,7 +47,7 @@ def plot_paths(points, paths, out_png, *, axis="z", title="", max_spheres=4000, 
     import matplotlib.pyplot as plt
 
     x = np.asarray(points, dtype=float)
-    ax_i = _AXES[axis]
+    ax_i = _axis_index(axis)
     other = [i for i in range(3) if i != ax_i][0]
     rng = np.random.default_rng(seed)
     sub = x if x.shape[0] <= max_spheres else x[rng.choice(x.shape[0], max_spheres, False)]
