@@ -21,6 +21,8 @@ as_throats
     Shape check at the door: two float (N, 3) arrays.
 triangle_vertices
     Planar vertex coordinates of the triangles.
+triangle_area
+    Triangle area from the sides (Heron, Kahan's stable form).
 shape_factor_qstar
     Fast Q* estimate in the Patzek & Silin (2001) form c_t A² G, fitted per contact type
     (median error 21 %, 95th percentile 54 % against FE; over 1e6 throats/s).
@@ -42,10 +44,11 @@ are closed by short no-slip cuts (:mod:`throats._mesh`, error < 2e-5 measured); 
 uses curved quadratic gmsh triangles and Lagrange P3/P4 (:mod:`throats._solve`).
 """
 
-from ._geometry import (as_throats, canonical_form, contact_type, open_area, triangle_vertices,
-                        validate_throats)
+from ._geometry import (as_throats, canonical_form, contact_type, open_area, triangle_area,
+                        triangle_vertices, validate_throats)
 from ._shape_factor import shape_factor_qstar
 from ._solve import SOLVER_VERSION, ThroatSolution, solve_fem
 
 __all__ = ["SOLVER_VERSION", "as_throats", "ThroatSolution", "canonical_form", "contact_type", "open_area",
-           "shape_factor_qstar", "solve_fem", "triangle_vertices", "validate_throats"]
+           "shape_factor_qstar", "solve_fem", "triangle_area", "triangle_vertices",
+           "validate_throats"]

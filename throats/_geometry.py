@@ -89,9 +89,24 @@ def triangle_vertices(sides):
     return v
 
 
-def _triangle_area(sides):
-    """Heron's formula (numerically stable form, Kahan), (N,)."""
-    a = np.sort(sides, axis=1)[:, ::-1]  # a >= b >= c
+def triangle_area(sides):
+    """Area of N triangles from their sides, Heron's formula in Kahan's stable form.
+
+    Parameters
+    ----------
+    sides : (N, 3) array_like
+        Side lengths, any unit (rows that are no triangle give 0).
+
+    Returns
+    -------
+    (N,) ndarray, the unit squared.
+
+    Examples
+    --------
+    >>> triangle_area([[3.0, 4.0, 5.0]]).tolist()
+    [6.0]
+    """
+    a = np.sort(np.asarray(sides, dtype=float), axis=1)[:, ::-1]  # a >= b >= c
     a, b, c = a[:, 0], a[:, 1], a[:, 2]
     prod = (a + (b + c)) * (c - (a - b)) * (c + (a - b)) * (a + (b - c))
     return 0.25 * np.sqrt(np.maximum(prod, 0.0))
@@ -211,7 +226,7 @@ def _validate(r, s, *, deep_overlap):
     flag((s <= 0).any(1), lambda k: f"side length <= 0 in sides {s[k].tolist()}")
     with np.errstate(invalid="ignore"):
         srt = np.sort(s, axis=1)
-        area = _triangle_area(np.where(np.isfinite(s), s, 1.0))
+        area = triangle_area(np.where(np.isfinite(s), s, 1.0))
         bad_tri = (srt[:, 2] >= srt[:, 0] + srt[:, 1]) | (area <= 1e-9 * srt[:, 2] ** 2)
     flag(bad_tri, lambda k: f"sides {s[k].tolist()} do not form a triangle "
                             "(triangle inequality violated or collinear vertices)")
