@@ -29,7 +29,8 @@ from ._flow import solve_fixed_pressure
 from ._io import Packing
 from ._merge import merge_pores
 from ._porosity import region_porosity
-from ._sample import AXES, Region, default_region, prune_disconnected, select_sample
+from ._sample import (AXES, Region, core_permeability, default_region, prune_disconnected,
+                      select_sample)
 from ._tessellation import Tessellation, tessellate, tie_groups
 
 __all__ = ["FlowResult", "solve_network", "DEFAULT_VELOCITY_M_S", "DEFAULT_DEPTH_M"]
@@ -88,7 +89,7 @@ class FlowResult:
     pore_xyz: np.ndarray = dataclasses.field(repr=False)
     pore_groups: np.ndarray | None = dataclasses.field(default=None, repr=False)
     #: k of the sample's core, ``core_margin_m`` in from every face (None: cylinder sample
-    #: or a core too small), m²; see :func:`network._lattices.core_permeability`.
+    #: or a core too small), m²; see :func:`network._sample.core_permeability`.
     permeability_core_m2: float | None = None
     core_margin_m: float | None = None
 
@@ -325,7 +326,6 @@ CORE_MIN_DIAMETERS = 5.0
 
 def _core_estimate(sample, g, p, region, mean_diameter_m, viscosity_pa_s):
     """(k of the core, margin) of a box sample, or (None, None) when there is no such core."""
-    from ._lattices import core_permeability
     if region.radius is not None:
         return None, None
     margin = CORE_MARGIN_DIAMETERS * float(mean_diameter_m)
