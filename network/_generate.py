@@ -26,7 +26,7 @@ from scipy.spatial import cKDTree
 
 from ._io import Packing
 
-__all__ = ["random_packing", "soybean_default_scene", "SOYBEAN_DEFAULT"]
+__all__ = ["random_packing", "periodic_copies", "soybean_default_scene", "SOYBEAN_DEFAULT"]
 
 log = logging.getLogger(__name__)
 
@@ -160,6 +160,28 @@ def random_packing(n_spheres: int, *, diameter_range_m=(5.5e-3, 7.5e-3),
     src = (f"random_packing(n={n_spheres}, d={dmin:g}-{dmax:g} m, phi={solid_fraction:g}, "
            f"periodic={periodic})")
     return Packing(x, r, source=src)
+
+
+def periodic_copies(packing: Packing, side: float, copies: int) -> Packing:
+    """``copies``³ copies of a periodic packing in a cube of side ``side`` (same unit).
+
+    Centres are wrapped into [0, side) first, so the copies tile space without overlaps;
+    copy (i, j, k) is shifted by (i, j, k) * side. Sphere order: copy by copy, each in the
+    order of ``packing``.
+
+    Examples
+    --------
+    >>> p = periodic_copies(Packing([[0.5, 0.5, 1.5]], [0.5]), 1.0, 2)
+    >>> p.centers.shape, float(p.centers[:, 2].max())
+    ((8, 3), 1.5)
+    """
+    n = int(copies)
+    if n < 1:
+        raise ValueError(f"copies must be >= 1, got {copies!r}")
+    shifts = np.stack(np.meshgrid(*[np.arange(n)] * 3, indexing="ij"), -1).reshape(-1, 3)
+    c = (np.mod(packing.centers, side)[None] + side * shifts[:, None]).reshape(-1, 3)
+    return Packing(c, np.tile(packing.radii, len(shifts)),
+                   source=f"{n}^3 periodic copies of {packing.source}")
 
 
 #: Parameters of the bundled scene ``network/data/soybean_default.csv``.

@@ -387,8 +387,7 @@ def random_sample_permeability(porosity: float, *, n_spheres: int = 800, rng=1,
     k : float
         Permeability in units of the sphere diameter squared.
     """
-    from ._generate import random_packing
-    from ._io import Packing
+    from ._generate import periodic_copies, random_packing
     from ._sample import Region
     from ._tessellation import tessellate
 
@@ -400,10 +399,7 @@ def random_sample_permeability(porosity: float, *, n_spheres: int = 800, rng=1,
                           periodic=True, rng=rng)
     side = (math.pi / 6.0 * int(n_spheres) / (1.0 - eps)) ** (1.0 / 3.0)
     n = _RANDOM_COPIES
-    shifts = np.stack(np.meshgrid(*(np.arange(n),) * 3, indexing="ij"), -1).reshape(-1, 3)
-    c = (np.mod(base.centers, side)[None] + side * shifts[:, None]).reshape(-1, 3)
-    r = np.tile(base.radii, len(shifts))
-    tess = tessellate(Packing(c, r))
+    tess = tessellate(periodic_copies(base, side, n))
     region = Region(np.full(3, 0.5 * side), np.full(3, (n - 0.5) * side))
     return _network_permeability(tess, region, model=model, policy=policy, qstar_fn=qstar_fn,
                                  n_sections=n_sections, axis=axis, estimator=estimator,

@@ -75,7 +75,7 @@ import numpy as np
 
 from ._conductance import MODELS, POLICIES
 from ._generate import random_packing
-from ._io import read_packing, write_packing_csv
+from ._io import Packing, read_packing, write_packing_csv
 from ._pipeline import solve_network
 
 
@@ -96,17 +96,16 @@ def _tiled(base_n: int, n: int, workdir: Path, seed: int):
     images tile space without overlaps; a cube of k³ copies is cropped to the sub-cube holding
     about n spheres. The structure repeats every L, which does not matter for timing.
     """
-    from ._io import Packing
+    from ._generate import periodic_copies
 
     base = read_packing(_packing_file(base_n, workdir, seed))
     box = (4.0 / 3.0 * np.pi * np.sum(base.radii**3) / 0.60) ** (1.0 / 3.0)
     k = int(np.ceil((n / base.n) ** (1.0 / 3.0)))
-    shifts = np.stack(np.meshgrid(*[np.arange(k)] * 3, indexing="ij"), -1).reshape(-1, 3) * box
-    c = (base.centers[None, :, :] + shifts[:, None, :]).reshape(-1, 3)
-    r = np.tile(base.radii, len(shifts))
-    side = k * box * (n / c.shape[0]) ** (1.0 / 3.0)
-    keep = np.all(c < side, axis=1)
-    return Packing(c[keep], r[keep], source=f"{k}^3 tiling of {base_n} periodic spheres")
+    big = periodic_copies(base, box, k)
+    side = k * box * (n / big.n) ** (1.0 / 3.0)
+    keep = np.all(big.centers < side, axis=1)
+    return Packing(big.centers[keep], big.radii[keep],
+                   source=f"{k}^3 tiling of {base_n} periodic spheres")
 
 
 def _packing_file(n: int, workdir: Path, seed: int) -> Path:
