@@ -265,9 +265,7 @@ def select_sample(tessellation, region: Region, *, axis="z", groups=None) -> Sam
     # that wide); the tessellation has no walls, so their huge windows would make a
     # spurious channel (measured: k 1e8 times too high with a sample reaching a bin wall).
     # Pore bodies holding one are left out of the sample: no flow, as at a wall.
-    circ_r = np.linalg.norm(t.pore_circumcenter - t.packing.centers[t.pore_vertices[:, 0]],
-                            axis=1)
-    big = circ_r > OUTSIDE_BED_DIAMETERS * t.packing.mean_diameter
+    big = t.outside_bed(OUTSIDE_BED_DIAMETERS)
     outside_bed = np.bincount(lab, big, xyz_all.shape[0]) > 0
     n_big = int(np.sum(inside & outside_bed))
     if n_big:

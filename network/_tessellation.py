@@ -128,6 +128,19 @@ class Tessellation:
     def n_throats(self) -> int:
         return int(self.throat_vertices.shape[0])
 
+    def outside_bed(self, diameters: float = 2.0) -> np.ndarray:
+        """(Np,) bool: tetrahedra whose empty sphere is wider than ``diameters`` mean diameters.
+
+        A packed bed has no void that wide (radius of the circumsphere through the four
+        centres, so an empty sphere of radius ``diameters * d - r`` between grains): these are
+        convex-hull artefacts along walls, free surfaces and open sides, flat tetrahedra with
+        huge windows, since the tessellation has no walls. Flat tetrahedra (NaN circumcentre)
+        are not flagged.
+        """
+        circ_r = np.linalg.norm(self.pore_circumcenter
+                                - self.packing.centers[self.pore_vertices[:, 0]], axis=1)
+        return circ_r > float(diameters) * self.packing.mean_diameter
+
     @property
     def interior_throats(self) -> np.ndarray:
         """Indices of throats shared by two pores (not on the hull)."""
