@@ -1,0 +1,203 @@
+"""The code's architecture, read with ``ast``: layer order, no cycles, small modules.
+
+Rules (issue 12):
+
+* packages: ``throats`` <- ``cache`` <- ``network``; ``dem`` stands apart (it imports no other
+  project package and none imports it). A benchmark (``<package>/bench.py``) is a tool on top of
+  the pipeline and may import the public API (the package itself, never a private module) of the
+  packages below or beside it;
+* inside a package, subpackages form layers (``LAYERS``): a module imports only its own layer
+  and the layers before it; the module import graph has no cycle;
+* no import of a project module inside a function (matplotlib and other optional libraries may
+  stay lazy); no import of another module's ``_private`` name;
+* no library module over ``MAX_LINES`` lines, no module docstring over ``MAX_DOC_LINES`` lines.
+"""
+
+from __future__ import annotations
+
+import ast
+from pathlib import Path
+
+import pytest
+
+ROOT = Path(__file__).resolve().parents[1]
+PACKAGES = ("throats", "cache", "network", "dem")
+#: which project packages each package may import (bench modules: see ``BENCH_MAY_IMPORT``)
+MAY_IMPORT = {"throats": set(), "cache": {"throats"}, "network": {"throats", "cache"},
+              "dem": set()}
+BENCH_MAY_IMPORT = {"throats": {"network"}, "cache": {"throats", "network"},
+                    "network": {"throats", "cache"}, "dem": set()}
+#: layers inside a package, lowest first; a module's layer is its first path component
+#: below the package (a subpackage name, or the module name for top-level modules)
+LAYERS = {
+    "network": [
+        {"_air", "packing"},
+        {"pores"},
+        {"conductance"},
+        {"flow"},
+        {"airpaths"},
+        {"validation"},
+        {"__init__", "solve", "throats", "paths", "curve", "report", "bench", "__main__"},
+    ],
+}
+MAX_LINES = 450
+MAX_DOC_LINES = 40
+
+
+def _modules(package):
+    for path in sorted((ROOT / package).rglob("*.py")):
+        rel = path.relative_to(ROOT).with_suffix("")
+        parts = list(rel.parts)
+        if parts[-1] == "__init__":
+            name, is_pkg = ".".join(parts[:-1]), True
+        else:
+            name, is_pkg = ".".join(parts), False
+        yield name, path, is_pkg
+
+
+def _resolve(module, is_pkg, node):
+    """Absolute dotted names a ``from``/``import`` statement refers to, with imported names."""
+    if isinstance(node, ast.Import):
+        return [(a.name, None) for a in node.names]
+    base = module.split(".") if is_pkg else module.split(".")[:-1]
+    if node.level:
+        base = base[: len(base) - (node.level - 1)]
+        target = ".".join(base + ([node.module] if node.module else []))
+    else:
+        target = node.module or ""
+    return [(target, a.name) for a in node.names]
+
+
+def _project_imports(package):
+    """(module, path, lineno, target, name, in_function) for every project import."""
+    out = []
+    for module, path, is_pkg in _modules(package):
+        tree = ast.parse(path.read_text(), filename=str(path))
+        func_lines = set()
+        for fn in ast.walk(tree):
+            if isinstance(fn, (ast.FunctionDef, ast.AsyncFunctionDef)):
+                for sub in ast.walk(fn):
+                    if isinstance(sub, (ast.Import, ast.ImportFrom)):
+                        func_lines.add(id(sub))
+        for node in ast.walk(tree):
+            if not isinstance(node, (ast.Import, ast.ImportFrom)):
+                continue
+            for target, name in _resolve(module, is_pkg, node):
+                top = target.split(".")[0]
+                if top in PACKAGES:
+                    out.append((module, path, node.lineno, target, name, id(node) in func_lines))
+    return out
+
+
+def _known_modules():
+    return {m for p in PACKAGES for m, _, _ in _modules(p)}
+
+
+@pytest.mark.parametrize("package", PACKAGES)
+def test_packages_import_only_what_they_may(package):
+    bad = []
+    for module, path, line, target, name, _ in _project_imports(package):
+        top = target.split(".")[0]
+        if top == package:
+            continue
+        is_bench = module == f"{package}.bench"
+        allowed = BENCH_MAY_IMPORT[package] if is_bench else MAY_IMPORT[package]
+        if top not in allowed or (is_bench and target != top):
+            bad.append(f"{path.relative_to(ROOT)}:{line} imports {target}")
+    assert not bad, "\n".join(bad)
+
+
+@pytest.mark.parametrize("package", PACKAGES)
+def test_no_function_level_project_imports(package):
+    bad = [f"{p.relative_to(ROOT)}:{line} imports {t} inside a function"
+           for _, p, line, t, _, in_fn in _project_imports(package) if in_fn]
+    assert not bad, "\n".join(bad)
+
+
+@pytest.mark.parametrize("package", PACKAGES)
+def test_no_private_names_of_other_modules(package):
+    known = _known_modules()
+    bad = []
+    for module, path, line, target, name, _ in _project_imports(package):
+        if name is None or not name.startswith("_") or name.startswith("__"):
+            continue
+        if f"{target}.{name}" in known:       # a private module imported from its package
+            continue
+        bad.append(f"{path.relative_to(ROOT)}:{line} imports {target}.{name}")
+    assert not bad, "\n".join(bad)
+
+
+def _layer_of(package, module):
+    parts = module.split(".")
+    key = parts[1] if len(parts) > 1 else "__init__"
+    for i, layer in enumerate(LAYERS[package]):
+        if key in layer:
+            return i
+    raise AssertionError(f"{module}: not in any layer of {package} (add it to LAYERS)")
+
+
+@pytest.mark.parametrize("package", sorted(LAYERS))
+def test_layer_order(package):
+    bad = []
+    for module, path, line, target, name, _ in _project_imports(package):
+        if target.split(".")[0] != package:
+            continue
+        full = f"{target}.{name}" if name and f"{target}.{name}" in _known_modules() else target
+        if full == package:
+            continue      # the package's public API (only the CLIs on top should use it)
+        if _layer_of(package, full) > _layer_of(package, module):
+            bad.append(f"{path.relative_to(ROOT)}:{line} ({module}) imports the higher layer "
+                       f"{full}")
+    assert not bad, "\n".join(bad)
+
+
+@pytest.mark.parametrize("package", PACKAGES)
+def test_no_import_cycles(package):
+    known = _known_modules()
+    graph: dict = {}
+    for module, _, _, target, name, _ in _project_imports(package):
+        full = f"{target}.{name}" if name and f"{target}.{name}" in known else target
+        if full.split(".")[0] == package and full != module:
+            graph.setdefault(module, set()).add(full)
+    # a package's __init__ imports its modules; an import of the package is an import of it
+    state: dict = {}
+    stack: list = []
+
+    def visit(m):
+        state[m] = 1
+        stack.append(m)
+        for n in graph.get(m, ()):
+            if state.get(n) == 1:
+                raise AssertionError("import cycle: " + " -> ".join(stack[stack.index(n):] + [n]))
+            if n not in state:
+                visit(n)
+        stack.pop()
+        state[m] = 2
+
+    for m in list(graph):
+        if m not in state:
+            visit(m)
+
+
+@pytest.mark.parametrize("package", PACKAGES)
+def test_modules_are_small(package):
+    bad = []
+    for module, path, _ in _modules(package):
+        text = path.read_text()
+        n = text.count("\n")
+        if n > MAX_LINES:
+            bad.append(f"{path.relative_to(ROOT)}: {n} lines (> {MAX_LINES})")
+        doc = ast.get_docstring(ast.parse(text), clean=False)
+        if doc and doc.count("\n") + 1 > MAX_DOC_LINES:
+            bad.append(f"{path.relative_to(ROOT)}: module docstring {doc.count(chr(10)) + 1} "
+                       f"lines (> {MAX_DOC_LINES})")
+    assert not bad, "\n".join(bad)
+
+
+def test_the_rules_see_a_violation(tmp_path):
+    """The checker itself: an in-function import and a private name are found."""
+    src = "def f():\n    from ._x import _y\n"
+    tree = ast.parse(src)
+    imports = [n for n in ast.walk(tree) if isinstance(n, ast.ImportFrom)]
+    assert _resolve("network.pores._a", False, imports[0]) == [("network.pores._x", "_y")]
+    assert _resolve("network.pores", True, imports[0]) == [("network.pores._x", "_y")]
