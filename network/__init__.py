@@ -39,7 +39,7 @@ from ._empirical import (asabe_d272_gradient, darcy_permeability, ergun_gradient
                          kozeny_carman_gradient)
 from ._flow import (SolveInfo, apply_pressure_bc, assemble_laplacian, solve_fixed_pressure,
                     solve_pressure, verify_solution)
-from ._generate import random_packing
+from ._generate import random_packing, sample_throats
 from ._io import Packing, default_packing_path, read_container, read_packing, write_packing_csv
 from ._lattices import lattice_packing, lattice_radius
 from ._paths import AirflowPath, trace_paths
@@ -60,7 +60,7 @@ __all__ = [
     "solve_fixed_pressure", "verify_solution",
     "FlowResult", "solve_network",
     "ergun_gradient", "kozeny_carman_gradient", "asabe_d272_gradient", "darcy_permeability",
-    "region_porosity", "random_packing", "write_network_vtu",
+    "region_porosity", "random_packing", "sample_throats", "write_network_vtu",
     "lattice_packing", "lattice_radius",
     "lattice_permeability", "beetstra_permeability", "kozeny_carman_permeability",
     "AirflowPath", "trace_paths", "BranchedResult", "branched_pressure_drop",
