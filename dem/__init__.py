@@ -10,15 +10,17 @@ pack_bed(container, *, porosity=0.408, rng=None, procedure='lid'|'sediment', ...
     Generate at reduced radius, expand (Eqs. 3.1–3.10), settle to equilibrium; 'sediment'
     (frictionless sedimentation + annealed taps, friction restored for the last settle) is the
     rect-bin default (``SCENE_DEFAULTS``), the only way found to its 0.408 ± 0.01 target with
-    overlaps below 1 % of a radius (0.415 interior; numbers in :mod:`dem._scenes`).
+    overlaps below 1 % of a radius (0.415 interior; numbers in ``docs/dem-packing.md``).
 vibrate_bed(centers, radii, container, *, freq_hz, amplitude_m, duration_s, ...) -> VibrationResult
     Sinusoidal vertical motion of the bin (Eq. 3.11) with porosity histories.
-Simulation, DemInstabilityError
+Simulation, DemInstabilityError, PlaneWall, CylinderWall
     The time integrator (Verlet list, linear spring–dashpot–Coulomb contacts, walls).
 linear_contact_forces, series_stiffness, damping_coefficient, restitution_coefficient
     The contact law and its closed forms.
-porosity_in_spheres, porosity_in_region, coordination_numbers, Region
-    Measurements.
+porosity_in_spheres, porosity_in_region, coordination_numbers, Region, lens_volume, sphere_volume
+    Measurements; summarize, surface_height, default_measure_spheres (B1–B5) for whole packings.
+generate_spheres, thesis_particle_count, intensity_g
+    Random sequential addition, Eq. 3.10, Eq. 3.11's Γ = Aω²/g.
 write_packing, read_packing
     CSV ``x,y,z,r`` (m) + JSON summary.
 
@@ -41,8 +43,13 @@ from ._contacts import damping_coefficient, linear_contact_forces, restitution_c
 from ._integrate import SOYBEAN, DemInstabilityError, Material, Simulation
 from ._io import read_packing, write_packing
 from ._measure import Region, coordination_numbers, porosity_in_region, porosity_in_spheres
-from ._scenes import PROCEDURES, SCENE_DEFAULTS, SCENES, Container, PackResult, pack_bed, scene_container, summarize, thesis_particle_count
-from ._vibrate import VibrationResult, vibrate_bed
+from ._container import SCENE_DEFAULTS, SCENES, Container, default_measure_spheres, scene_container
+from ._fill import generate_spheres, thesis_particle_count
+from ._measure import lens_volume, sphere_volume
+from ._procedures import PROCEDURES, PackResult, pack_bed
+from ._summary import summarize, surface_height
+from ._vibrate import VibrationResult, intensity_g, vibrate_bed
+from ._walls import CylinderWall, PlaneWall
 
 __all__ = [
     "Material", "SOYBEAN", "Simulation", "DemInstabilityError",
@@ -51,4 +58,7 @@ __all__ = [
     "vibrate_bed", "VibrationResult",
     "Region", "porosity_in_spheres", "porosity_in_region", "coordination_numbers",
     "read_packing", "write_packing",
+    # added by issue 12 (public names the tests and CLIs use instead of private modules)
+    "PlaneWall", "CylinderWall", "generate_spheres", "default_measure_spheres", "surface_height",
+    "lens_volume", "sphere_volume", "intensity_g",
 ]

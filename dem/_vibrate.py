@@ -21,7 +21,8 @@ import numpy as np
 
 from ._integrate import SOYBEAN
 from ._measure import Region, porosity_in_region, porosity_in_spheres, sphere_volume
-from ._scenes import _surface_height, default_measure_spheres, make_simulation, summarize
+from ._container import default_measure_spheres, make_simulation
+from ._summary import summarize, surface_height
 
 __all__ = ["vibrate_bed", "VibrationResult", "intensity_g"]
 
@@ -97,7 +98,7 @@ def vibrate_bed(centers, radii, container, *, freq_hz=15.0, amplitude_m=0.002, d
     if measure_spheres is None:
         measure_spheres = default_measure_spheres(container)
     mc, mr = measure_spheres
-    surface0 = _surface_height(centers, radii, container)
+    surface0 = surface_height(centers, radii, container)
     dmean = 2 * float(radii.mean())
     region0 = container.interior(2 * dmean, surface0)
     vp = float(sphere_volume(radii).sum())
@@ -116,7 +117,7 @@ def vibrate_bed(centers, radii, container, *, freq_hz=15.0, amplitude_m=0.002, d
         times.append(sim.time_s)
         ps.append(porosity_in_spheres(shifted, radii, mc, mr))
         pi.append(porosity_in_region(shifted, radii, region0))
-        pg.append(1.0 - vp / (container.area_m2 * _surface_height(shifted, radii, container)))
+        pg.append(1.0 - vp / (container.area_m2 * surface_height(shifted, radii, container)))
 
     record()
     next_rec = record_every_s

@@ -21,7 +21,8 @@ import time
 
 import numpy as np
 
-from ._scenes import Container, make_simulation, pack_bed
+from ._container import Container, make_simulation
+from ._procedures import pack_bed
 from ._perf import tune_malloc
 
 

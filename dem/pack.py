@@ -13,15 +13,14 @@ on success, 2 on bad arguments, 3 when the simulation went unstable (nothing wri
 from __future__ import annotations
 
 import argparse
-import sys
-import time
 
 import numpy as np
 
-from ._integrate import DemInstabilityError, Material
+from ._cli import progress_printer, resolve_container, run_main
+from ._container import SCENE_DEFAULTS, SCENES, default_measure_spheres
+from ._integrate import Material
 from ._io import summary_path, write_packing
-from ._scenes import PROCEDURES, SCENE_DEFAULTS, SCENES, Container, pack_bed
-from ._perf import tune_malloc
+from ._procedures import PROCEDURES, pack_bed
 
 
 def _parser():
@@ -39,7 +38,7 @@ def _parser():
     p.add_argument("--procedure", choices=list(PROCEDURES), default=None,
                    help="'lid': expand under a lid, then settle (Appendix B style; Appendix A closed box with "
                         "--lid-headroom 0 --keep-lid); 'sediment': frictionless sedimentation and taps, then friction "
-                        "restored and settled (default for rect-bin, see dem._scenes.SCENE_DEFAULTS)")
+                        "restored and settled (default for rect-bin, see dem.SCENE_DEFAULTS)")
     p.add_argument("--lid-headroom", type=float, default=None,
                    help="lid height above the fill height during expansion, as a fraction (0: Appendix A closed box; "
                         "default 0.2 for 'lid', 0.3 for 'sediment')")
@@ -64,41 +63,16 @@ def _parser():
     return p
 
 
-def main(argv=None) -> int:
-    tune_malloc()
-    args = _parser().parse_args(argv)
-    try:
-        material = Material(
-            density_kg_m3=args.density, kn_n_m=args.kn, ks_n_m=args.ks, friction=args.friction,
-            wall_kn_n_m=args.wall_kn, wall_ks_n_m=args.wall_ks, wall_friction=args.wall_friction,
-            damping_ratio=args.damping, radius_min_m=args.r_min, radius_max_m=args.r_max,
-        )
-        if args.scene in SCENES:
-            container = SCENES[args.scene]
-        else:
-            if args.size is None or args.height is None:
-                raise ValueError(f"--scene {args.scene} needs --size and --height")
-            kind = "box" if args.scene == "box" else "cylinder"
-            container = Container(kind, tuple(args.size), args.height)
-    except ValueError as e:
-        print(f"error: {e}", file=sys.stderr)
-        return 2
-    measure = None
-    if args.measure:
-        from ._scenes import default_measure_spheres
+def _material(args):
+    return Material(
+        density_kg_m3=args.density, kn_n_m=args.kn, ks_n_m=args.ks, friction=args.friction,
+        wall_kn_n_m=args.wall_kn, wall_ks_n_m=args.wall_ks, wall_friction=args.wall_friction,
+        damping_ratio=args.damping, radius_min_m=args.r_min, radius_max_m=args.r_max,
+    )
 
-        r = args.measure_radius or default_measure_spheres(container)[1]
-        measure = (np.array(args.measure, dtype=float), r)
-    t0 = time.perf_counter()
 
-    def progress(stage, sim, force):
-        if args.quiet or sim.steps % (10 * 200) != 0:
-            return
-        rate = sim.steps * sim.n / (time.perf_counter() - t0)
-        print(f"[{stage:7s}] step {sim.steps:7d}  t = {sim.time_s:7.4f} s  KE = {sim.kinetic_energy():9.3e} J  "
-              f"ratio = {sim.unbalanced_force_ratio(force):8.2e}  {rate:9.3e} particle-steps/s", file=sys.stderr,
-              flush=True)
-
+def _procedure_options(args):
+    """The scene's default procedure options, overridden by the ones given on the command line."""
     opts = dict(SCENE_DEFAULTS.get(args.scene, {}))
     if args.procedure is not None and args.procedure != opts.get("procedure", "lid"):
         opts = {"procedure": args.procedure}
@@ -109,17 +83,22 @@ def main(argv=None) -> int:
             opts[key] = val
     if opts.get("procedure", "lid") == "lid" and "lid_headroom" not in opts:
         opts["lid_headroom"] = 0.2
-    try:
-        res = pack_bed(container, material=material, porosity=args.porosity, n_particles=args.n_particles,
+    return opts
+
+
+def _pack(args) -> int:
+    material = _material(args)
+    container = resolve_container(args.scene, size_m=args.size, height_m=args.height)
+    measure = None
+    if args.measure:
+        r = args.measure_radius or default_measure_spheres(container)[1]
+        measure = (np.array(args.measure, dtype=float), r)
+    opts = _procedure_options(args)
+    res = pack_bed(container, material=material, porosity=args.porosity, n_particles=args.n_particles,
                    rng=args.seed, mass_scale=args.mass_scale, packing_friction=args.packing_friction,
                    open_top=not args.keep_lid, tol=args.tol, max_steps=args.max_steps,
-                   dt_safety=args.dt_safety, measure_spheres=measure, progress=progress, **opts)
-    except ValueError as e:
-        print(f"error: {e}", file=sys.stderr)
-        return 2
-    except DemInstabilityError as e:
-        print(f"unstable, nothing written: {e}", file=sys.stderr)
-        return 3
+                   dt_safety=args.dt_safety, measure_spheres=measure,
+                   progress=progress_printer(quiet=args.quiet), **opts)
     s = res.summary
     s["scene"] = args.scene
     s["procedure_options"] = opts
@@ -133,6 +112,10 @@ def main(argv=None) -> int:
     print(f"{s['steps']} steps, simulated {s['simulated_time_s']:.3f} s (mass scale {s['mass_scale']:g}), "
           f"wall {s['wall_time_s']:.1f} s, {s['particle_steps_per_s']:.3e} particle-steps/s")
     return 0
+
+
+def main(argv=None) -> int:
+    return run_main(_parser(), _pack, argv)
 
 
 if __name__ == "__main__":

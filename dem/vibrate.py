@@ -14,17 +14,16 @@ from __future__ import annotations
 
 import argparse
 import json
-import sys
 import time
 from pathlib import Path
 
 import numpy as np
 
+from ._cli import progress_printer, resolve_container, run_main
+from ._container import SCENES
 from ._integrate import DemInstabilityError, Material
 from ._io import read_packing, write_packing
-from ._scenes import SCENES, Container
 from ._vibrate import intensity_g, vibrate_bed
-from ._perf import tune_malloc
 
 THESIS_AMPLITUDES_M = (0.0005, 0.001, 0.002, 0.003, 0.004)
 
@@ -47,53 +46,34 @@ def _parser():
     return p
 
 
-def main(argv=None) -> int:
-    tune_malloc()
-    args = _parser().parse_args(argv)
-    try:
-        centers, radii, summary = read_packing(args.packing)
-        if args.scene:
-            container = SCENES[args.scene]
-        elif summary and "container" in summary:
-            container = Container.from_dict(summary["container"])
-        else:
-            raise ValueError("no container: give --scene or keep the packing's JSON summary beside it")
-        material = Material(**summary["material"]) if summary and "material" in summary else Material()
-        if args.series:
-            amps = list(THESIS_AMPLITUDES_M)
-        elif args.amplitude:
-            amps = list(args.amplitude)
-        elif args.intensity:
-            amps = [g * 9.81 / (2 * np.pi * args.freq) ** 2 for g in args.intensity]
-        else:
-            raise ValueError("give --amplitude, --intensity or --series")
-    except (ValueError, OSError) as e:
-        print(f"error: {e}", file=sys.stderr)
-        return 2
+def _amplitudes(args):
+    """Amplitudes (m) asked for: the thesis series, --amplitude, or --intensity in g at --freq."""
+    if args.series:
+        return list(THESIS_AMPLITUDES_M)
+    if args.amplitude:
+        return list(args.amplitude)
+    if args.intensity:
+        return [g * 9.81 / (2 * np.pi * args.freq) ** 2 for g in args.intensity]
+    raise ValueError("give --amplitude, --intensity or --series")
+
+
+def _vibrate(args) -> int:
+    centers, radii, summary = read_packing(args.packing)
+    container = resolve_container(args.scene, summary=summary)
+    material = Material(**summary["material"]) if summary and "material" in summary else Material()
+    amps = _amplitudes(args)
     out = Path(args.out)
     out.mkdir(parents=True, exist_ok=True)
     rows = []
     for amp in amps:
         t0 = time.perf_counter()
-
-        def progress(stage, sim, force, t0=t0):
-            if args.quiet or sim.steps % 2000 != 0:
-                return
-            rate = sim.steps * sim.n / (time.perf_counter() - t0)
-            print(f"[A={amp * 1e3:.1f} mm {stage}] t = {sim.time_s:7.4f} s  KE = {sim.kinetic_energy():9.3e} J  "
-                  f"{rate:9.3e} particle-steps/s", file=sys.stderr, flush=True)
-
         try:
             res = vibrate_bed(centers, radii, container, freq_hz=args.freq, amplitude_m=amp, duration_s=args.duration,
-                          material=material, mass_scale=args.mass_scale, record_every_s=args.record_every,
-                          snapshot_times_s=args.snapshots, max_settle_steps=args.settle_steps,
-                          progress=progress)
-        except ValueError as e:
-            print(f"error: {e}", file=sys.stderr)
-            return 2
+                              material=material, mass_scale=args.mass_scale, record_every_s=args.record_every,
+                              snapshot_times_s=args.snapshots, max_settle_steps=args.settle_steps,
+                              progress=progress_printer(f"A={amp * 1e3:.1f} mm ", quiet=args.quiet))
         except DemInstabilityError as e:
-            print(f"unstable at A = {amp} m, nothing written: {e}", file=sys.stderr)
-            return 3
+            raise DemInstabilityError(f"A = {amp} m: {e}") from e
         tag = f"vib_{amp * 1e3:g}mm"
         s = res.summary
         s["wall_time_s"] = time.perf_counter() - t0
@@ -121,6 +101,10 @@ def main(argv=None) -> int:
         best = min(rows, key=lambda r: r["porosity_interior_after"])
         print(f"lowest porosity at {best['intensity_g']:.2f} g ({100 * best['relative_change_interior']:+.2f} %)")
     return 0
+
+
+def main(argv=None) -> int:
+    return run_main(_parser(), _vibrate, argv)
 
 
 if __name__ == "__main__":

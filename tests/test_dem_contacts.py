@@ -3,8 +3,8 @@
 import numpy as np
 import pytest
 
-from dem import Material, Simulation, restitution_coefficient, series_stiffness
-from dem._walls import CylinderWall, PlaneWall
+from dem import (CylinderWall, DemInstabilityError, Material, PlaneWall, Simulation, restitution_coefficient,
+                 series_stiffness)
 
 R = 0.00325  # m, mean soybean radius (thesis Table 3.1: 5.5-7.5 mm diameters)
 
@@ -154,8 +154,6 @@ def test_verlet_list_rebuilds_only_after_half_skin():
 
 
 def test_instability_and_escape_stop_with_clear_messages():
-    from dem import DemInstabilityError
-
     sim = Simulation([[0, 0, 0.01]], [R], [], Material(), gravity_m_s2=0.0,
                      bounds_m=[[-0.05, -0.05, 0.0], [0.05, 0.05, 0.05]])
     sim.velocities[:] = [[0, 0, 50.0]]  # energy blow-up signature

@@ -1,15 +1,14 @@
 """Packing procedures of dem.pack (issue 5, rect-bin target interior porosity 0.408 ± 0.01).
 
-The full rect-bin is measured by ``python -m dem.pack --scene rect-bin`` (numbers in the
-dem._scenes module notes); here a 0.06 × 0.02 m slab with rect-bin's thickness (about three
+The full rect-bin is measured by ``python -m dem.pack --scene rect-bin`` (numbers in
+docs/dem-packing.md); here a 0.06 × 0.02 m slab with rect-bin's thickness (about three
 grains) checks that the 'sediment' procedure does what it says, with short stages.
 """
 
 import numpy as np
 import pytest
 
-from dem import Container, pack_bed
-from dem._scenes import SCENE_DEFAULTS
+from dem import SCENE_DEFAULTS, Container, pack_bed
 
 SLAB = Container("box", (0.06, 0.02), 0.06)
 SHORT = dict(rng=3, grow_steps=1000, tol=1e-2, max_steps=4000)

@@ -3,11 +3,9 @@
 import numpy as np
 import pytest
 
-from dem import (Container, Material, Region, SCENES, pack_bed, porosity_in_region, porosity_in_spheres,
-                 read_packing, thesis_particle_count, write_packing)
-from dem._measure import coordination_numbers, lens_volume, sphere_volume
-from dem._scenes import generate_spheres
-from dem._vibrate import intensity_g
+from dem import (SCENES, Container, Material, Region, coordination_numbers, generate_spheres, intensity_g,
+                 lens_volume, pack_bed, porosity_in_region, porosity_in_spheres, read_packing, sphere_volume,
+                 thesis_particle_count, vibrate_bed, write_packing)
 
 TINY = Container("box", (0.03, 0.02), 0.03)
 
@@ -121,8 +119,6 @@ def test_same_seed_same_packing_and_io_roundtrip(tmp_path, tiny_bed):
 
 
 def test_vibration_records_histories(tiny_bed):
-    from dem import vibrate_bed
-
     res = vibrate_bed(tiny_bed.centers, tiny_bed.radii, TINY, freq_hz=15, amplitude_m=0.0, duration_s=0.02,
                   record_every_s=0.005, snapshot_times_s=[0.01], max_settle_steps=200)
     # 0.02 s recorded every 0.005 s, plus the initial and the post-settling records
@@ -163,5 +159,5 @@ def test_cli_modules_do_not_shadow_the_library_functions():
     importlib.import_module("dem.pack")
     importlib.import_module("dem.vibrate")
     assert callable(dem.pack_bed) and callable(dem.vibrate_bed)
-    assert dem.pack_bed.__module__ == "dem._scenes"
+    assert dem.pack_bed.__module__ == "dem._procedures"
     assert dem.vibrate_bed.__module__ == "dem._vibrate"

@@ -1,0 +1,75 @@
+"""What the dem command lines share: process setup, exit codes, progress lines, the container.
+
+``python -m dem.pack`` and ``python -m dem.vibrate`` (and the vibration study) run their body
+through :func:`run_main`: malloc tuning (:mod:`dem._perf`), argument parsing, and one mapping
+of failures to exit codes: 2 for bad input (``ValueError``, ``OSError``), 3 for a simulation
+that went unstable (:class:`~dem._integrate.DemInstabilityError`). No physics here.
+"""
+
+from __future__ import annotations
+
+import sys
+import time
+
+from ._container import SCENES, Container
+from ._integrate import DemInstabilityError
+from ._perf import tune_malloc
+
+__all__ = ["EXIT_BAD_INPUT", "EXIT_UNSTABLE", "run_main", "progress_printer", "resolve_container"]
+
+EXIT_BAD_INPUT = 2
+EXIT_UNSTABLE = 3
+
+
+def run_main(parser, body, argv=None) -> int:
+    """Parse ``argv`` with ``parser`` and return ``body(args)``, mapping failures to exit codes.
+
+    A ``ValueError`` or ``OSError`` prints ``error: ...`` and returns 2; a
+    ``DemInstabilityError`` prints ``unstable: ...`` and returns 3 (what was written before it
+    stays). argparse's own errors exit 2 as usual.
+    """
+    tune_malloc()
+    args = parser.parse_args(argv)
+    try:
+        return body(args)
+    except (ValueError, OSError) as e:
+        print(f"error: {e}", file=sys.stderr)
+        return EXIT_BAD_INPUT
+    except DemInstabilityError as e:
+        print(f"unstable, not written: {e}", file=sys.stderr)
+        return EXIT_UNSTABLE
+
+
+def progress_printer(label="", *, quiet=False, every_steps=2000):
+    """Progress callback ``(stage, sim, force)`` printing one line to stderr every ``every_steps``.
+
+    The line gives the stage, step, simulated time, kinetic energy, the unbalanced-force ratio
+    (when ``force`` is given) and the particle-steps per second since the printer was made.
+    """
+    t0 = time.perf_counter()
+
+    def progress(stage, sim, force):
+        if quiet or sim.steps % every_steps != 0:
+            return
+        rate = sim.steps * sim.n / (time.perf_counter() - t0)
+        ratio = "" if force is None else f"  ratio = {sim.unbalanced_force_ratio(force):8.2e}"
+        print(f"[{label}{stage:7s}] step {sim.steps:7d}  t = {sim.time_s:7.4f} s  KE = {sim.kinetic_energy():9.3e} J"
+              f"{ratio}  {rate:9.3e} particle-steps/s", file=sys.stderr, flush=True)
+
+    return progress
+
+
+def resolve_container(scene, *, size_m=None, height_m=None, summary=None):
+    """The container of a command line: a named scene, ``box``/``cylinder`` with size and
+    height, or the ``container`` entry of a packing's JSON summary (in that order)."""
+    if scene in SCENES:
+        return SCENES[scene]
+    if scene in ("box", "cylinder"):
+        if size_m is None or height_m is None:
+            raise ValueError(f"--scene {scene} needs --size and --height")
+        return Container(scene, tuple(size_m), height_m)
+    if scene is not None:
+        raise ValueError(f"unknown scene {scene!r}; choose from {sorted(SCENES)} or 'box'/'cylinder'")
+    if summary and "container" in summary:
+        return Container.from_dict(summary["container"])
+    raise ValueError("no container: give --scene or keep the packing's JSON summary beside it")
