@@ -1,0 +1,68 @@
+"""dem.bench: the rate scene and the JSON it writes (issue 12: benchmarks get tests)."""
+
+import importlib
+import json
+import math
+
+import numpy as np
+import pytest
+
+from dem import Container
+
+bench = importlib.import_module("dem.bench")
+
+#: 2 * 4^3 = 128 spheres: a complete 4 x 4 x 8 simple cubic lattice (lattice_simulation's layout)
+N = 128
+#: lattice bonds of a 4 x 4 x 8 simple cubic lattice: 3*4*8 (x) + 4*3*8 (y) + 4*4*7 (z)
+BONDS = 3 * 4 * 8 + 4 * 3 * 8 + 4 * 4 * 7
+
+
+def test_lattice_scene_is_a_touching_simple_cubic_lattice():
+    sim = bench.lattice_simulation(N)
+    assert sim.n == N
+    np.testing.assert_allclose(sim.radii, 0.00325 * (1 + 1e-4), rtol=1e-15)
+    sim.step()
+    # radii 1e-4 larger than half the 6.5 mm spacing: every lattice bond touches, no diagonal
+    # (6.5 mm * sqrt 2 is far beyond the 0.1 r skin), so pairs = contacts = bonds
+    assert len(sim.verlet.pairs) == BONDS
+    assert len(sim.contact_fn) == BONDS
+    # overlap 2 * 3.25e-7 m at k = 2e6 N/m: F_n = 1.3 N (noise 1e-7 m and gravity move it a little)
+    assert np.median(sim.contact_fn) == pytest.approx(2e6 * 6.5e-7, rel=0.5)
+
+
+def test_rate_returns_a_positive_finite_rate_for_the_right_count():
+    r = bench.rate(N, steps=10, repeat=2)
+    assert r["n"] == N and r["steps"] == 10
+    assert r["pairs"] == BONDS and r["contacts"] == BONDS
+    assert len(r["seconds"]) == 2 and r["rebuilds"] >= 1
+    for key in ("rate_best", "rate_median", "rate_per_cpu_s_best", "ms_per_step_best"):
+        assert math.isfinite(r[key]) and r[key] > 0
+    # the rate is particle-steps over the best wall time, and ms/step the same time per step
+    assert r["rate_best"] == pytest.approx(N * 10 / min(r["seconds"]), rel=1e-12)
+    assert r["ms_per_step_best"] == pytest.approx(1e3 * min(r["seconds"]) / 10, rel=1e-12)
+    assert r["rate_best"] >= r["rate_median"]
+
+
+def test_bench_json_has_what_it_prints(tmp_path, capsys):
+    out = tmp_path / "b.json"
+    assert bench.main(["--n", str(N), "64", "--steps", "5", "--repeat", "1", "--json", str(out)]) == 0
+    printed = capsys.readouterr().out
+    assert "p-steps/s best" in printed and "load average" in printed and str(out) in printed
+    data = json.loads(out.read_text())
+    assert [row["n"] for row in data["rates"]] == [N, 64]
+    for row in data["rates"]:
+        # one key per printed column: N, pairs, contacts, ms/step, best, median, per CPU-s
+        assert {"n", "pairs", "contacts", "ms_per_step_best", "rate_best", "rate_median",
+                "rate_per_cpu_s_best"} <= set(row)
+    meta = data["meta"]
+    assert {"loadavg_before", "loadavg_after", "cpu_count", "platform", "numpy", "timestamp"} <= set(meta)
+    assert len(meta["loadavg_before"]) == 3
+
+
+def test_lattice_box_holds_the_lattice():
+    sim = bench.lattice_simulation(N)
+    x = sim.centers
+    # the closed box of the scene: 4 x 4 cells wide, 8 high, every sphere inside
+    box = Container("box", (4 * 0.0065, 4 * 0.0065), 8 * 0.0065)
+    assert np.all(np.abs(x[:, :2]) + sim.radii[:, None] <= np.array(box.size_m) / 2 + 1e-6)
+    assert np.all((x[:, 2] - sim.radii >= -1e-6) & (x[:, 2] + sim.radii <= box.fill_height_m + 1e-6))
