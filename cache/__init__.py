@@ -25,19 +25,11 @@ GridSpec, GridTable, GRIDS, grid_coordinates, load_grid_table
 
 Command lines: ``python -m cache.precompute``, ``python -m cache.lookup``, ``python -m cache.bench``.
 
-The interpolation table
------------------------
-``cache/data/grid_g1.npz`` (shipped, about 5 MB) holds Q* at the 390 625 nodes of grid
-``g1`` (gaps -0.2 … 2.2 r̄ step 0.1, radius deviations -0.25 … 0.25 step 0.125; 105 427
-distinct shapes after symmetry), solved by ``throats.solve_fem`` at rtol 1e-3.  It is served
-only while ``throats.SOLVER_VERSION`` equals the version it was built with.  Rebuild it (both
-commands resume where they stopped; g2 is g1's coarse sub-grid, reused by g1)::
-
-    python -m cache.precompute --db throats.sqlite --grid g2 --workers 1 --export cache/data/grid_g2.npz
-    python -m cache.precompute --db throats.sqlite --grid g1 --workers 1 --export cache/data/grid_g1.npz
-
-Accuracy and speed are measured by ``python -m cache.bench`` (see its docstring).
-``cache`` never imports ``network`` (data flows network → cache through CSV files) and never
+The shipped table ``cache/data/grid_g1.npz`` (Q* at the 390 625 nodes of grid ``g1``, solved
+by ``throats.solve_fem`` at rtol 1e-3) is served only while ``throats.SOLVER_VERSION`` equals
+the version it was built with; how it was built and how to rebuild it:
+``docs/cache-table.md``.  Accuracy and speed: ``python -m cache.bench``.  ``cache`` never
+imports ``network`` (data flows network → cache through arrays and CSV files) and never
 meshes or solves itself: it calls ``throats``.
 """
 

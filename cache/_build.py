@@ -28,7 +28,8 @@ from ._signature import as_throats, shape_keys, signature
 
 logger = logging.getLogger(__name__)
 
-__all__ = ["precompute_throats", "precompute_grid", "PrecomputeSummary", "default_solver"]
+__all__ = ["precompute_throats", "precompute_grid", "PrecomputeSummary", "default_solver",
+           "resolve_solver"]
 
 
 @dataclass
@@ -57,11 +58,13 @@ def default_solver():
     return throats.solve_fem, throats.SOLVER_VERSION
 
 
-def _resolve_solver(solver, solver_version):
-    if solver is None:
-        from . import _build  # look the default up at call time (tests may patch it)
+def resolve_solver(solver, solver_version):
+    """``(solver, solver_version)``: the injected pair, or :func:`default_solver`'s.
 
-        solver, version = _build.default_solver()
+    ``default_solver`` is looked up at call time (a module global), so tests may patch it.
+    """
+    if solver is None:
+        solver, version = default_solver()
         return solver, (version if solver_version is None else solver_version)
     if solver_version is None:
         solver_version = getattr(solver, "SOLVER_VERSION", None)
@@ -137,7 +140,7 @@ def precompute_throats(store, radii, sides, *, rtol=1e-3, solver=None, solver_ve
         raise ValueError(f"workers and batch_size must be >= 1, got {workers}, {batch_size}")
     if not rtol > 0:
         raise ValueError(f"rtol must be > 0, got {rtol}")
-    solver, solver_version = _resolve_solver(solver, solver_version)
+    solver, solver_version = resolve_solver(solver, solver_version)
     summary = PrecomputeSummary(n_input=len(r))
 
     validate = throats.validate_throats
@@ -243,7 +246,7 @@ def precompute_grid(store, spec, *, rtol=1e-3, solver=None, solver_version=None,
 
     Keyword arguments go to :func:`precompute_throats`; returns its summary.
     """
-    solver, solver_version = _resolve_solver(solver, solver_version)
+    solver, solver_version = resolve_solver(solver, solver_version)
     d = spec.to_dict()
     d.update(rtol=float(rtol), solver_version=str(solver_version))
     store.put_grid(spec.name, d)

@@ -346,8 +346,9 @@ def _second_difference(v, a, axis):
     return np.moveaxis(out, 0, axis)
 
 
-def _cell_mean(a):
-    """Mean over the 2^5 corners of each cell, stored at the cell's lower node."""
+def _cell_reduce(a, pair, last=None):
+    """Reduce each cell's 2^5 corners with ``pair(lower, upper)`` one axis at a time, stored at
+    the cell's lower node (same shape as ``a``); ``last`` overwrites the last layer of each axis."""
     out = a.copy()
     for d in range(a.ndim):
         if a.shape[d] == 1:
@@ -356,39 +357,27 @@ def _cell_mean(a):
         hi = [slice(None)] * a.ndim
         lo[d] = slice(0, -1)
         hi[d] = slice(1, None)
-        out[tuple(lo)] = 0.5 * (out[tuple(lo)] + out[tuple(hi)])
+        out[tuple(lo)] = pair(out[tuple(lo)], out[tuple(hi)])
+        if last is not None:
+            edge = [slice(None)] * a.ndim
+            edge[d] = -1
+            out[tuple(edge)] = last
     return out
+
+
+def _cell_mean(a):
+    """Mean over the 2^5 corners of each cell, stored at the cell's lower node."""
+    return _cell_reduce(a, lambda lo, hi: 0.5 * (lo + hi))
 
 
 def _cell_max(a):
     """Max over the 2^5 corners of each cell, stored at the cell's lower node (same shape as a)."""
-    out = a.copy()
-    for d in range(a.ndim):
-        if a.shape[d] == 1:
-            continue
-        sl_lo = [slice(None)] * a.ndim
-        sl_hi = [slice(None)] * a.ndim
-        sl_lo[d] = slice(0, -1)
-        sl_hi[d] = slice(1, None)
-        out[tuple(sl_lo)] = np.maximum(out[tuple(sl_lo)], out[tuple(sl_hi)])
-    return out
+    return _cell_reduce(a, np.maximum)
 
 
 def _cell_all(mask):
     """True where all corners of the cell at that lower node are True (last layers: False)."""
-    out = mask.copy()
-    for d in range(mask.ndim):
-        if mask.shape[d] == 1:
-            continue
-        sl_lo = [slice(None)] * mask.ndim
-        sl_hi = [slice(None)] * mask.ndim
-        sl_lo[d] = slice(0, -1)
-        sl_hi[d] = slice(1, None)
-        out[tuple(sl_lo)] &= out[tuple(sl_hi)]
-        last = [slice(None)] * mask.ndim
-        last[d] = -1
-        out[tuple(last)] = False
-    return out
+    return _cell_reduce(mask, np.logical_and, last=False)
 
 
 def _fill_nan(v, max_sweeps=50):

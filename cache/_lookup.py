@@ -33,7 +33,7 @@ import numpy as np
 import throats
 
 from . import _build
-from ._build import _resolve_solver, precompute_throats
+from ._build import precompute_throats, resolve_solver
 from ._interp import GridSpec, GridTable, grid_coordinates
 from ._signature import as_throats, match_keys, shape_keys, signature
 from ._store import open_store
@@ -41,7 +41,7 @@ from ._store import open_store
 logger = logging.getLogger(__name__)
 
 __all__ = ["Lookup", "lookup_qstar", "default_db_path", "load_grid_table", "POLICIES",
-           "export_grid", "shipped_grid_path"]
+           "export_grid", "grid_from_store", "shipped_grid_path"]
 
 POLICIES = ("table-only", "table+fe", "fe-only", "shape-factor")
 _DATA = Path(__file__).resolve().parent / "data"
@@ -89,7 +89,12 @@ def shipped_grid_path(name=DEFAULT_GRID):
 _TABLES: dict = {}
 
 
-def _grid_from_store(store, name, solver_version):
+def grid_from_store(store, name, solver_version):
+    """The :class:`GridTable` of grid ``name`` in ``store`` for ``solver_version`` (None if absent).
+
+    Nodes not solved yet are NaN (cells with such corners are never served); the table's
+    ``n_missing`` counts the valid nodes still to solve.
+    """
     spec_d = store.grid(name)
     if spec_d is None:
         return None
@@ -120,7 +125,7 @@ def export_grid(store, name, path, *, solver_version):
     """Write grid ``name`` of ``store`` as a compact ``.npz`` (spec, node Q*, node FE errors)."""
     import json
 
-    table = _grid_from_store(store, name, solver_version)
+    table = grid_from_store(store, name, solver_version)
     if table is None:
         raise ValueError(f"{store.path} holds no grid named {name!r} (grids: {store.grid_names()})")
     spec = dict(store.grid(name))
@@ -151,7 +156,7 @@ def load_grid_table(db=None, *, grid=None, solver_version=None):
             with open_store(path, create=False) as store:
                 names = store.grid_names()
                 name = grid if grid is not None else (names[-1] if names else None)
-                table = _grid_from_store(store, name, solver_version) if name in names else None
+                table = grid_from_store(store, name, solver_version) if name in names else None
             if table is not None:
                 _TABLES[key] = (mtime, table.n_missing == 0, table)
         if table is not None and table.n_missing == 0:
@@ -249,7 +254,7 @@ def lookup_qstar(radii, sides, *, db=None, policy="table+fe", rtol=1e-3, workers
         src[pending] = "shape-factor"
     else:
         if solver is not None or policy != "table-only":
-            solver, solver_version = _resolve_solver(solver, solver_version)
+            solver, solver_version = resolve_solver(solver, solver_version)
         elif solver_version is None:
             solver_version = _build.default_solver()[1]
         if policy in ("table-only", "table+fe"):

@@ -32,8 +32,8 @@ def signature(radii, sides):
 
     Parameters
     ----------
-    radii, sides : (N, 3) array_like, any consistent length unit
-        ``[r1, r2, r3]`` and ``[l12, l13, l23]``.
+    radii, sides : (N, 3) array_like
+        A throat a row (``[r1, r2, r3]``, ``[l12, l13, l23]``); the unit drops out.
 
     Returns
     -------

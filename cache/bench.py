@@ -2,8 +2,8 @@
 
     python -m cache.bench [--db throats.sqlite] [--n-fe 300] [--seed 2024] [--out cache_bench.json]
 
-1. Held-out throats: a random packing of 5.5–7.5 mm spheres (``cache._sample``, seed
-   ``--seed``), ``--n-fe`` of its Delaunay faces; reference Q* by FE at ``rtol=1e-4``
+1. Held-out throats: ``--n-fe`` Delaunay faces of random 5.5–7.5 mm packings
+   (``network.sample_throats``, seed ``--seed``); reference Q* by FE at ``rtol=1e-4``
    (``throats.solve_fem``).  No grid is built from packings, so these are never table nodes.
 2. For every grid table in ``--db`` (and the shipped one): interpolation error (median, p90,
    p99, max) against the reference, coverage (rows with a finite error estimate), and how
@@ -32,6 +32,13 @@ import time
 from pathlib import Path
 
 import numpy as np
+
+import network
+import throats
+
+from ._interp import GridSpec, GridTable, grid_coordinates
+from ._lookup import default_db_path, grid_from_store, lookup_qstar, shipped_grid_path
+from ._store import open_store
 
 
 def _pct(err):
@@ -70,13 +77,7 @@ def build_parser():
 
 def main(argv=None) -> int:
     args = build_parser().parse_args(argv)
-    import cache
-    import throats
-    from cache._interp import GridSpec, GridTable
-    from cache._lookup import _grid_from_store, shipped_grid_path
-    from cache._sample import _sample_throats
-
-    db = Path(args.db) if args.db else cache.default_db_path()
+    db = Path(args.db) if args.db else default_db_path()
     version = throats.SOLVER_VERSION
     res = {"timestamp": _dt.datetime.now(_dt.timezone.utc).isoformat(timespec="seconds"),
            "platform": platform.platform(), "python": sys.version.split()[0],
@@ -90,7 +91,7 @@ def main(argv=None) -> int:
         r, s, q_ref, q_fe = z["radii"], z["sides"], z["q_ref"], z["q_fe"]
         t_fe, c_fe = float(z["t_fe"]), float(z["c_fe"])
     else:
-        r, s = _sample_throats(args.n_fe, rng=args.seed)
+        r, s = network.sample_throats(args.n_fe, rng=args.seed)
         ref = throats.solve_fem(r, s, rtol=1e-4)
         c0, t0 = time.process_time(), time.perf_counter()
         fe = throats.solve_fem(r, s, rtol=1e-3)
@@ -111,9 +112,9 @@ def main(argv=None) -> int:
     # 2. grid tables ------------------------------------------------------------------------
     tables = {}
     if db.exists():
-        with cache.open_store(db, create=False) as st:
+        with open_store(db, create=False) as st:
             for name in st.grid_names():
-                t = _grid_from_store(st, name, version)
+                t = grid_from_store(st, name, version)
                 if t is not None:
                     tables[f"{name} (db)"] = t
             res["table_rows"] = st.count()
@@ -129,7 +130,7 @@ def main(argv=None) -> int:
                 tables[f"{name} (shipped)"] = GridTable(
                     GridSpec.from_dict(json.loads(str(z["spec"]))), z["qstar"], z["fe_error"])
                 res[f"shipped_{name}_bytes"] = sp.stat().st_size
-    x = cache.grid_coordinates(r, s)
+    x = grid_coordinates(r, s)
     res["tables"] = {}
     for name, t in tables.items():
         for curv in (False, True):
@@ -155,17 +156,17 @@ def main(argv=None) -> int:
         best = next(iter(tables))
     if best is not None:
         t = tables[best]
-        lk, w, c = _timed(lambda: cache.lookup_qstar(r, s, db=db, policy="table-only", table=t), 1)
+        lk, w, c = _timed(lambda: lookup_qstar(r, s, db=db, policy="table-only", table=t), 1)
         rows.append((f"table-only [{best}]", _pct(rel(lk.qstar)), w[0] / n, c[0] / n,
                      float(np.mean(lk.source == "shape-factor"))))
         for rt in [float(v) for v in args.rtols.split(",") if v]:
             with tempfile.TemporaryDirectory() as tmp:
                 scratch = Path(tmp) / "scratch.sqlite"
                 if db.exists():
-                    with cache.open_store(db, create=False) as st:  # consistent copy (WAL)
+                    with open_store(db, create=False) as st:  # consistent copy (WAL)
                         st.conn.execute("PRAGMA wal_checkpoint(FULL)")
                     shutil.copy(db, scratch)
-                lk, w, c = _timed(lambda: cache.lookup_qstar(r, s, db=scratch, policy="table+fe",
+                lk, w, c = _timed(lambda: lookup_qstar(r, s, db=scratch, policy="table+fe",
                                                              rtol=rt, table=t), 1)
             rows.append((f"table+fe rtol={rt:g} [{best}]", _pct(rel(lk.qstar)), w[0] / n,
                          c[0] / n, lk.stats["n_fe"] / n))
@@ -181,12 +182,12 @@ def main(argv=None) -> int:
         rb, sb = r[idx] * rng.uniform(0.5, 2.0, (args.n_batch, 1)), None
         sb = s[idx] * (rb[:, :1] / r[idx][:, :1])
         t = tables[best]
-        _, walls, cpus = _timed(lambda: cache.lookup_qstar(rb, sb, db=db, policy="table-only",
+        _, walls, cpus = _timed(lambda: lookup_qstar(rb, sb, db=db, policy="table-only",
                                                            table=t), args.repeat)
         res["throughput_table_only"] = {"n": args.n_batch, "wall_s": walls, "cpu_s": cpus,
                                         "rows_per_s_wall_best": args.n_batch / min(walls),
                                         "rows_per_s_cpu_best": args.n_batch / min(cpus)}
-        xb = cache.grid_coordinates(rb, sb)
+        xb = grid_coordinates(rb, sb)
         _, walls, cpus = _timed(lambda: t(xb), args.repeat)
         res["throughput_interp_kernel"] = {"n": args.n_batch, "wall_s": walls, "cpu_s": cpus,
                                            "rows_per_s_cpu_best": args.n_batch / min(cpus)}

@@ -21,7 +21,7 @@ import json
 import logging
 import sys
 
-from ._build import _resolve_solver, precompute_grid, precompute_throats
+from ._build import precompute_grid, precompute_throats, resolve_solver
 from ._csvio import read_throat_csv
 from ._interp import GRIDS
 from ._lookup import export_grid
@@ -48,7 +48,7 @@ def main(argv=None) -> int:
     args = build_parser().parse_args(argv)
     logging.basicConfig(level=logging.INFO, format="%(levelname)s %(name)s: %(message)s")
     try:
-        solver, version = _resolve_solver(None, None)
+        solver, version = resolve_solver(None, None)
     except ImportError as e:
         print(f"error: {e}", file=sys.stderr)
         return 2

@@ -7,6 +7,7 @@ import numpy as np
 import pytest
 
 import cache
+import network
 from cache import GRIDS, GridSpec, GridTable, grid_coordinates, lookup_qstar, open_store
 from cache import precompute as precompute_cli
 from cache import lookup as lookup_cli
@@ -183,8 +184,6 @@ def test_shipped_table_serves_current_solver_within_its_estimate(tmp_path):
 
     from throats import SOLVER_VERSION, solve_fem
 
-    from cache._sample import _sample_throats
-
     path = cache.shipped_grid_path()
     z = np.load(path)
     assert str(z["solver_version"]) == SOLVER_VERSION, (
@@ -192,7 +191,7 @@ def test_shipped_table_serves_current_solver_within_its_estimate(tmp_path):
         "rebuild it (see the cache package docstring)")
     spec = json.loads(str(z["spec"]))
     assert spec["name"] == "g1" and z["qstar"].size == 25**3 * 5**2
-    r, s = _sample_throats(12, n_spheres=400, rng=31)
+    r, s = network.sample_throats(12, n_spheres=400, rng=31)
     fe = solve_fem(r, s, rtol=1e-3).qstar
     res = lookup_qstar(r, s, db=tmp_path / "none.sqlite", policy="table-only")
     err = np.abs(res.qstar / fe - 1)

@@ -3,9 +3,10 @@
 import numpy as np
 import pytest
 
+import network
 from throats import canonical_form, contact_type, shape_factor_qstar, solve_fem
-from throats._sampling import sample_throats
-from throats._shape_factor import FIT, _exact_area_perimeter, open_area_perimeter
+from throats._area import exact_area_perimeter, open_area_perimeter
+from throats._shape_factor import FIT
 
 
 def test_closed_form_area_and_perimeter_match_exact_engine():
@@ -22,7 +23,7 @@ def test_closed_form_area_and_perimeter_match_exact_engine():
     keep &= np.all(r < np.minimum(s[:, [0, 0, 1]], s[:, [1, 2, 2]]), axis=1)
     rs, ss = canonical_form(r[keep], s[keep])
     a, per = open_area_perimeter(rs, ss)
-    a_ex, per_ex = _exact_area_perimeter(rs, ss)
+    a_ex, per_ex = exact_area_perimeter(rs, ss)
     np.testing.assert_allclose(a, a_ex, atol=1e-12)
     np.testing.assert_allclose(per, per_ex, atol=1e-12)
 
@@ -36,7 +37,7 @@ def test_three_touching_disks_perimeter_is_half_circle():
 
 def test_fit_constants_reproduce_stated_error_on_fresh_throats():
     # fresh packing (seed not in the fit): median error within the recorded fit's 1.5x
-    r, s = sample_throats(40, rng=11)
+    r, s = network.sample_throats(40, rng=11)
     q_fe = solve_fem(r, s, rtol=1e-3).qstar
     err = np.abs(shape_factor_qstar(r, s) / q_fe - 1)
     assert np.median(err) < 1.5 * FIT["median_rel_error"]

@@ -4,8 +4,8 @@ import numpy as np
 import pytest
 
 from throats import SOLVER_VERSION, canonical_form, solve_fem
-from throats._mesh import (ThroatGeometry, build_geometries, disk_geometry, mesh_geometry,
-                           polygon_geometry)
+from throats._mesh import ThroatGeometry, build_geometries, disk_geometry, polygon_geometry
+from throats._trimesh import mesh_geometry
 from throats._solve import _fe_solve, _solve_geometry
 
 PERMS = [(0, 1, 2), (0, 2, 1), (1, 0, 2), (1, 2, 0), (2, 0, 1), (2, 1, 0)]
@@ -195,7 +195,7 @@ def test_random_extreme_throats_all_solve():
 
 
 def test_folded_curved_element_is_detected():
-    from throats._mesh import TriMesh
+    from throats._trimesh import TriMesh
     g = build_geometries([[1, 1, 1]], [[2.2, 2.2, 2.2]])[0]
     m = mesh_geometry(g, 0.6)
     p = m.p.copy()

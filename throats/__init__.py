@@ -9,43 +9,31 @@ dimensional conductance is g = Q* r̄⁴/(μL), formed by ``network``, not here.
 
 Public functions
 ----------------
-canonical_form
-    Scale/permutation/mirror-invariant form of a throat (units of r̄).
-contact_type
-    Contact type 'a' | 'b' | 'c' | 'd' (thesis Fig. 3.17).
-open_area
-    Exact open area, also for overlapping disks and disks covering the triangle.
-validate_throats
-    Row checks: ``(ok_mask, messages)``.
-as_throats
-    Shape check at the door: two float (N, 3) arrays.
-triangle_vertices
-    Planar vertex coordinates of the triangles.
-triangle_area
-    Triangle area from the sides (Heron, Kahan's stable form).
+canonical_form, contact_type
+    Scale/permutation/mirror-invariant form (units of r̄); contact type 'a'-'d' (Fig. 3.17).
+open_area, triangle_area, triangle_vertices
+    Exact open area (also for overlapping disks and disks covering the triangle); the triangle.
+validate_throats, as_throats
+    Row checks ``(ok_mask, messages)``; shape check at the door (two float (N, 3) arrays).
 shape_factor_qstar
-    Fast Q* estimate in the Patzek & Silin (2001) form c_t A² G, fitted per contact type
-    (median error 21 %, 95th percentile 54 % against FE; over 1e6 throats/s).
-solve_fem
-    Q* by finite elements (gmsh + scikit-fem), batch, ``rtol``-driven, with an error
-    estimate; returns a ``ThroatSolution``.
-SOLVER_VERSION
-    Version string of the numerical method (bumped whenever results could change).
+    Fast Q* estimate c_t A² G (Patzek & Silin 2001) fitted per contact type, over 1e6
+    throats/s; median error about 20 % against FE (``docs/throats-shape-factor.md``).
+solve_fem, ThroatSolution, SOLVER_VERSION
+    Q* by finite elements (gmsh + scikit-fem), batch, ``rtol``-driven, with an error estimate;
+    the version string is bumped whenever results could change.
 
-Command line
-------------
-``python -m throats.solve``
-    One throat (JSON) or a CSV of throats, ``--method fem|shape-factor``.
-``python -m throats.bench``
-    Time per throat against error for FE tolerances and the shape factor (table + JSON).
+Command line: ``python -m throats.solve`` (one throat as JSON, or a CSV of throats,
+``--method fem|shape-factor``); ``python -m throats.bench`` (time per throat against error).
 
-Method notes: passages narrower than 0.01 r̄ (tangent, overlapping or nearly touching disks)
-are closed by short no-slip cuts (:mod:`throats._mesh`, error < 2e-5 measured); the FE solve
-uses curved quadratic gmsh triangles and Lagrange P3/P4 (:mod:`throats._solve`).
+Method (closing rule for passages narrower than 0.01 r̄, curved quadratic gmsh triangles,
+Lagrange P3/P4, the error estimate, and what each was measured to cost) in
+``docs/throats-method.md``; modules, lowest first: ``_geometry``, ``_boundary``, ``_area``,
+``_shape_factor``, ``_mesh``, ``_trimesh``, ``_solve``.
 """
 
-from ._geometry import (as_throats, canonical_form, contact_type, open_area, triangle_area,
-                        triangle_vertices, validate_throats)
+from ._area import open_area
+from ._geometry import (as_throats, canonical_form, contact_type, triangle_area, triangle_vertices,
+                        validate_throats)
 from ._shape_factor import shape_factor_qstar
 from ._solve import SOLVER_VERSION, ThroatSolution, solve_fem
 

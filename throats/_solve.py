@@ -35,9 +35,10 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ._geometry import (as_throats, canonical_form, contact_type, mean_radius, open_area,
-                        validate_throats)
-from ._mesh import DELTA_DEFAULT, ThroatGeometry, TriMesh, build_geometries, mesh_geometry
+from ._area import open_area
+from ._geometry import as_throats, canonical_form, contact_type, mean_radius, validate_throats
+from ._mesh import DELTA_DEFAULT, ThroatGeometry, build_geometries
+from ._trimesh import TriMesh, mesh_geometry, start_gmsh
 
 __all__ = ["SOLVER_VERSION", "ThroatSolution", "solve_fem"]
 
@@ -281,9 +282,7 @@ def _solve_geometry(geom, rtol, *, max_refine=2, delta=DELTA_DEFAULT):
 
 def _solve_chunk(radii, sides, rtol, delta):
     """Solve N valid throats in this process (geometry vectorised, one mesh per throat)."""
-    from ._mesh import _gmsh
-
-    _gmsh()                      # initialise gmsh and import skfem outside the timings
+    start_gmsh()                 # initialise gmsh and import skfem outside the timings
     _reference(4, 8)
     rs, ss = canonical_form(radii, sides)
     try:

@@ -4,9 +4,10 @@ shape-factor estimate.
     python -m throats.bench [--n 200] [--seed 1] [--rtols 1e-2 3e-3 1e-3 1e-4]
                             [--json throats_bench.json] [--fit]
 
-Throats: ``--n`` interior Delaunay faces of a random 5.5–7.5 mm packing
-(:mod:`throats._sampling`) plus hand-made hard cases (tangent and overlapping disks, gaps
-of 1e-4 r̄, a disk across the opposite side, slivers, large radius ratios).  The reference
+Throats: ``--n`` interior Delaunay faces of random 5.5–7.5 mm packings
+(``network.sample_throats``, the project's one sampler) plus hand-made hard cases (tangent
+and overlapping disks, gaps of 1e-4 r̄, a disk across the opposite side, slivers, large
+radius ratios).  The reference
 is the finest solve: ``solve_fem(rtol=1e-6, delta=0.002)`` (five times narrower closing
 width, so the closing-rule error is part of the measured error).  Each FE tolerance is run
 twice and the per-throat minimum time is kept (the machine is shared); the process is pinned
@@ -26,6 +27,13 @@ import sys
 import time
 
 import numpy as np
+
+import network
+
+from ._area import open_area_perimeter
+from ._geometry import canonical_form, contact_type
+from ._shape_factor import shape_factor_qstar
+from ._solve import SOLVER_VERSION, solve_fem
 
 HARD_CASES = {
     # name: (radii, sides)
@@ -68,10 +76,7 @@ def run(n=200, seed=1, rtols=(1e-2, 3e-3, 1e-3, 1e-4), repeats=2):
 
 def _run(n, seed, rtols, repeats):
     load_start = list(os.getloadavg())
-    from throats import SOLVER_VERSION, contact_type, shape_factor_qstar, solve_fem
-    from throats._sampling import sample_throats
-
-    r_pack, s_pack = sample_throats(n, rng=seed)
+    r_pack, s_pack = network.sample_throats(n, rng=seed)
     rbar = r_pack.mean(axis=1, keepdims=True)
     r_pack, s_pack = r_pack / rbar, s_pack / rbar          # any unit: report in rbar
     names = list(HARD_CASES)
@@ -154,12 +159,12 @@ def _run(n, seed, rtols, repeats):
 
 
 def fit(n=1600, seed=2026, rtol=1e-4):
-    """Refit the shape-factor constants c_t = exp(median(log(Q_FE/(A^3/P^2)))) per type."""
-    from throats import canonical_form, contact_type, solve_fem
-    from throats._sampling import sample_throats
-    from throats._shape_factor import open_area_perimeter
+    """Refit the shape-factor constants c_t = exp(median(log(Q_FE/(A^3/P^2)))) per type.
 
-    r, s = sample_throats(n, rng=seed)
+    Throats from ``network.sample_throats(n, rng=seed)``; the shipped constants were fitted on
+    the former ``throats._sampling`` packer (``docs/throats-shape-factor.md``).
+    """
+    r, s = network.sample_throats(n, rng=seed)
     sol = solve_fem(r, s, rtol=rtol, progress=True)
     rs, ss = canonical_form(r, s)
     a, p = open_area_perimeter(rs, ss)

@@ -27,6 +27,11 @@ import time
 
 import numpy as np
 
+from ._area import open_area
+from ._geometry import contact_type, validate_throats
+from ._shape_factor import FIT, shape_factor_qstar
+from ._solve import solve_fem
+
 COLUMNS = ["r1", "r2", "r3", "l12", "l13", "l23"]
 METHODS = ("fem", "shape-factor")
 
@@ -55,10 +60,6 @@ def _parser():
 
 def _compute(radii, sides, method, rtol, workers, progress):
     """Per-row results as a dict of (N,) arrays (open_area in input units²)."""
-    from throats import (contact_type, open_area, shape_factor_qstar, solve_fem,
-                         validate_throats)
-    from throats._shape_factor import FIT
-
     t0 = time.perf_counter()
     if method == "fem":
         sol = solve_fem(radii, sides, rtol=rtol, workers=workers, progress=progress)
