@@ -73,10 +73,9 @@ from pathlib import Path
 
 import numpy as np
 
-from ._conductance import MODELS, POLICIES
-from ._generate import random_packing
-from ._io import Packing, read_packing, write_packing_csv
-from ._pipeline import solve_network
+from .conductance import MODELS, POLICIES
+from .flow import solve_network
+from .packing import Packing, random_packing, read_packing, write_packing_csv
 
 
 def _machine() -> dict:
@@ -96,7 +95,7 @@ def _tiled(base_n: int, n: int, workdir: Path, seed: int):
     images tile space without overlaps; a cube of k³ copies is cropped to the sub-cube holding
     about n spheres. The structure repeats every L, which does not matter for timing.
     """
-    from ._generate import periodic_copies
+    from .packing import periodic_copies
 
     base = read_packing(_packing_file(base_n, workdir, seed))
     box = (4.0 / 3.0 * np.pi * np.sum(base.radii**3) / 0.60) ** (1.0 / 3.0)
@@ -266,7 +265,7 @@ _FE_POLICIES = ("table+fe", "fe-only")
 
 def _lattice_case(text: str):
     """``kind:phi`` (``phi`` a number or ``touch``) -> (kind, phi), for argparse."""
-    from ._lattices import LATTICES, TOUCHING_FRACTION
+    from .packing import LATTICES, TOUCHING_FRACTION
 
     kind, sep, phi = text.partition(":")
     kind = kind.lower()
@@ -286,7 +285,7 @@ def _lattice_case(text: str):
 
 def _lattice_reference(kind: str, phi: float, radius: float) -> float:
     """Exact Stokes k of the array, lattice constant²: Zick & Homsy (SC), own FE (BCC/FCC)."""
-    from ._references import computed_lattice_permeability, lattice_permeability
+    from .validation import computed_lattice_permeability, lattice_permeability
 
     if kind == "sc":
         return float(lattice_permeability("sc", phi, radius))
@@ -311,7 +310,7 @@ def _store_totals(path: Path) -> tuple[int, float]:
 def _ref_cell(case: dict, model: str, policy: str, base: Path | None, tmp: Path,
               repeats: int) -> dict:
     """One case × model × policy: k, k/k_ref, minimum wall time over fresh-table repeats."""
-    from ._lattices import lattice_sample_permeability, random_sample_permeability
+    from .validation import lattice_sample_permeability, random_sample_permeability
 
     cell = {"conductance_model": model, "policy": policy, "repeats": repeats,
             "seconds_all": [], "fe_solves": [], "fe_seconds": []}
@@ -353,7 +352,7 @@ def _ref_cell(case: dict, model: str, policy: str, base: Path | None, tmp: Path,
 
 def _warm_up(base: Path | None, tmp: Path) -> float:
     """Import the pipeline and load the interpolation grid (not timed in the cells)."""
-    from ._lattices import lattice_sample_permeability
+    from .validation import lattice_sample_permeability
 
     db = tmp / "warm-up.sqlite"
     _copy_db(base, db)
@@ -365,8 +364,8 @@ def _warm_up(base: Path | None, tmp: Path) -> float:
 def _references(lattice_cases, random_porosities, models, policies, db, *, fe_random=(0.40,),
                 repeats=2, n_spheres=800, seed=1) -> dict:
     """Part 3: every case × model × policy, with summaries per model × policy column."""
-    from ._generate import random_packing
-    from ._references import beetstra_permeability
+    from .packing import random_packing
+    from .validation import beetstra_permeability
 
     base = Path(db) if db else None   # None: every cell starts from an empty table
     if base is not None and not base.exists():

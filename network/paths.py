@@ -30,7 +30,7 @@ import time
 
 import numpy as np
 
-from ._paths import (
+from .airpaths._paths import (
     _relaxed_packing,
     bed_depth,
     branched_table,
@@ -90,7 +90,7 @@ def main(argv=None) -> int:
         x, r = _relaxed_packing(args.standin, rng=args.seed)
         source = f"stand-in {args.standin} seed {args.seed}"
     elif args.packing:
-        from ._io import read_packing
+        from .packing import read_packing
 
         pk = read_packing(args.packing)
         x, r = np.asarray(pk.centers), np.asarray(pk.radii)
@@ -108,8 +108,8 @@ def main(argv=None) -> int:
     graph = tess = None
     t1 = time.perf_counter()
     if need_graph or args.pressure:
-        from ._io import Packing
-        from ._tessellation import tessellate
+        from .packing import Packing
+        from .pores import tessellate
 
         tess = tessellate(Packing(x, r, source))
         graph = face_graph(tess)
@@ -199,7 +199,7 @@ def main(argv=None) -> int:
         with open(args.json, "w") as f:
             json.dump(out, f, indent=1)
     if args.plot:
-        from ._plots import plot_paths
+        from .airpaths import plot_paths
 
         plot_paths(x, paths, args.plot, axis=args.axis, title=source)
     return 0
@@ -208,7 +208,7 @@ def main(argv=None) -> int:
 def _table_4_5(x, r, depth, velocities, branched):
     """Pressure drops over the bed depth (Pa): measured (thesis), branched model (ours, mean of
     the MFx3 average-width paths), ASABE D272 and Ergun at the bed's porosity (thesis 4.2.2)."""
-    from ._empirical import asabe_d272_gradient, ergun_gradient
+    from .flow import asabe_d272_gradient, ergun_gradient
 
     lo, hi = (x - r[:, None]).min(axis=0), (x + r[:, None]).max(axis=0)
     porosity = 1.0 - float(np.sum(4.0 / 3.0 * np.pi * r**3) / np.prod(hi - lo))
@@ -226,13 +226,13 @@ def _table_4_5(x, r, depth, velocities, branched):
 
 def _pressure_along(args, x, r, source, tess, graph, paths):
     """Network-model pressures along the paths that lie on the tessellation."""
-    from ._io import Packing
-    from ._paths import pore_pressure_array, pressure_along_path
-    from ._pipeline import solve_network
-    from ._tessellation import tie_groups
+    from .packing import Packing
+    from .airpaths import pore_pressure_array, pressure_along_path
+    from .flow import solve_network
+    from .pores import tie_groups
 
     t = time.perf_counter()
-    from ._sample import Region
+    from .pores import Region
 
     # sample: 1.5 mean diameters from the side walls (less in a thin bin), 4 mean diameters
     # (the thesis's 0.026 m) from the floor and from the highest centre, so a loose top surface

@@ -21,12 +21,12 @@ from pathlib import Path
 
 import numpy as np
 
-from ._conductance import MODELS, MU_AIR_PA_S, POLICIES
-from ._io import default_packing_path, read_container, read_packing
-from ._pipeline import DEFAULT_DEPTH_M, DEFAULT_VELOCITY_M_S, solve_network
-from ._sample import AXES, Region, default_region
-from ._tessellation import tessellate
-from ._vtk import write_network_vtu
+from ._air import MU_AIR_PA_S, check_positive
+from .conductance import MODELS, POLICIES
+from .flow import (DEFAULT_DEPTH_M, DEFAULT_VELOCITY_M_S, combined_summary, solve_axes,
+                   write_network_vtu)
+from .packing import default_packing_path, read_container, read_packing
+from .pores import sample_region
 
 # Thesis section 4.2.3 and Table 4.5: pressure drop over 0.25 m at 0.013 m/s (Pa)
 THESIS_LSV = {"measured": 2.44, "measured_sd": 0.20, "asabe_d272": 2.28, "thesis_network": 2.20,
@@ -111,6 +111,16 @@ def _print_result(res, out):
                                      if isinstance(v, float)), file=out)
 
 
+def _check_options(args) -> None:
+    """Every numeric option checked before any work (ValueError names the option)."""
+    for name in ("viscosity", "velocity", "depth", "rtol"):
+        check_positive(f"--{name}", getattr(args, name))
+    if args.margin is not None and not args.margin >= 0:
+        raise ValueError(f"--margin must be >= 0, got {args.margin!r}")
+    if args.workers < 1:
+        raise ValueError(f"--workers must be >= 1, got {args.workers!r}")
+
+
 def main(argv=None) -> int:
     args = build_parser().parse_args(argv)
     if not args.quiet:
@@ -118,46 +128,31 @@ def main(argv=None) -> int:
                             stream=sys.stderr)
     t0 = time.perf_counter()
     path = Path(args.packing) if args.packing else default_packing_path()
+    axes = ["x", "y", "z"] if args.axis == "all" else [args.axis]
     try:
+        _check_options(args)
         packing = read_packing(path)
+        container = None if args.sample else read_container(path)
+        regions = {ax: sample_region(packing, box=args.sample, margin=args.margin,
+                                     cylinder=args.cylinder, container=container, axis=ax)
+                   for ax in axes}
     except (OSError, ValueError) as e:
         print(f"error: {e}", file=sys.stderr)
         return 2
     t_read = time.perf_counter() - t0
-    container = None if args.sample else read_container(path)
     if container is not None:
         print(f"container from {container['source']}: {container['kind']} {container['size_m']}")
-    axes = ["x", "y", "z"] if args.axis == "all" else [args.axis]
-    t1 = time.perf_counter()
-    tess = tessellate(packing) if len(axes) > 1 else None   # one tessellation for three axes
-    t_tess = time.perf_counter() - t1
-    results = []
-    for ax in axes:
-        try:
-            if args.sample:
-                s = args.sample
-                reg = Region([s[0], s[2], s[4]], [s[1], s[3], s[5]])
-                if args.cylinder:
-                    lat = np.delete(reg.hi - reg.lo, AXES[ax])
-                    reg = Region(reg.lo, reg.hi, 0.5 * float(np.min(lat)))
-            else:
-                reg = default_region(packing, margin=args.margin, cylinder=args.cylinder,
-                                     container=container, axis=ax)
-            same = (results and np.array_equal(results[0].region_lo, reg.lo)
-                    and np.array_equal(results[0].region_hi, reg.hi)
-                    and results[0].region_radius == reg.radius)
-            res = solve_network(
-                packing, axis=ax, region=reg, conductance_model=args.conductance_model,
-                policy=args.policy, viscosity_pa_s=args.viscosity, velocity_m_s=args.velocity,
-                depth_m=args.depth, rtol=args.rtol, db=args.db, workers=args.workers,
-                progress=not args.quiet, tessellation=tess,
-                porosity=(results[0].porosity, results[0].porosity_std) if same else None)
-        except (ValueError, RuntimeError, NotImplementedError) as e:
-            print(f"error: {e}", file=sys.stderr)
-            return 1
-        results.append(res)
-        if args.vtk:
-            p = _vtk_path(args.vtk, ax, len(axes) > 1)
+    try:
+        results = solve_axes(
+            packing, regions, conductance_model=args.conductance_model, policy=args.policy,
+            viscosity_pa_s=args.viscosity, velocity_m_s=args.velocity, depth_m=args.depth,
+            rtol=args.rtol, db=args.db, workers=args.workers, progress=not args.quiet)
+    except (ValueError, RuntimeError, NotImplementedError) as e:
+        print(f"error: {e}", file=sys.stderr)
+        return 1
+    if args.vtk:
+        for res in results:
+            p = _vtk_path(args.vtk, res.axis, len(axes) > 1)
             write_network_vtu(p, res.pore_xyz, res.conns,
                               point_data={"pressure": res.pressure_pa},
                               cell_data={"flow": np.abs(res.throat_flow_m3_s),
@@ -168,9 +163,7 @@ def main(argv=None) -> int:
           f"policy {args.policy}")
     for res in results:
         _print_result(res, sys.stdout)
-    out = _combine(results, t_read, total)
-    if tess is not None:
-        out["seconds"]["tessellate"] = t_tess
+    out = combined_summary(results, seconds={"read": t_read, "wall": total})
     out["packing"] = str(path)
     out["n_spheres"] = packing.n
     out["thesis_lsv_reference_pa"] = THESIS_LSV
@@ -188,51 +181,14 @@ def main(argv=None) -> int:
     print(f"total {total:.2f} s")
     if args.json_out:
         with open(args.json_out, "w") as f:
-            json.dump(out, f, indent=2, default=_json_default)
+            json.dump(out, f, indent=2)
         print(f"wrote {args.json_out}")
-    ok = all(r.check["ok"] for r in results)
-    return 0 if ok else 3
-
-
-def _combine(results, t_read, total) -> dict:
-    if len(results) == 1:
-        out = results[0].summary()
-        out["seconds"] = dict(out["seconds"], read=t_read, wall=total)
-        return out
-    by = {r.axis: r.summary() for r in results}
-    ks = np.array([r.permeability_m2 for r in results])
-    first = results[0]
-    k = float(ks.mean())
-    grad = first.viscosity_pa_s * first.velocity_m_s / k
-    out = {
-        "axis": "all",
-        "conductance_model": first.conductance_model,
-        "policy": first.policy,
-        "permeability_m2": k,
-        "permeability_note": "arithmetic mean of the three directional permeabilities",
-        "k_over_d2": k / first.sauter_diameter_m**2,
-        "pressure_gradient_pa_per_m": grad,
-        "pressure_drop_pa": grad * first.depth_m,
-        "porosity": first.porosity,
-        "porosity_std": first.porosity_std,
-        "n_pores": max(r.n_pores for r in results),
-        "n_throats": max(r.n_throats for r in results),
-        "anisotropy": {r.axis: float(r.permeability_m2 / k) for r in results},
-        "comparisons": by[first.axis]["comparisons"],
-        "by_axis": by,
-        "seconds": {"read": t_read, "wall": total},
-    }
-    return out
-
-
-def _json_default(o):
-    if isinstance(o, (np.integer,)):
-        return int(o)
-    if isinstance(o, (np.floating,)):
-        return float(o)
-    if isinstance(o, np.ndarray):
-        return o.tolist()
-    return str(o)
+    bad = [r.axis for r in results if not r.check["ok"]]
+    if bad:
+        print(f"error: mass balance check failed along {', '.join(bad)} (see mass_balance)",
+              file=sys.stderr)
+        return 1
+    return 0
 
 
 if __name__ == "__main__":

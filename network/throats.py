@@ -21,9 +21,8 @@ from pathlib import Path
 
 import numpy as np
 
-from ._io import default_packing_path, read_packing
-from ._sample import Region, default_region, select_sample
-from ._tessellation import tessellate, tie_groups
+from .packing import default_packing_path, read_packing
+from .pores import sample_region, select_sample, tessellate, tie_groups
 
 
 def build_parser() -> argparse.ArgumentParser:
@@ -57,11 +56,7 @@ def main(argv=None) -> int:
         if args.everything:
             idx = tess.interior_throats
         else:
-            if args.sample:
-                s = args.sample
-                region = Region([s[0], s[2], s[4]], [s[1], s[3], s[5]])
-            else:
-                region = default_region(packing, margin=args.margin)
+            region = sample_region(packing, box=args.sample, margin=args.margin)
             labels, n_groups = tie_groups(tess)
             sample = select_sample(tess, region, axis="z",
                                    groups=None if n_groups == tess.n_pores else labels)

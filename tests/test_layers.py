@@ -31,7 +31,7 @@ BENCH_MAY_IMPORT = {"throats": {"network"}, "cache": {"throats", "network"},
 #: below the package (a subpackage name, or the module name for top-level modules)
 LAYERS = {
     "network": [
-        {"_air", "packing"},
+        {"_air", "_json", "packing"},
         {"pores"},
         {"conductance"},
         {"flow"},

@@ -14,8 +14,8 @@ import numpy as np
 import pytest
 
 from network import bench
-from network._lattices import lattice_sample_permeability, random_sample_permeability
-from network._references import beetstra_permeability, lattice_permeability
+from network.validation import lattice_sample_permeability, random_sample_permeability
+from network.validation import beetstra_permeability, lattice_permeability
 
 pytest.importorskip("throats")
 

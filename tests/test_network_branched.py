@@ -3,7 +3,7 @@
 import numpy as np
 import pytest
 
-from network._branched import (
+from network.airpaths import (
     branched_pressure_drop,
     branching_multiplier,
     equivalent_diameter,

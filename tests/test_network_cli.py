@@ -8,7 +8,7 @@ import pytest
 from network import default_packing_path, read_packing, tessellate
 from network import solve as solve_cli
 from network import throats as throats_cli
-from network._vtk import read_vtu_arrays
+from network.flow import read_vtu_arrays
 
 KEYS = ["permeability_m2", "pressure_drop_pa", "pressure_gradient_pa_per_m", "porosity",
         "n_pores", "n_throats", "seconds", "comparisons", "conductance_model", "k_over_d2"]

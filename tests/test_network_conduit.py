@@ -14,8 +14,9 @@ import pytest
 from scipy.integrate import quad
 
 from network import Packing, tessellate
-from network._conduit import conduit_conductance, section_estimate, side_resistance
-from network._lattices import lattice_packing, lattice_sample_permeability
+from network.conductance import conduit_conductance, section_estimate, side_resistance
+from network.packing import lattice_packing
+from network.validation import lattice_sample_permeability
 
 
 def test_constant_section_gives_y_times_length():
@@ -136,7 +137,7 @@ LATTICE_CASES = [
 
 
 def _exact_lattice_k(kind, phi, r):
-    from network._references import computed_lattice_permeability, lattice_permeability
+    from network.validation import computed_lattice_permeability, lattice_permeability
     if kind == "sc":
         return lattice_permeability("sc", phi, r)
     return computed_lattice_permeability(kind, phi)
@@ -202,8 +203,8 @@ RANDOM_CASES = [(0.36, 1.054), (0.40, 1.014), (0.45, 1.043)]
 def test_random_packings_against_lbm_drag_law(porosity, expected):
     # issue 7 target: within 10 % of the LBM law for random packings of porosity 0.36-0.45;
     # the thesis model is about a third of it (measured 0.30-0.33)
-    from network._lattices import random_sample_permeability
-    from network._references import beetstra_permeability
+    from network.validation import random_sample_permeability
+    from network.validation import beetstra_permeability
     k_ref = beetstra_permeability(1.0 - porosity, 1.0)
     k = random_sample_permeability(porosity)
     assert k / k_ref == pytest.approx(expected, abs=0.01)

@@ -6,10 +6,10 @@ import importlib
 import numpy as np
 import pytest
 
-from network._empirical import (asabe_d272_gradient, darcy_permeability, ergun_gradient,
+from network.flow import (asabe_d272_gradient, darcy_permeability, ergun_gradient,
                                 kozeny_carman_gradient)
-from network._porosity import region_porosity
-from network._sample import Region
+from network.pores import region_porosity
+from network.pores import Region
 from network import Packing
 
 
@@ -50,8 +50,8 @@ def test_monte_carlo_porosity_of_one_sphere_in_a_box():
     assert 0.001 < err < 0.002
 
 
-@pytest.mark.parametrize("mod", ["network._empirical", "network._flow", "network._conductance",
-                                 "network._tessellation"])
+@pytest.mark.parametrize("mod", ["network.flow._empirical", "network.flow._linear", "network.conductance._thesis",
+                                 "network.pores._tessellation"])
 def test_docstring_examples(mod):
     res = doctest.testmod(importlib.import_module(mod), optionflags=doctest.ELLIPSIS)
     assert res.failed == 0 and res.attempted > 0

@@ -5,7 +5,7 @@ import pytest
 import scipy.sparse as sp
 from scipy.sparse.linalg import spsolve
 
-from network._flow import (apply_pressure_bc, assemble_laplacian, boundary_flows,
+from network.flow import (apply_pressure_bc, assemble_laplacian, boundary_flows,
                            solve_fixed_pressure, solve_pressure)
 
 

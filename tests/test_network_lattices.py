@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 from scipy.spatial import cKDTree
 
-from network._lattices import (
+from network.packing import (
     LATTICES,
     SPHERES_PER_CELL,
     TOUCHING_FRACTION,
@@ -89,7 +89,8 @@ def test_radius_units_and_bad_input():
 
 
 def test_core_estimator_arguments():
-    from network._lattices import core_permeability, lattice_sample_permeability
+    from network.flow import core_permeability
+    from network.validation import lattice_sample_permeability
     with pytest.raises(ValueError, match="estimator"):
         lattice_sample_permeability("sc", 0.3, estimator="bogus")
     # SC with 6 cells: the core (one lattice constant in from each face) holds one pore plane

@@ -11,8 +11,8 @@ import numpy as np
 import pytest
 
 from network import Packing, tessellate
-from network._lattices import lattice_packing
-from network._merge import circumspheres, merge_pores
+from network.packing import lattice_packing
+from network.pores import circumspheres, merge_pores
 
 
 def test_circumsphere_closed_form():

@@ -6,8 +6,8 @@ import numpy as np
 import pytest
 
 from network import Packing, tessellate
-from network._lattices import lattice_packing
-from network._paths import (
+from network.packing import lattice_packing
+from network.airpaths._paths import (
     EXIT_FACES,
     _eq323_negative,
     _relaxed_packing,
@@ -95,7 +95,7 @@ def test_maximin_follows_the_only_wide_channel(lattice):
     # maximin path must be that chain, and its tortuosity that of the chain
     c, r, tess, g = lattice
     xy = np.array([[9.75e-3, 9.75e-3]])
-    from network._paths import entry_faces
+    from network.airpaths import entry_faces
 
     f0, p0 = entry_faces(g, xy)
     (chain,), ok = shortest_paths(g, f0, p0)
@@ -145,7 +145,7 @@ def test_built_paths_obey_the_step_rule(lattice, kind):
 def test_walked_paths_and_network_pressure(lattice):
     c, r, tess, g = lattice
     xy = np.array([[9.75e-3, 9.75e-3]])
-    from network._paths import entry_faces
+    from network.airpaths import entry_faces
 
     f0, p0 = entry_faces(g, xy)
     (faces,), status, _, _ = walk_paths(g, f0, p0, kind="widest")
@@ -191,7 +191,7 @@ def test_cli_json_and_plot(tmp_path):
 
 
 def test_pore_pressure_array_maps_sample_and_groups():
-    from network._paths import pore_pressure_array
+    from network.airpaths import pore_pressure_array
 
     # tetrahedra 0-4; the sample solved bodies 1 and 3; tetrahedra 3 and 4 form body 3
     p = pore_pressure_array(5, [1, 3], [2.0, 7.0], labels=[0, 1, 2, 3, 3])

@@ -11,7 +11,7 @@ import math
 import numpy as np
 import pytest
 
-from network._references import (
+from network.validation import (
     ZICK_HOMSY_SC,
     beetstra_permeability,
     beetstra_stokes_drag,

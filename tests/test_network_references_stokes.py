@@ -13,7 +13,7 @@ and Richardson-extrapolated. At the coarse h = 0.08a used here the discretisatio
 import numpy as np
 import pytest
 
-from network._references import (computed_lattice_permeability, lattice_permeability)
+from network.validation import computed_lattice_permeability, lattice_permeability
 
 gmsh = pytest.importorskip("gmsh")
 skfem = pytest.importorskip("skfem")

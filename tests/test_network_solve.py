@@ -6,10 +6,10 @@ from scipy.sparse.linalg import spsolve
 
 import throats
 from network import Packing, tessellate
-from network._generate import random_packing
-from network._lattices import lattice_packing
-from network._pipeline import solve_network
-from network._sample import Region, default_region, prune_disconnected, select_sample
+from network.packing import random_packing
+from network.packing import lattice_packing
+from network.flow import solve_network
+from network.pores import Region, default_region, prune_disconnected, select_sample
 
 MU = 1.932e-5
 
@@ -123,7 +123,7 @@ def test_tie_breaking_does_not_change_the_answer(kind, phi):
 
 @pytest.mark.parametrize("kw, match", [
     (dict(axis="w"), "axis must be"),
-    (dict(velocity_m_s=-1.0), "velocity must be > 0"),
+    (dict(velocity_m_s=-1.0), "velocity_m_s must be finite and > 0"),
     (dict(region=Region([10, 10, 10], [11, 11, 11])), "contains no pore"),
 ])
 def test_bad_arguments(small_bed, kw, match):
@@ -140,19 +140,11 @@ def test_region_validation():
 
 
 def test_conduit_model_hook(small_bed):
-    """'conduit' dispatches to network._conduit (issue 7) with its pore bodies contracted; until
-    that module exists the error says what is missing."""
-    import importlib.util
-
-    if importlib.util.find_spec("network._conduit") is None:
-        with pytest.raises(NotImplementedError, match="conduit_conductance"):
-            solve_network(small_bed, conductance_model="conduit", policy="shape-factor",
-                          porosity_points=0)
-    else:
-        res = solve_network(small_bed, conductance_model="conduit", policy="shape-factor",
-                            porosity_points=0)
-        assert res.conductance_model == "conduit" and res.check["ok"]
-        assert res.solver["iterations"] < 150
+    """'conduit' dispatches to the conduit model (issue 7) with its pore bodies contracted."""
+    res = solve_network(small_bed, conductance_model="conduit", policy="shape-factor",
+                        porosity_points=0)
+    assert res.conductance_model == "conduit" and res.check["ok"]
+    assert res.solver["iterations"] < 150
 
 
 def test_unknown_model_and_policy(small_bed):
@@ -199,7 +191,7 @@ def test_cylindrical_container_from_companion_json(tmp_path, caplog):
     reg = default_region(cyl, container=cont, axis="z")
     np.testing.assert_allclose(reg.radius, big_r - m)
     good = run(cyl, axis="z", region=reg)
-    with caplog.at_level("WARNING", logger="network._sample"):
+    with caplog.at_level("WARNING", logger="network.pores._sample"):
         bad = run(cyl, axis="z")                       # bounding box, no container
     assert "outside the packed bed" in caplog.text
     # the hull tetrahedra outside the bed are left out of the sample (no flow), so the box no
@@ -216,8 +208,8 @@ def test_sample_reaching_a_flat_wall_stays_finite(monkeypatch):
     """A sample box out to the walls of a closed bin: the tessellation has no walls, and the
     flat tetrahedra along them (empty spheres far wider than a grain) have huge windows. They
     are left out of the sample; kept, they made a channel with k many orders too high."""
-    import network._sample as smp
-    from network._sample import Region
+    import network.pores._sample as smp
+    from network.pores import Region
 
     # measured: k over the full width 0.87 of the interior's; with the outside tetrahedra
     # kept, 170 times it

@@ -1,146 +1,25 @@
 r"""Conduit conductance model: pore body → window → pore body resistance from the geometry.
 
-The thesis model (Eq. 3.41) gives a throat :math:`g = Q^*\bar r^4/(\mu L)` with
-:math:`L = 2\bar r`: the narrowest cross-section (the Delaunay face, "window") is taken to run
-the whole way between the pores. This module replaces that fixed length by the resistance of
-the actual conduit between the two pore bodies.
+Derivation, validation tables and where the model misses: ``docs/conduit-model.md``.
 
-Derivation
-----------
-*Geometry.* Take a throat face with vertex spheres of radii :math:`r_k` and sides
-:math:`\ell_{ij}`, unit normal :math:`\mathbf n`, and a pore body on each side with centre
-:math:`\mathbf c_P` (:mod:`network._merge`: mean of the distinct sphere centres of the body;
-the centroid for a lone tetrahedron). The conduit on side P runs from the face (:math:`h=0`)
-along :math:`\mathbf n` to the height of the pore centre, :math:`h_P = |\mathbf n\cdot
-(\mathbf c_P - \mathbf x_{face})|`. Its cross-section at height :math:`h` is taken as the face
-triangle (the prism over the face, its walls symmetry planes as in the window problem) minus
-the sections of the three vertex spheres, disks of radius
-
-.. math:: \rho_k(h) = \sqrt{\max(r_k^2 - h^2,\, 0)}
-
-centred on the triangle's vertices. So every section is an ordinary throat shape
-``(ρ1, ρ2, ρ3; l12, l13, l23)`` that ``throats``/``cache`` can answer, with flow rate per unit
-pressure gradient :math:`Q(h) = Q^*(\rho(h), \ell)\,\bar\rho(h)^4/\mu`. For a simple cubic
-array this section is exact (the cell's cross-section at distance h from a window is exactly
-the square minus four such disks); for other pores it neglects the tapering of the
-tetrahedron and the spheres not on the face, which are far from the window where most of the
-resistance sits.
-
-*Lubrication, first order.* For a slowly varying duct the pressure gradient is the local
-Poiseuille one, :math:`-dp/dh = \mu\,y(h)\,Q_{flow}` with :math:`y = 1/(Q^*\bar\rho^4)`, so the
-side resistance is :math:`R_P = \mu\int_0^{h_P} y\,dh`. On simple cubic arrays (exact sections,
-FE Q*) this alone is 21-28 % too permeable for 0.3 <= phi <= pi/6: the walls open steeply
-(the slope of the equivalent radius reaches 0.5 within a quarter radius of the window), and
-first-order lubrication misses the dissipation of the non-parallel flow.
-
-*Second order.* For an axisymmetric tube of radius :math:`a(z)` the Stokes stream function
-expanded to second order in the wall slope (the classical slowly-varying-tube expansion of
-Manton 1971, J. Fluid Mech. 49:451; re-derived here with sympy: :math:`E^4\psi = 0`,
-:math:`\psi = \psi_0 + \epsilon^2\psi_2`, no slip on :math:`r = a`) gives on the axis
-
-.. math:: \frac{dp}{dz} = -\frac{8\mu Q}{\pi a^4}
-          \Bigl[1 + \tfrac{11}{6}a'^2 - \tfrac16 a a''\Bigr],
-
-and after integrating the :math:`a a''` term by parts (the boundary term vanishes at the
-window, where :math:`a' = 0` by symmetry) :math:`R = \frac{8\mu}{\pi}\int a^{-4}
-(1 + \tfrac43 a'^2)\,dz`. For a section of any shape we use the radius of the circular tube of
-equal conductance, :math:`a_{eq} = (8 Q^*\bar\rho^4/\pi)^{1/4}`, whose slope is
-:math:`a_{eq}' = -\tfrac14 a_{eq}\, y'/y`. The expansion holds for small slopes only; where
-the sphere surfaces turn parallel to the flow (:math:`\rho \to 0`) :math:`a_{eq}'` diverges and
-so would the correction. It is therefore used in the bounded (Padé-type) form
+The conduit on side P of a throat runs from the face (h = 0) along its normal to the height
+:math:`h_P` of the pore body's centre. Its section at height h is the face triangle minus the
+sections of the three vertex spheres, disks of radius :math:`\rho_k(h) = \sqrt{r_k^2 - h^2}`,
+an ordinary throat shape that ``throats``/``cache`` answer with :math:`Q^*`. With
+:math:`y = 1/(Q^*\bar\rho^4)` and the slope of the equivalent tube radius
+:math:`a_{eq} = (8 Q^*\bar\rho^4/\pi)^{1/4}` (second-order slowly-varying-tube theory,
+Manton 1971, in a bounded form)
 
 .. math:: R_P = \mu \int_0^{H_P} y(h)\Bigl[1 + \frac{s}{1+s}\Bigr] dh,
-          \qquad s = \tfrac43 a_{eq}'(h)^2,
-          \qquad H_P = \min\bigl(h_P, \max_k r_k\bigr),
+          \qquad s = \tfrac43 a_{eq}'(h)^2, \qquad H_P = \min(h_P, \max_k r_k),
 
-equal to the second-order theory to :math:`O(s)` and at most doubling the local resistance
-where the walls are steep. Beyond :math:`\max_k r_k` the prism has no wall and adds nothing.
-The coefficient 4/3 is theory; the saturating form is a modelling choice, made after seeing
-simple-cubic results: of four regularisations tried (none, this one, a cap at slope 1, a cut
-at slope 1) it was the one whose error did not drift with phi. Measured with FE Q* on every
-section (``sections='qstar'``), through the network pipeline (merged cells), against
-Zick & Homsy (1982): simple cubic +7.6 % (phi = 0.5236), +8.0 % (0.45), +8.2 % (0.343),
-+8.7 % (0.3) with 8 intervals (+8.7 to +9.9 % with the default 6; +6.1 % and +7.0 % at
-0.5236 and 0.3 converged); first order alone +21 % to +28 %; the thesis model 0.48-0.63 of
-exact. Random monodisperse packings (periodic, 2000 spheres, Q* from the cache's g1 table)
-against the LBM law of van der Hoef et al. (2005): +2.8 %, +1.9 %, +0.9 %, +2.8 %, +1.0 % at
-porosity 0.45, 0.42, 0.40, 0.38, 0.36 (default 6 intervals; 8 give 0.1-0.2 % less); the
-thesis model 0.30-0.33 of it. BCC and FCC arrays against the Stokes FE of
-:func:`network._references.computed_lattice_permeability`, read in the sample core
-(:func:`network._lattices.core_permeability`, FE Q*, 6 intervals): BCC 0.871, 0.902, 0.933,
-0.969, 0.989 of exact at phi = 0.3, 0.4, 0.5, 0.6, 0.66 (misses 10 % at phi = 0.3 only);
-FCC 1.020, 0.990, 0.979, 0.994, 0.997 at phi = 0.3, 0.45, 0.55, 0.65, 0.72. The 7-cell
-whole-box values (0.80-0.91, 0.86-0.89) are 7-14 % lower only through the sample's boundary
-layer, which falls as 1/H (BCC phi = 0.5: 0.837, 0.860, 0.874, 0.883, 0.890, 0.896 from 6 to
-11 cells; core 0.931-0.933 throughout). Random packings read the same way in their core
-(periodic 2000-sphere packings repeated to 2.5 periods, 1-3 diameters in, table Q*):
-+5.5 to +6.7, +4.6 to +4.8, +3.4 to +4.1, +5.4 to +5.7, +4.3 to +5.0 % against the LBM law
-at porosity 0.45, 0.42, 0.40, 0.38, 0.36 (whole box +1.9 to +3.6 %); with
-:func:`network._lattices.random_sample_permeability` (800 spheres, copied 3 x 3 x 3, the tests'
-cases) +5.4, +1.4, +4.3 % at porosity 0.36, 0.40, 0.45.
+and :math:`g = 1/(R_P + R_Q)` (m³ Pa⁻¹ s⁻¹). Throats inside one merged pore body get
+``internal_factor`` times the largest conduit conductance (one pressure node); a hull face
+counts its one side twice; a closed window (Q* = 0) has g = 0.
 
-*Where it misses, and why.* BCC at phi = 0.3 is 12.9 % low (0.871), outside the 10 % target;
-every other lattice and random case is inside it. The miss is not a matter of the slope
-correction: the ratio of the simple-cubic to the BCC result at phi = 0.3 (both normalised by
-exact) stays above 1.1/0.9 = 1.222 for every per-section correction tried, so none can put
-both inside 10 % at once (lattices with FE Q*, random packings with the 800-sphere cases):
-
-=========================================  ======  =======  ==========  =========
-correction of the section resistance       SC 0.3  BCC 0.3  SC/BCC 0.3  random
-=========================================  ======  =======  ==========  =========
-none (first-order lubrication)             1.297   0.983    1.32        1.09-1.13
-this module (a_eq slope, 4/3, saturating)  1.099   0.871    1.26        1.01-1.05
-wall slope of the spheres, arc-weighted    1.109   0.897    1.24        1.03-1.08
-  same, 24 section intervals (converged)   1.097   0.896    1.22        --
-  same, coefficient 2                      1.069   0.869    1.23        --
-wall slope over the whole perimeter, x3    1.106   0.888    1.25        1.00-1.04
-=========================================  ======  =======  ==========  =========
-
-So the difference lies in the geometry the model sees, not in how it integrates it. In SC the
-flow crosses its windows head-on and the prism over a window is the exact cell; in BCC every
-Delaunay face is a {110} plane at 45 degrees to the flow, the windows hardly constrict (window
-to pore inscribed radius 0.87 at phi = 0.3, against 0.65 in SC) and much of the flow passes
-the wide gap between second neighbours (the long Delaunay edges, 0.34 a at phi = 0.3), i.e.
-between tetrahedra that share only an edge, which a network of face conduits cannot join
-directly. Consistent with this, the BCC error falls steadily as that gap closes: -12.9, -9.8,
--6.7, -3.1, -1.1 % at gaps 0.34, 0.27, 0.22, 0.17, 0.14 a (phi 0.3 to 0.66). The porosities of
-grain beds (0.36-0.45) are far from phi = 0.3; the random packings there are within 1.4-5.4 %.
-Ending the conduits at half the chord to the most opposite window of the body instead of the
-body centre (a shorter path through tetrahedral bodies, SC unchanged) was tried and rejected:
-it lifts BCC/FCC by 10-25 % but random packings by 10 % as well (whole box 1.11-1.13).
-
-*Conductance.* :math:`g = 1/(R_P + R_Q)`. Throats inside one merged pore body get a
-conductance ``internal_factor`` (1e6) times the largest conduit conductance of the call, so
-the body is one pressure node for the solver. A sliver tetrahedron (flat, left unmerged) has
-its centre in the face plane, :math:`h = 0`, and adds no resistance, so tie-breaking slivers
-do not change the result. A hull face (no second pore) counts its one side twice.
-
-Assumptions, stated
--------------------
-Stokes flow; sections parallel to the window (prism over the face); each section's flow
-fully developed up to the second-order slope correction; conduit ends at the pore centre's
-height; a window whose disks cover the triangle (Q* = 0) is closed (g = 0).
-
-Numerics and cost
------------------
-Both sides of a throat share one set of ``n_sections`` + 1 heights (the sections depend on
-h only) up to the larger conduit height, :math:`h = r_{max}\sin\theta` equally spaced in
-:math:`\theta` (window included; the disks then shrink smoothly and the nodes gather where the
-sphere walls turn steep); each side is integrated up to its own height by the trapezoid rule
-(the last part-segment linearly interpolated); :math:`y'` by second-order differences with
-:math:`y'(0) = 0`. ``sections='qstar'`` (default) asks the Q* policy for every section
-(``n_sections`` lookups per throat beyond the window's; with FE Q* the simple-cubic results
-above).
-``sections='ratio'`` asks it only for the window (the lookups of the thesis model) and scales
-along the conduit with the closed-form cell-model estimate of :func:`section_estimate`; it is
-too permeable where the window is nearly closed (the cell model is a dilute theory): FE window,
-ratios along the conduit, simple cubic 1.18, 1.31, 1.44 at phi = 0.3, 0.45, 0.5236 (the former
-:math:`A^3/P_w^2` estimate: 1.24, 1.35, 1.47), BCC 0.88-1.10, FCC 1.01-1.24, so it is a fast
-approximation only. The same estimate continues the sections that the Q* table does not cover
-(policy 'table-only'; most simple-cubic sections away from the window, whose gaps exceed the
-grid's 2.2 r̄): simple cubic 1.109, 1.108, 1.092 against 1.099, 1.092, 1.087 with FE on every
-section (1.136, 1.123, 1.097 with the former estimate); random packings unchanged (0.4 % of
-their sections lie outside the grid).
+Accuracy (FE Q*, sample core): simple cubic 1.087-1.099 of Zick & Homsy (1982), BCC
+0.871-0.989, FCC 0.979-1.020 of Stokes FE of the cell, random packings at porosity 0.36-0.45
+1.4-5.4 % above the LBM law of van der Hoef et al. (2005); the thesis model gives 0.24-0.63.
 """
 
 from __future__ import annotations
@@ -152,12 +31,11 @@ import numpy as np
 
 import throats
 
-from ._merge import PoreMerge, merge_pores
-
-class _QS:
-    def __init__(self, qstar, stats, source):
-        self.qstar, self.stats, self.source = qstar, stats, source
-
+from .._air import MU_AIR_PA_S, check_viscosity
+from .._json import jsonable
+from ..pores import PoreMerge, merge_pores
+from ._qstar import qstar_from_function, throat_qstar as policy_qstar
+from ._result import ConductanceResult
 
 __all__ = [
     "SECTION_MODES",
@@ -365,7 +243,7 @@ def side_resistance(radii, sides, h_side, y_window, *, n_sections: int = 8,
     return R[:, 0] if one else R
 
 
-def conduit_conductance(tessellation, throats_idx=None, *, viscosity_pa_s: float = 1.932e-5,
+def conduit_conductance(tessellation, throats_idx=None, *, viscosity_pa_s: float = MU_AIR_PA_S,
                         policy: str = "table+fe", rtol: float = 1e-3, db=None,
                         workers: int = 1, progress: bool = False, sections: str = "qstar",
                         n_sections: int = 6, merge: PoreMerge | bool = True,
@@ -409,32 +287,24 @@ def conduit_conductance(tessellation, throats_idx=None, *, viscosity_pa_s: float
 
     Returns
     -------
-    g : (M,) ndarray, m³ Pa⁻¹ s⁻¹
-    info : dict
-        ``model``, ``sections``, ``n_sections``, ``qstar`` (window Q*, r̄ units), ``h`` (M, 2)
-        conduit heights, ``internal`` (M,) bool, ``merge`` (PoreMerge), ``qstar_stats``,
-        ``seconds``.
+    ConductanceResult
+        ``g`` (M,) m³ Pa⁻¹ s⁻¹, window ``qstar``, conduit heights ``h_m`` (M, 2), ``internal``;
+        ``stats``: sections, n_sections, merge summary, n_internal, qstar_stats, seconds.
 
     Raises
     ------
     ValueError
         Unknown ``sections``, non-positive viscosity, bad indices.
     """
-    from ._conductance import throat_qstar as _policy_qstar
-
     def throat_qstar(r_, s_, **kw):
         if qstar_fn is None:
-            return _policy_qstar(r_, s_, **kw)
-        q_ = np.asarray(qstar_fn(r_, s_), dtype=float)
-        return _QS(q_, {"policy": "qstar_fn", "n_throats": int(q_.size)},
-                   np.full(q_.size, "qstar_fn"))
+            return policy_qstar(r_, s_, **kw)
+        return qstar_from_function(qstar_fn, r_, s_)
 
     t0 = time.perf_counter()
     if sections not in SECTION_MODES:
         raise ValueError(f"unknown sections mode {sections!r}; choose one of {SECTION_MODES}")
-    mu = float(viscosity_pa_s)
-    if not (np.isfinite(mu) and mu > 0):
-        raise ValueError(f"viscosity_pa_s must be positive, got {viscosity_pa_s!r}")
+    mu = check_viscosity(viscosity_pa_s)
     t = tessellation
     idx = np.arange(t.n_throats) if throats_idx is None else np.asarray(throats_idx, np.int64)
     if idx.size and (idx.min() < 0 or idx.max() >= t.n_throats):
@@ -494,7 +364,7 @@ def conduit_conductance(tessellation, throats_idx=None, *, viscosity_pa_s: float
                                    workers=workers, progress=progress)
                 rb = rr[live].mean(axis=1)
                 qq = np.asarray(res.qstar, dtype=float) * rb**4
-                src = np.asarray(getattr(res, "source", np.full(qq.size, "")), dtype=str)
+                src = np.asarray(res.source, dtype=str)
                 if policy != "shape-factor":
                     # outside the table the cache falls back to the shape factor, which is
                     # 2-10 times off for these open sections: continue by ratios instead
@@ -513,9 +383,9 @@ def conduit_conductance(tessellation, throats_idx=None, *, viscosity_pa_s: float
     g[internal] = g_big
     g[np.isnan(g)] = g_big            # both sides of zero length (sliver to sliver)
     seconds = time.perf_counter() - t0
-    info = {"model": "conduit", "sections": sections, "n_sections": int(n_sections),
-            "qstar": qstar, "h": h, "internal": internal, "merge": pm,
-            "n_internal": int(internal.sum()), "qstar_stats": qstats, "seconds": seconds}
+    stats = jsonable({"model": "conduit", "sections": sections, "n_sections": int(n_sections),
+                      "merge": pm, "n_internal": int(internal.sum()), "qstar_stats": qstats,
+                      "seconds": seconds})
     logger.info("conduit conductance of %d throats (%d inside merged bodies) in %.2f s",
                 idx.size, int(internal.sum()), seconds)
-    return g, info
+    return ConductanceResult(g, "conduit", qstar, stats, h_m=h, internal=internal)

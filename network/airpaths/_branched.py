@@ -55,8 +55,9 @@ import logging
 
 import numpy as np
 
+from .._air import MU_AIR_PA_S
+
 __all__ = [
-    "MU_AIR_PA_S",
     "MULTIPLIERS",
     "WIDTHS",
     "BranchedResult",
@@ -69,8 +70,6 @@ __all__ = [
 
 logger = logging.getLogger(__name__)
 
-#: Air viscosity used by the thesis, Pa s.
-MU_AIR_PA_S = 1.932e-5
 #: Multiplier functions of the branching angle (Eq. 3.39).
 MULTIPLIERS = ("MFx3", "MFx2")
 #: Local flow-path width choices (section 3.5.1).

@@ -32,7 +32,7 @@ import scipy.sparse as sp
 from scipy.sparse.csgraph import connected_components
 from scipy.spatial import Delaunay, QhullError
 
-from ._io import Packing
+from ..packing import Packing
 
 __all__ = ["Tessellation", "tessellate", "QHULL_OPTIONS", "tie_groups"]
 

@@ -35,9 +35,9 @@ import numpy as np
 from scipy import sparse
 from scipy.sparse import csgraph
 
-from ._sample import _axis_index
+from ..pores import axis_index
+from .._air import MU_AIR_PA_S
 from ._branched import (
-    MU_AIR_PA_S,
     BranchedResult,
     branched_pressure_drop,
     equivalent_diameter,
@@ -232,7 +232,7 @@ def bed_depth(centers, radii, axis="z"):
     6.5 mm mean diameter); this is the same with the packing's own mean diameter.
     """
     c = np.asarray(centers, dtype=float)
-    ax = _axis_index(axis)
+    ax = axis_index(axis)
     return float(np.ptp(c[:, ax]) + 2.0 * np.mean(radii))
 
 
@@ -436,7 +436,7 @@ def random_entry_points(centers, radii, n, *, axis="z", rng=None, margin_m=None)
     thesis keeps its entry points away from the walls (4.1.2).
     Coordinates are the two other axes in x, y, z order.
     """
-    ax = _axis_index(axis)
+    ax = axis_index(axis)
     rng = np.random.default_rng(rng)
     if n < 1:
         raise ValueError(f"n must be >= 1, got {n}")
@@ -461,7 +461,7 @@ def entry_faces(graph, entry_xy, *, axis="z", min_quality=MIN_QUALITY):
     -------
     start_face, start_pore : (n,) int ndarrays
     """
-    ax = _axis_index(axis)
+    ax = axis_index(axis)
     xy = np.atleast_2d(np.asarray(entry_xy, dtype=float))
     if xy.ndim != 2 or xy.shape[1] != 2:
         raise ValueError(f"entry points must have shape (n, 2), got {xy.shape}")
@@ -629,7 +629,7 @@ class AirflowPath:
         Paths on the tessellation start and end up to :data:`END_BAND_DIAMETERS` inside the
         bed, so their thesis tortuosity (over the bed depth) undercounts; this one does not.
         """
-        ext = float(np.ptp(self.points[:, _axis_index(self.axis)])) if self.points.size else 0.0
+        ext = float(np.ptp(self.points[:, axis_index(self.axis)])) if self.points.size else 0.0
         return self.length_m / ext if ext > 0 else float("nan")
 
     @property
@@ -749,7 +749,7 @@ def build_paths(points, radii, entry_xy, *, kind="widest", axis="z", k_neighbors
 
     if kind not in ("widest", "narrowest"):
         raise ValueError(f"build kind must be 'widest' or 'narrowest', got {kind!r}")
-    ax = _axis_index(axis)
+    ax = axis_index(axis)
     x = _as_points(points)
     r = np.asarray(radii, dtype=float)
     if r.shape != (x.shape[0],):
@@ -971,7 +971,7 @@ def walk_paths(graph, entry_face, entry_pore, *, kind="widest", axis="z", max_st
     """
     if kind not in ("widest", "narrowest"):
         raise ValueError(f"greedy kind must be 'widest' or 'narrowest', got {kind!r}")
-    ax = _axis_index(axis)
+    ax = axis_index(axis)
     f0 = np.atleast_1d(np.asarray(entry_face, dtype=np.intp))
     p0 = np.atleast_1d(np.asarray(entry_pore, dtype=np.intp))
     n = f0.size
@@ -1104,7 +1104,7 @@ def shortest_paths(graph, entry_face, entry_pore, *, axis="z", min_quality=MIN_Q
     ok : (n,) bool ndarray
         False where the entry is not connected to the outlet.
     """
-    ax = _axis_index(axis)
+    ax = axis_index(axis)
     f0 = np.atleast_1d(np.asarray(entry_face, dtype=np.intp))
     out, usable, pore_ok = _graph_setup(graph, ax, f0, entry_pore, min_quality)
     nt = graph.n_throats
@@ -1152,7 +1152,7 @@ def maximin_paths(graph, entry_face, entry_pore, *, axis="z", tiebreak="shortest
     """
     if tiebreak not in ("shortest", "tree"):
         raise ValueError(f"tiebreak must be 'shortest' or 'tree', got {tiebreak!r}")
-    ax = _axis_index(axis)
+    ax = axis_index(axis)
     f0 = np.atleast_1d(np.asarray(entry_face, dtype=np.intp))
     out, usable, pore_ok = _graph_setup(graph, ax, f0, entry_pore, min_quality)
     nt = graph.n_throats
@@ -1357,7 +1357,7 @@ def pressure_along_path(graph, path, pore_pressure_pa, *, axis="z"):
     if np.any(path.pores < 0):
         raise ValueError("the path is not on the tessellation (method 'build'); trace it with "
                          "method='delaunay' or kind 'maximin'/'shortest'")
-    ax = _axis_index(axis)
+    ax = axis_index(axis)
     pos = graph.points[graph.pore_vertices[path.pores]].mean(axis=1)[:, ax]
     return pos, p[path.pores]
 

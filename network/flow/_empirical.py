@@ -24,10 +24,10 @@ from __future__ import annotations
 
 import numpy as np
 
-from ._conductance import MU_AIR_PA_S, RHO_AIR_KG_M3
+from .._air import MU_AIR_PA_S, RHO_AIR_KG_M3
 
 __all__ = ["ergun_gradient", "kozeny_carman_gradient", "asabe_d272_gradient",
-           "ASABE_SOYBEAN_A", "ASABE_SOYBEAN_B", "darcy_permeability"]
+           "ASABE_SOYBEAN_A", "ASABE_SOYBEAN_B"]
 
 #: ASABE D272 Hukill–Ives constant a for soybeans, Pa·s²/m³.
 ASABE_SOYBEAN_A = 1.02e4
@@ -73,14 +73,3 @@ def asabe_d272_gradient(velocity_m_s, *, a=ASABE_SOYBEAN_A, b=ASABE_SOYBEAN_B):
     if not velocity_m_s > 0:
         raise ValueError(f"velocity must be > 0, got {velocity_m_s!r}")
     return a * velocity_m_s**2 / np.log1p(b * velocity_m_s)
-
-
-def darcy_permeability(q_m3_s, dp_pa, length_m, area_m2, *, viscosity_pa_s=MU_AIR_PA_S):
-    r"""Darcy permeability :math:`k = \mu Q H / (A \Delta P)`, m².
-
-    >>> darcy_permeability(1.0, 1.0, 1.0, 1.0, viscosity_pa_s=2.0)
-    2.0
-    """
-    if not dp_pa > 0 or not length_m > 0 or not area_m2 > 0:
-        raise ValueError(f"need dp > 0, H > 0, A > 0; got {dp_pa}, {length_m}, {area_m2}")
-    return float(viscosity_pa_s * q_m3_s * length_m / (area_m2 * dp_pa))

@@ -14,7 +14,6 @@ we solve once with :math:`\Delta P = 1` Pa between inlet and outlet pores, obtai
 
 from __future__ import annotations
 
-import dataclasses
 import logging
 import time
 import tracemalloc
@@ -22,18 +21,17 @@ from typing import Callable
 
 import numpy as np
 
-from ._conductance import MU_AIR_PA_S, RHO_AIR_KG_M3, throat_conductance
-from ._empirical import (asabe_d272_gradient, darcy_permeability, ergun_gradient,
-                         kozeny_carman_gradient)
-from ._flow import solve_fixed_pressure
-from ._io import Packing
-from ._merge import merge_pores
-from ._porosity import region_porosity
-from ._sample import (AXES, Region, core_permeability, default_region, prune_disconnected,
-                      select_sample)
-from ._tessellation import Tessellation, tessellate, tie_groups
+from .._air import MU_AIR_PA_S, check_positive, check_viscosity
+from ..conductance import check_model, check_policy, throat_conductance
+from ..packing import Packing
+from ..pores import (Region, Tessellation, axis_index, default_region, merge_pores,
+                     prune_disconnected, region_porosity, select_sample, tessellate, tie_groups)
+from ._darcy import core_permeability, darcy_permeability
+from ._linear import solve_fixed_pressure
+from ._result import FlowResult
 
-__all__ = ["FlowResult", "solve_network", "DEFAULT_VELOCITY_M_S", "DEFAULT_DEPTH_M"]
+__all__ = ["solve_network", "solve_axes", "DEFAULT_VELOCITY_M_S", "DEFAULT_DEPTH_M",
+           "CORE_MARGIN_DIAMETERS", "CORE_MIN_DIAMETERS"]
 
 log = logging.getLogger(__name__)
 
@@ -41,131 +39,6 @@ log = logging.getLogger(__name__)
 DEFAULT_VELOCITY_M_S = 0.013
 #: Bed depth of the thesis's comparison, m.
 DEFAULT_DEPTH_M = 0.25
-
-
-@dataclasses.dataclass(frozen=True)
-class FlowResult:
-    """Network-model result along one axis (all SI). See :meth:`summary` for the JSON keys.
-
-    Per-pore arrays (``pressure_pa`` in Pa for the flow-imposed problem, ``pore_xyz`` in m) are
-    indexed like ``pore_ids``; per-throat arrays (``throat_flow_m3_s``, ``throat_conductance``,
-    ``conns`` in local pore indices) like ``throat_ids`` (tessellation throats). When
-    tetrahedra were joined into pore bodies, ``pore_groups`` (Np,) gives every tetrahedron's
-    body and ``pore_ids`` are body ids; otherwise it is None and ``pore_ids`` are tetrahedra.
-    """
-
-    axis: str
-    conductance_model: str
-    policy: str
-    viscosity_pa_s: float
-    velocity_m_s: float
-    depth_m: float
-    region_lo: tuple
-    region_hi: tuple
-    region_radius: float | None
-    n_pores: int
-    n_throats: int
-    n_inlet: int
-    n_outlet: int
-    n_dropped: int
-    length_m: float
-    area_m2: float
-    flow_m3_s: float
-    permeability_m2: float
-    mean_diameter_m: float
-    sauter_diameter_m: float
-    porosity: float
-    porosity_std: float
-    solver: dict
-    check: dict
-    qstar_stats: dict
-    timings_s: dict
-    pressure_pa: np.ndarray = dataclasses.field(repr=False)
-    throat_flow_m3_s: np.ndarray = dataclasses.field(repr=False)
-    throat_conductance: np.ndarray = dataclasses.field(repr=False)
-    pore_ids: np.ndarray = dataclasses.field(repr=False)
-    throat_ids: np.ndarray = dataclasses.field(repr=False)
-    conns: np.ndarray = dataclasses.field(repr=False)
-    pore_xyz: np.ndarray = dataclasses.field(repr=False)
-    pore_groups: np.ndarray | None = dataclasses.field(default=None, repr=False)
-    #: k of the sample's core, ``core_margin_m`` in from every face (None: cylinder sample
-    #: or a core too small), m²; see :func:`network._sample.core_permeability`.
-    permeability_core_m2: float | None = None
-    core_margin_m: float | None = None
-
-    @property
-    def k_over_d2(self) -> float:
-        """k / d32² (Sauter mean diameter), dimensionless."""
-        return self.permeability_m2 / self.sauter_diameter_m**2
-
-    @property
-    def pressure_gradient_pa_per_m(self) -> float:
-        return self.viscosity_pa_s * self.velocity_m_s / self.permeability_m2
-
-    @property
-    def pressure_drop_pa(self) -> float:
-        return self.pressure_gradient_pa_per_m * self.depth_m
-
-    def comparisons(self) -> dict:
-        """Empirical pressure gradients (Pa/m) and drops over ``depth_m`` (Pa) at the same v."""
-        v, e, d = self.velocity_m_s, self.porosity, self.sauter_diameter_m
-        out = {}
-        for name, grad in (
-            ("ergun", ergun_gradient(v, porosity=e, diameter_m=d, viscosity_pa_s=self.viscosity_pa_s,
-                                     density_kg_m3=RHO_AIR_KG_M3)),
-            ("kozeny_carman", kozeny_carman_gradient(v, porosity=e, diameter_m=d,
-                                                     viscosity_pa_s=self.viscosity_pa_s)),
-            ("asabe_d272", asabe_d272_gradient(v)),
-        ):
-            out[name] = {"pressure_gradient_pa_per_m": float(grad),
-                         "pressure_drop_pa": float(grad * self.depth_m)}
-        return out
-
-    def summary(self) -> dict:
-        """Every scalar as a JSON-ready dict (keys named in issue 4, item 7)."""
-        return {
-            "axis": self.axis,
-            "conductance_model": self.conductance_model,
-            "policy": self.policy,
-            "permeability_m2": self.permeability_m2,
-            "permeability_core_m2": self.permeability_core_m2,
-            "permeability_core_note": (
-                "Darcy's law in the sample's core, core_margin_m in from every face, free of "
-                "the sample's boundary layer (cut conduits on the lateral faces, inlet/outlet "
-                "pores that are not a plane), which lowers permeability_m2 by a term falling "
-                "as 1/H; null for cylindrical samples or a core narrower than 5 mean "
-                "diameters"),
-            "core_margin_m": self.core_margin_m,
-            "k_over_d2": self.k_over_d2,
-            "k_over_d2_note": "d = Sauter mean diameter d32 = 2 sum(r^3)/sum(r^2) (also used in "
-                              "Ergun and Kozeny-Carman)",
-            "pressure_gradient_pa_per_m": self.pressure_gradient_pa_per_m,
-            "pressure_drop_pa": self.pressure_drop_pa,
-            "velocity_m_s": self.velocity_m_s,
-            "depth_m": self.depth_m,
-            "viscosity_pa_s": self.viscosity_pa_s,
-            "flow_m3_s": self.flow_m3_s,
-            "flow_m3_s_note": "total flow for 1 Pa across the sample",
-            "porosity": self.porosity,
-            "porosity_std": self.porosity_std,
-            "mean_diameter_m": self.mean_diameter_m,
-            "sauter_diameter_m": self.sauter_diameter_m,
-            "n_pores": self.n_pores,
-            "n_throats": self.n_throats,
-            "n_inlet_pores": self.n_inlet,
-            "n_outlet_pores": self.n_outlet,
-            "n_dropped_pores": self.n_dropped,
-            "sample_length_m": self.length_m,
-            "sample_area_m2": self.area_m2,
-            "sample_lo_m": list(self.region_lo),
-            "sample_hi_m": list(self.region_hi),
-            "sample_radius_m": self.region_radius,
-            "solver": self.solver,
-            "mass_balance": self.check,
-            "qstar": self.qstar_stats,
-            "comparisons": self.comparisons(),
-            "seconds": self.timings_s,
-        }
 
 
 def solve_network(packing: Packing, *, axis="z", region: Region | None = None,
@@ -177,7 +50,9 @@ def solve_network(packing: Packing, *, axis="z", region: Region | None = None,
                   tessellation: Tessellation | None = None, solver: Callable | None = None,
                   porosity_points: int = 200_000, conductance: Callable | None = None,
                   trace_memory: bool = False, merge_ties: bool = True,
-                  porosity: tuple | None = None, container: dict | None = None) -> FlowResult:
+                  porosity: tuple | None = None, container: dict | None = None,
+                  qstar_fn: Callable | None = None, model_options: dict | None = None,
+                  core_margin_m: float | None = None) -> FlowResult:
     """Permeability and pressure drop of a packing by the Delaunay network model.
 
     Parameters
@@ -187,7 +62,7 @@ def solve_network(packing: Packing, *, axis="z", region: Region | None = None,
     axis : {'x', 'y', 'z'}
         Flow direction (default 'z').
     region : Region, optional
-        Sample box/cylinder; default :func:`network._sample.default_region` with ``margin``.
+        Sample box/cylinder; default :func:`network.default_region` with ``margin``.
     margin : float, optional, m
         Wall margin of the default region (default 1.5 mean diameters).
     cylinder : bool
@@ -195,10 +70,10 @@ def solve_network(packing: Packing, *, axis="z", region: Region | None = None,
     container : dict, optional
         The packing's container (:func:`network.read_container`), for the default region.
     conductance_model : {'conduit', 'thesis'}
-        Throat conductance model (default 'conduit', :mod:`network._conduit`; 'thesis' is
+        Throat conductance model (default 'conduit', :mod:`network.conductance`; 'thesis' is
         Eq. 3.41 with L = 2r̄, kept to reproduce the thesis).
     policy : {'shape-factor', 'table-only', 'table+fe', 'fe-only'}
-        Q* source (see :mod:`network._conductance`); default 'table-only' (the table, the
+        Q* source (see :mod:`network.conductance`); default 'table-only' (the table, the
         shape-factor estimate where it cannot answer, never FE).
     viscosity_pa_s, velocity_m_s, depth_m : float
         μ (1.932e-5 Pa·s), superficial velocity (0.013 m/s), bed depth (0.25 m).
@@ -220,18 +95,31 @@ def solve_network(packing: Packing, *, axis="z", region: Region | None = None,
         Join exactly co-spherical tetrahedra (and slivers) into one pore body
         (:func:`network.tie_groups`) so lattices do not depend on Qhull's tie-breaking
         (default True; random packings have no exact ties and are unchanged).
+    qstar_fn : callable, optional
+        ``qstar_fn(radii (N,3), sides (N,3)) -> (N,)`` Q* instead of the policy (validation
+        cases with exact FE of lattice sections).
+    model_options : dict, optional
+        Options of the conduit model (e.g. ``{"n_sections": 8}``).
+    core_margin_m : float, optional, m
+        Margin of the core permeability: default 2 mean diameters, reported only when the
+        core is 5 diameters wide; given, the core estimate is always made (and its failure
+        raised), as the lattice validation cases need.
 
     Returns
     -------
     FlowResult
     """
-    if axis not in AXES:
-        raise ValueError(f"axis must be one of 'x', 'y', 'z', got {axis!r}")
-    for name, val in (("viscosity", viscosity_pa_s), ("velocity", velocity_m_s),
-                      ("depth", depth_m)):
-        if not (np.isfinite(val) and val > 0):
-            raise ValueError(f"{name} must be > 0, got {val!r}")
-    ax = AXES[axis]
+    # every option is checked before any work (a bad policy is refused before the tessellation)
+    ax = axis_index(axis)
+    axis = "xyz"[ax]
+    viscosity_pa_s = check_viscosity(viscosity_pa_s)
+    velocity_m_s = check_positive("velocity_m_s", velocity_m_s)
+    depth_m = check_positive("depth_m", depth_m)
+    if conductance is None:
+        check_model(conductance_model)
+        check_policy(policy)
+    if core_margin_m is not None:
+        core_margin_m = check_positive("core_margin_m", core_margin_m)
     times: dict = {}
     peaks: dict = {}
 
@@ -243,13 +131,13 @@ def solve_network(packing: Packing, *, axis="z", region: Region | None = None,
     with stage("sample"):
         reg = (default_region(packing, margin=margin, cylinder=cylinder, container=container,
                               axis=axis) if region is None else region)
-        labels, model_opts = None, {}
+        labels, model_opts = None, dict(model_options or {})
         if conductance is None and conductance_model == "conduit" and merge_ties:
             # the conduit model's pore bodies (near-co-spherical groups, slivers) are
             # contracted here, so its near-infinite internal conductances never reach the solver
             merge = merge_pores(tess)
             labels = np.asarray(merge.labels)
-            model_opts = {"merge": merge}
+            model_opts["merge"] = merge
         if labels is None and merge_ties:
             labels, n_groups = tie_groups(tess)
             if n_groups == tess.n_pores:
@@ -260,14 +148,11 @@ def solve_network(packing: Packing, *, axis="z", region: Region | None = None,
         if conductance is not None:
             g = np.asarray(conductance(tess, sample.throats), dtype=float)
         else:
-            g, qres = throat_conductance(tess, sample.throats, model=conductance_model,
-                                         policy=policy, viscosity_pa_s=viscosity_pa_s, rtol=rtol,
-                                         db=db, workers=workers, progress=progress,
-                                         **model_opts)
-            if qres is not None and hasattr(qres, "stats"):
-                qstats = _jsonable(qres.stats)
-            elif isinstance(qres, dict):
-                qstats = _jsonable(qres)
+            cres = throat_conductance(tess, sample.throats, model=conductance_model,
+                                      policy=policy, viscosity_pa_s=viscosity_pa_s, rtol=rtol,
+                                      db=db, workers=workers, progress=progress,
+                                      qstar_fn=qstar_fn, **model_opts)
+            g, qstats = cres.g, cres.stats
     with stage("prune"):
         sample, g = prune_disconnected(sample, tess, g)
     with stage("solve"):
@@ -300,8 +185,13 @@ def solve_network(packing: Packing, *, axis="z", region: Region | None = None,
                    "converged": info.converged, "residual": info.residual,
                    "setup_s": info.setup_s, "solve_s": info.solve_s}
     chk = {k2: v for k2, v in check.items() if k2 != "throat_flow"}
-    k_core, core_margin = _core_estimate(sample, g, p, reg, packing.mean_diameter,
-                                         viscosity_pa_s)
+    if core_margin_m is None:
+        k_core, core_margin = _core_estimate(sample, g, p, reg, packing.mean_diameter,
+                                             viscosity_pa_s)
+    else:
+        core_margin = core_margin_m
+        k_core = core_permeability(sample, g, p, margin_m=core_margin_m,
+                                   viscosity_pa_s=viscosity_pa_s)
     return FlowResult(
         axis=axis, conductance_model=conductance_model if conductance is None else "custom",
         policy=policy if conductance is None else "custom", viscosity_pa_s=viscosity_pa_s,
@@ -366,26 +256,31 @@ class _Stage:
         return False
 
 
-def _jsonable(d):
-    """Copy of a stats dict with numpy scalars turned into Python numbers."""
-    out = {}
-    for k, v in dict(d).items():
-        if isinstance(v, dict):
-            out[str(k)] = _jsonable(v)
-        elif isinstance(v, (np.integer,)):
-            out[str(k)] = int(v)
-        elif isinstance(v, (np.floating,)):
-            out[str(k)] = float(v)
-        elif isinstance(v, (str, int, float, bool)) or v is None:
-            out[str(k)] = v
-        elif isinstance(v, np.ndarray):
-            if v.size <= 8:
-                out[str(k)] = v.tolist()
-            # long per-throat arrays are not summary material: left out
-        elif isinstance(v, (list, tuple)):
-            out[str(k)] = [x.item() if hasattr(x, "item") else x for x in v]
-        elif dataclasses.is_dataclass(v):   # e.g. the conduit's PoreMerge: its scalar fields
-            out[str(k)] = _jsonable({f.name: getattr(v, f.name) for f in dataclasses.fields(v)})
-        else:
-            out[str(k)] = str(v)
-    return out
+def solve_axes(packing: Packing, regions: dict, **options) -> list[FlowResult]:
+    """:func:`solve_network` along several axes, sharing one tessellation and the porosity.
+
+    Parameters
+    ----------
+    packing : Packing
+    regions : dict
+        ``{axis: Region}`` in solve order (e.g. from :func:`network.pores.sample_region`).
+    **options
+        Passed to :func:`solve_network` (not ``axis``, ``region``, ``porosity``).
+
+    Returns
+    -------
+    list of FlowResult
+        One per axis; the porosity is measured once per distinct region.
+    """
+    if not regions:
+        raise ValueError("no axis to solve")
+    if len(regions) > 1 and options.get("tessellation") is None:
+        options["tessellation"] = tessellate(packing)      # one tessellation for every axis
+    results, porosity_of = [], {}
+    for axis, reg in regions.items():
+        key = (tuple(reg.lo), tuple(reg.hi), reg.radius)
+        res = solve_network(packing, axis=axis, region=reg, porosity=porosity_of.get(key),
+                            **options)
+        porosity_of.setdefault(key, (res.porosity, res.porosity_std))
+        results.append(res)
+    return results

@@ -1,84 +1,17 @@
 r"""Reference permeabilities of sphere packings: periodic arrays and random beds (Stokes flow).
 
-These are the numbers the network model is checked against. All functions are vectorised
-over the solid fraction :math:`\phi` (volume of spheres per total volume, :math:`1-\varepsilon`)
-and return permeability in the units of the radius or diameter passed in, squared.
+The numbers the network model is checked against; derivations of the drag-to-permeability
+conversions and the full account of the sources: ``docs/reference-permeabilities.md``.
+All functions are vectorised over the solid fraction :math:`\phi = 1 - \varepsilon` and return
+permeability in the units of the radius or diameter passed in, squared:
 
-From drag to permeability
--------------------------
-In steady Stokes flow through a periodic array (or a statistically homogeneous bed) the mean
-pressure gradient balances the *total* hydrodynamic force on the spheres, per unit volume:
-:math:`-\nabla p = n F_{tot}`, with :math:`n = \phi / (\tfrac43 \pi a^3)` spheres per unit
-volume. Darcy's law for the superficial (volume-averaged over fluid and solid) velocity
-:math:`U` is :math:`U = -(k/\mu)\nabla p`, hence
-
-.. math:: k = \frac{\mu U}{n F_{tot}}.
-
-*Zick & Homsy (1982)* report :math:`K = F_{tot} / (6\pi\mu a U)` with :math:`U` the mean
-velocity over the unit cell (superficial), so
-
-.. math:: k = \frac{2 a^2}{9 \phi K}.   \qquad (1)
-
-Check: an isolated sphere (:math:`K \to 1`) gives the Stokes value :math:`2a^2/(9\phi)`.
-
-*van der Hoef, Beetstra & Kuipers (2005)* and *Beetstra et al. (2007)* report
-:math:`F = F_d / (3\pi\mu d U)` with :math:`U` superficial and :math:`F_d` the drag force
-*without* the part of the fluid force that the mean pressure gradient exerts on the sphere's
-volume, :math:`F_{tot} = F_d - V_p \nabla p`. With :math:`-\nabla p = n F_{tot}` this gives
-:math:`F_d = (1-\phi) F_{tot}`, hence
-
-.. math:: k = \frac{(1-\phi)\, d^2}{18 \phi F}.   \qquad (2)
-
-Check: their dense-limit term :math:`F = 10\phi/(1-\phi)^2` then gives exactly the
-Kozeny-Carman law :math:`k = d^2 (1-\phi)^3 / (180 \phi^2)`, which is how those authors
-describe it; and their normalisation of the Ergun law,
-:math:`F = 150\phi / (18 (1-\phi)^2)`, gives Ergun's viscous term
-:math:`k = d^2\varepsilon^3/(150(1-\varepsilon)^2)` (the same normalisation as in the
-waLBerla drag-correlation module, ``DragForceCorrelations.h``). Without the :math:`(1-\phi)`
-factor neither would hold.
-
-Sources and what is tabulated here
-----------------------------------
-* **Simple cubic (SC) array, exact**: Zick, A. A. & Homsy, G. M. (1982) *Stokes flow through
-  periodic arrays of spheres*, J. Fluid Mech. 115, 13-26, **Table 2**: drag coefficient
-  :math:`K` (dimensionless, definition above) at :math:`\phi` = 0.027, 0.064, 0.125, 0.216,
-  0.343, 0.45, 0.5236 (touching). The seven values were taken from the Basilisk test suite
-  (``basilisk.fr/src/test/spheres.c``, "adapted from Table 2 of Zick and Homsy, 1982"); the
-  same seven values are quoted, cross-checked against the paper, in the PoreWise
-  verification notes, and the pystokes periodic example quotes the mobilities
-  :math:`1/K` = 0.4980, 0.3559, 0.2330, 0.1344, 0.06494 for the first five. Between
-  tabulated points :math:`\ln K` is interpolated monotonically (PCHIP) in :math:`\phi`;
-  below 0.027 the dilute series below is used.
-* **SC dilute series**: Sangani, A. S. & Acrivos, A. (1982) *Slow flow through a periodic
-  array of spheres*, Int. J. Multiphase Flow 8, 343-360 (extending Hasimoto 1959):
-  :math:`1/K = 1 - 1.7601\chi + \chi^3 - 1.5593\chi^6 + 3.9799\chi^8 - 3.0734\chi^{10}`,
-  :math:`\chi = \phi^{1/3}`. It reproduces the Zick-Homsy table to 0.1 % for
-  :math:`\phi \le 0.125` and 0.8 % at 0.216 (tested), which cross-validates both.
-* **BCC and FCC arrays**: Zick & Homsy (1982) also tabulate BCC and FCC over the full range,
-  but those tables **could not be found in the stored reference material** available to this
-  project (only the abstract, and the SC table as quoted above). No BCC/FCC values are entered
-  here rather than entering numbers from memory. :func:`lattice_permeability` raises
-  ``NotImplementedError`` for them, naming this gap.
-* **Random monodisperse packings (LBM)**: van der Hoef, M. A., Beetstra, R. & Kuipers, J. A. M.
-  (2005) J. Fluid Mech. 528, 233-254, Stokes-limit fit to their lattice-Boltzmann data
-  (also Beetstra, van der Hoef & Kuipers 2007, AIChE J. 53, 489-501, Re -> 0 limit):
-  :math:`F = 10\phi/(1-\phi)^2 + (1-\phi)^2(1 + 1.5\sqrt{\phi})`, converted with (2). Their
-  data cover :math:`0.1 \le \phi \le 0.6`; the stated fit accuracy is a few per cent. The
-  paper's own tables of LB values were not available here, so the tests check the fit's
-  published limits (Stokes drag at :math:`\phi\to 0`, Kozeny-Carman term) and the
-  conversion, not a tabulated LB number.
-* **BCC and FCC arrays, computed here** (not literature): Stokes flow in the 1/8 symmetry
-  cell :math:`[0, a/2]^3` of the cubic cell (mirror planes of all three lattices), Taylor-Hood
-  P2/P1 finite elements (gmsh + scikit-fem), no slip on the spheres, symmetry on the lateral
-  planes, a unit pressure drop as traction on the planes normal to the flow;
-  :math:`k = \int u_x\,dV / (a/2)^2`. Meshes of size 0.05a and 0.04a, Richardson-extrapolated
-  (order 2). The same solver reproduces Zick & Homsy's simple-cubic table to +0.01 % (phi =
-  0.45) and +0.2 % (0.3) after extrapolation (+1.0-1.1 % at 0.05a), and the extrapolation
-  correction is 0.6-2.2 % for BCC/FCC; the solver is in ``tests/test_network_references_stokes.py``,
-  which re-derives a coarse value. Tables :data:`STOKES_CELL_BCC`, :data:`STOKES_CELL_FCC`:
-  (phi, k/a^2) with a the lattice constant; :func:`computed_lattice_permeability`.
-* **Kozeny-Carman** (sanity reference): :math:`k = d^2\varepsilon^3/(180(1-\varepsilon)^2)`.
-* **Ergun, viscous term**: :math:`k = d^2\varepsilon^3/(150(1-\varepsilon)^2)`.
+* simple cubic, exact: Zick & Homsy (1982) J. Fluid Mech. 115:13, Table 2,
+  :math:`k = 2a^2/(9\phi K)`; dilute series of Sangani & Acrivos (1982);
+* BCC and FCC: our own Stokes FE of the symmetry cell (Taylor-Hood P2/P1, Richardson-
+  extrapolated; tables :data:`STOKES_CELL_BCC`, :data:`STOKES_CELL_FCC`);
+* random monodisperse packings: the LBM drag law of van der Hoef, Beetstra & Kuipers (2005)
+  J. Fluid Mech. 528:233, :math:`k = (1-\phi) d^2/(18\phi F)`;
+* Kozeny-Carman and the viscous Ergun term (sanity references).
 """
 
 from __future__ import annotations
@@ -88,7 +21,7 @@ import logging
 import numpy as np
 from scipy.interpolate import PchipInterpolator
 
-from ._lattices import TOUCHING_FRACTION
+from ..packing import TOUCHING_FRACTION
 
 __all__ = [
     "ZICK_HOMSY_SC",

@@ -12,7 +12,7 @@ import logging
 
 import numpy as np
 
-from ._sample import _axis_index
+from ..pores import axis_index
 
 __all__ = ["plot_paths"]
 
@@ -47,7 +47,7 @@ def plot_paths(points, paths, out_png, *, axis="z", title="", max_spheres=4000, 
     import matplotlib.pyplot as plt
 
     x = np.asarray(points, dtype=float)
-    ax_i = _axis_index(axis)
+    ax_i = axis_index(axis)
     other = [i for i in range(3) if i != ax_i][0]
     rng = np.random.default_rng(seed)
     sub = x if x.shape[0] <= max_spheres else x[rng.choice(x.shape[0], max_spheres, False)]

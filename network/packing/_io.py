@@ -21,7 +21,7 @@ log = logging.getLogger(__name__)
 
 def default_packing_path() -> Path:
     """The bundled soybean-like scene, ``network/data/soybean_default.csv`` (see its README)."""
-    return Path(__file__).resolve().parent / "data" / "soybean_default.csv"
+    return Path(__file__).resolve().parents[1] / "data" / "soybean_default.csv"
 
 
 #: Fewest spheres that make a three-dimensional Delaunay tessellation with an interior.

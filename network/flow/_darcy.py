@@ -1,0 +1,112 @@
+r"""Darcy's law on a solved network: the whole-sample and the core permeability.
+
+.. math:: k = \frac{\mu Q H}{A \Delta P}
+
+over the whole sample (inlet to outlet pores), or over its core, free of the sample's boundary
+layer (:func:`core_permeability`).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from .._air import MU_AIR_PA_S
+
+__all__ = ["darcy_permeability", "core_permeability"]
+
+
+def darcy_permeability(q_m3_s, dp_pa, length_m, area_m2, *, viscosity_pa_s=MU_AIR_PA_S):
+    r"""Darcy permeability :math:`k = \mu Q H / (A \Delta P)`, m².
+
+    >>> darcy_permeability(1.0, 1.0, 1.0, 1.0, viscosity_pa_s=2.0)
+    2.0
+    """
+    if not dp_pa > 0 or not length_m > 0 or not area_m2 > 0:
+        raise ValueError(f"need dp > 0, H > 0, A > 0; got {dp_pa}, {length_m}, {area_m2}")
+    return float(viscosity_pa_s * q_m3_s * length_m / (area_m2 * dp_pa))
+
+
+def core_permeability(sample, g, p, *, margin_m: float, viscosity_pa_s: float = 1.0,
+                      n_planes: int = 9):
+    r"""Permeability of the core of a solved sample, free of its boundary layer, m².
+
+    The whole-box estimate :math:`k = \mu Q H/(A\,\Delta p)` includes the layer of pores
+    along the six faces of the sample, where conduits are cut (lateral faces) and the
+    pressure is imposed on pores that are not a lattice plane (inlet/outlet). That layer
+    lowers k by a term that falls as 1/H: on BCC/FCC arrays with the 4-cell sample of
+    :func:`network.validation.lattice_sample_permeability`, -11 to -18 % at 4 cells, still -7 to -9 % at
+    8 cells (measured). Here Darcy's law is applied to the core only,
+
+    .. math:: k = \frac{\mu\,\overline{Q_c}}{A_c\,G},
+
+    with :math:`Q_c` the flow through a plane normal to the axis counted over the throats
+    whose segment (pore centre to pore centre) crosses the plane inside the core
+    cross-section :math:`A_c` (the region shrunk by ``margin_m`` on every lateral side),
+    averaged over ``n_planes`` planes spread over the core length, and :math:`G` the pressure
+    gradient from a least-squares line through the pressures of the core pores (region
+    shrunk by ``margin_m`` on all sides). In a periodic array with integer-cell margins both
+    are exact up to the decaying boundary disturbance (measured: k/k_exact constant to
+    0.3 % from 6 to 11 cells; the whole-box estimate drifts by 8-10 %). The core averages
+    over fewer cells, so it is the noisier of the two in a disordered sample: on 7-cell
+    lattices jittered by 1e-3 lattice constants it varies by about 1 %, the box by 0.2 %.
+
+    Parameters
+    ----------
+    sample : SampleNetwork
+        The solved sample (``pore_xyz``, ``conns``, ``axis``, ``region``).
+    g : (Ms,) array_like
+        Throat conductances, m³ Pa⁻¹ s⁻¹.
+    p : (Ns,) array_like
+        Pore pressures, Pa.
+    margin_m : float, keyword-only
+        Width of the excluded boundary layer, m (> 0; e.g. one lattice constant, or a few
+        sphere diameters in a random packing).
+    viscosity_pa_s : float, keyword-only
+        μ used for ``g`` (default 1).
+    n_planes : int, keyword-only
+        Flux planes (default 9).
+
+    Returns
+    -------
+    k : float
+        m².
+
+    Raises
+    ------
+    ValueError
+        Non-positive margin, a core with fewer than two distinct pore positions along the
+        axis, or no throat crossing the planes.
+    """
+    margin = float(margin_m)
+    if not (np.isfinite(margin) and margin > 0):
+        raise ValueError(f"margin_m must be positive, got {margin_m!r}")
+    ax = int(sample.axis)
+    lat = [i for i in range(3) if i != ax]
+    lo = np.asarray(sample.region.lo, dtype=float) + margin
+    hi = np.asarray(sample.region.hi, dtype=float) - margin
+    if np.any(hi <= lo):
+        raise ValueError(f"margin_m={margin_m!r} leaves no core in the region")
+    x = np.asarray(sample.pore_xyz, dtype=float)
+    p = np.asarray(p, dtype=float)
+    g = np.asarray(g, dtype=float)
+    core = np.all((x >= lo) & (x < hi), axis=1)
+    xa = x[core, ax]
+    if np.unique(np.round(xa / (hi[ax] - lo[ax]), 9)).size < 2:
+        raise ValueError("the core holds fewer than two distinct pore positions along the "
+                         "axis: enlarge the sample or reduce margin_m")
+    grad = -np.polyfit(xa, p[core], 1)[0]
+    i, j = sample.conns[:, 0], sample.conns[:, 1]
+    xi, xj = x[i], x[j]
+    q = g * (p[i] - p[j])                                       # flow from i to j
+    ai, aj = xi[:, ax], xj[:, ax]
+    flows = []
+    for x0 in np.linspace(lo[ax], hi[ax], int(n_planes) + 2)[1:-1]:
+        cross = (ai < x0) != (aj < x0)
+        t = np.where(cross, (x0 - ai) / np.where(cross, aj - ai, 1.0), 0.0)
+        pt = xi[:, lat] + t[:, None] * (xj[:, lat] - xi[:, lat])
+        ok = cross & np.all((pt >= lo[lat]) & (pt < hi[lat]), axis=1)
+        flows.append(np.sum(q[ok] * np.sign(aj[ok] - ai[ok])))
+    if not np.any(flows):
+        raise ValueError("no throat crosses the core planes")
+    area = float(np.prod(hi[lat] - lo[lat]))
+    return float(viscosity_pa_s) * float(np.mean(flows)) / (area * grad)

@@ -1,0 +1,176 @@
+"""The result of the flow stage along one axis, and the summary of several axes."""
+
+from __future__ import annotations
+
+import dataclasses
+
+import numpy as np
+
+from .._air import RHO_AIR_KG_M3
+from ._empirical import asabe_d272_gradient, ergun_gradient, kozeny_carman_gradient
+
+__all__ = ["FlowResult", "combined_summary"]
+
+
+@dataclasses.dataclass(frozen=True)
+class FlowResult:
+    """Network-model result along one axis (all SI). See :meth:`summary` for the JSON keys.
+
+    Per-pore arrays (``pressure_pa`` in Pa for the flow-imposed problem, ``pore_xyz`` in m) are
+    indexed like ``pore_ids``; per-throat arrays (``throat_flow_m3_s``, ``throat_conductance``,
+    ``conns`` in local pore indices) like ``throat_ids`` (tessellation throats). When
+    tetrahedra were joined into pore bodies, ``pore_groups`` (Np,) gives every tetrahedron's
+    body and ``pore_ids`` are body ids; otherwise it is None and ``pore_ids`` are tetrahedra.
+    """
+
+    axis: str
+    conductance_model: str
+    policy: str
+    viscosity_pa_s: float
+    velocity_m_s: float
+    depth_m: float
+    region_lo: tuple
+    region_hi: tuple
+    region_radius: float | None
+    n_pores: int
+    n_throats: int
+    n_inlet: int
+    n_outlet: int
+    n_dropped: int
+    length_m: float
+    area_m2: float
+    flow_m3_s: float
+    permeability_m2: float
+    mean_diameter_m: float
+    sauter_diameter_m: float
+    porosity: float
+    porosity_std: float
+    solver: dict
+    check: dict
+    qstar_stats: dict
+    timings_s: dict
+    pressure_pa: np.ndarray = dataclasses.field(repr=False)
+    throat_flow_m3_s: np.ndarray = dataclasses.field(repr=False)
+    throat_conductance: np.ndarray = dataclasses.field(repr=False)
+    pore_ids: np.ndarray = dataclasses.field(repr=False)
+    throat_ids: np.ndarray = dataclasses.field(repr=False)
+    conns: np.ndarray = dataclasses.field(repr=False)
+    pore_xyz: np.ndarray = dataclasses.field(repr=False)
+    pore_groups: np.ndarray | None = dataclasses.field(default=None, repr=False)
+    #: k of the sample's core, ``core_margin_m`` in from every face (None: cylinder sample
+    #: or a core too small), m²; see :func:`network.flow.core_permeability`.
+    permeability_core_m2: float | None = None
+    core_margin_m: float | None = None
+
+    @property
+    def k_over_d2(self) -> float:
+        """k / d32² (Sauter mean diameter), dimensionless."""
+        return self.permeability_m2 / self.sauter_diameter_m**2
+
+    @property
+    def pressure_gradient_pa_per_m(self) -> float:
+        return self.viscosity_pa_s * self.velocity_m_s / self.permeability_m2
+
+    @property
+    def pressure_drop_pa(self) -> float:
+        return self.pressure_gradient_pa_per_m * self.depth_m
+
+    def comparisons(self) -> dict:
+        """Empirical pressure gradients (Pa/m) and drops over ``depth_m`` (Pa) at the same v."""
+        v, e, d = self.velocity_m_s, self.porosity, self.sauter_diameter_m
+        out = {}
+        for name, grad in (
+            ("ergun", ergun_gradient(v, porosity=e, diameter_m=d, viscosity_pa_s=self.viscosity_pa_s,
+                                     density_kg_m3=RHO_AIR_KG_M3)),
+            ("kozeny_carman", kozeny_carman_gradient(v, porosity=e, diameter_m=d,
+                                                     viscosity_pa_s=self.viscosity_pa_s)),
+            ("asabe_d272", asabe_d272_gradient(v)),
+        ):
+            out[name] = {"pressure_gradient_pa_per_m": float(grad),
+                         "pressure_drop_pa": float(grad * self.depth_m)}
+        return out
+
+    def summary(self) -> dict:
+        """Every scalar as a JSON-ready dict (keys named in issue 4, item 7)."""
+        return {
+            "axis": self.axis,
+            "conductance_model": self.conductance_model,
+            "policy": self.policy,
+            "permeability_m2": self.permeability_m2,
+            "permeability_core_m2": self.permeability_core_m2,
+            "permeability_core_note": (
+                "Darcy's law in the sample's core, core_margin_m in from every face, free of "
+                "the sample's boundary layer (cut conduits on the lateral faces, inlet/outlet "
+                "pores that are not a plane), which lowers permeability_m2 by a term falling "
+                "as 1/H; null for cylindrical samples or a core narrower than 5 mean "
+                "diameters"),
+            "core_margin_m": self.core_margin_m,
+            "k_over_d2": self.k_over_d2,
+            "k_over_d2_note": "d = Sauter mean diameter d32 = 2 sum(r^3)/sum(r^2) (also used in "
+                              "Ergun and Kozeny-Carman)",
+            "pressure_gradient_pa_per_m": self.pressure_gradient_pa_per_m,
+            "pressure_drop_pa": self.pressure_drop_pa,
+            "velocity_m_s": self.velocity_m_s,
+            "depth_m": self.depth_m,
+            "viscosity_pa_s": self.viscosity_pa_s,
+            "flow_m3_s": self.flow_m3_s,
+            "flow_m3_s_note": "total flow for 1 Pa across the sample",
+            "porosity": self.porosity,
+            "porosity_std": self.porosity_std,
+            "mean_diameter_m": self.mean_diameter_m,
+            "sauter_diameter_m": self.sauter_diameter_m,
+            "n_pores": self.n_pores,
+            "n_throats": self.n_throats,
+            "n_inlet_pores": self.n_inlet,
+            "n_outlet_pores": self.n_outlet,
+            "n_dropped_pores": self.n_dropped,
+            "sample_length_m": self.length_m,
+            "sample_area_m2": self.area_m2,
+            "sample_lo_m": list(self.region_lo),
+            "sample_hi_m": list(self.region_hi),
+            "sample_radius_m": self.region_radius,
+            "solver": self.solver,
+            "mass_balance": self.check,
+            "qstar": self.qstar_stats,
+            "comparisons": self.comparisons(),
+            "seconds": self.timings_s,
+        }
+
+
+def combined_summary(results, *, seconds: dict | None = None) -> dict:
+    r"""JSON-ready summary of one or several :class:`FlowResult` (one per axis).
+
+    One axis: its :meth:`FlowResult.summary`. Several: the arithmetic mean of the directional
+    permeabilities, :math:`\bar k = \tfrac13 \sum_a k_a`, the gradient :math:`\mu v/\bar k`
+    (Pa/m) and drop over the depth (Pa) it gives, the anisotropy :math:`k_a/\bar k`, and every
+    axis's own summary under ``by_axis``. ``seconds`` is merged into the ``seconds`` entry.
+    """
+    results = list(results)
+    if not results:
+        raise ValueError("no results to summarise")
+    if len(results) == 1:
+        out = results[0].summary()
+        out["seconds"] = dict(out["seconds"], **(seconds or {}))
+        return out
+    by = {r.axis: r.summary() for r in results}
+    first = results[0]
+    k = float(np.mean([r.permeability_m2 for r in results]))
+    grad = first.viscosity_pa_s * first.velocity_m_s / k
+    return {
+        "axis": "all",
+        "conductance_model": first.conductance_model,
+        "policy": first.policy,
+        "permeability_m2": k,
+        "permeability_note": "arithmetic mean of the three directional permeabilities",
+        "k_over_d2": k / first.sauter_diameter_m**2,
+        "pressure_gradient_pa_per_m": grad,
+        "pressure_drop_pa": grad * first.depth_m,
+        "porosity": first.porosity,
+        "porosity_std": first.porosity_std,
+        "n_pores": max(r.n_pores for r in results),
+        "n_throats": max(r.n_throats for r in results),
+        "anisotropy": {r.axis: float(r.permeability_m2 / k) for r in results},
+        "comparisons": by[first.axis]["comparisons"],
+        "by_axis": by,
+        "seconds": dict(seconds or {}),
+    }

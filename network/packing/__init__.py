@@ -1,0 +1,17 @@
+"""Packings: the :class:`Packing` table, its readers and writers, and generated packings.
+
+Readers take CSV ``x,y,z,r`` (m), ``.npz`` and LAMMPS/LIGGGHTS dumps; :func:`random_packing` is the
+project's one random sphere packer (grow and push, no gravity); :func:`lattice_packing` builds
+the regular arrays whose exact permeability is known.
+"""
+
+from ._generate import SOYBEAN_DEFAULT, periodic_copies, random_packing, soybean_default_scene
+from ._io import (MIN_SPHERES, Packing, default_packing_path, read_container, read_packing,
+                  write_packing_csv)
+from ._lattices import (LATTICES, SPHERES_PER_CELL, TOUCHING_FRACTION, lattice_basis,
+                        lattice_packing, lattice_radius)
+
+__all__ = ["LATTICES", "MIN_SPHERES", "SOYBEAN_DEFAULT", "SPHERES_PER_CELL", "TOUCHING_FRACTION",
+           "Packing", "default_packing_path", "lattice_basis", "lattice_packing",
+           "lattice_radius", "periodic_copies", "random_packing", "read_container",
+           "read_packing", "soybean_default_scene", "write_packing_csv"]
