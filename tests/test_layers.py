@@ -201,3 +201,34 @@ def test_the_rules_see_a_violation(tmp_path):
     imports = [n for n in ast.walk(tree) if isinstance(n, ast.ImportFrom)]
     assert _resolve("network.pores._a", False, imports[0]) == [("network.pores._x", "_y")]
     assert _resolve("network.pores", True, imports[0]) == [("network.pores._x", "_y")]
+
+
+def _public_home(target: str):
+    """The public package above a private module path (``network.pores._sample`` ->
+    ``network.pores``), or None when the path has no private part."""
+    parts = target.split(".")
+    for i, p in enumerate(parts):
+        if p.startswith("_"):
+            return ".".join(parts[:i]) if i else None
+    return None
+
+
+def test_tests_use_the_public_api():
+    """A test imports from a private module only what no public package above it exports."""
+    import importlib
+
+    bad = []
+    for path in sorted((ROOT / "tests").glob("test_*.py")):
+        tree = ast.parse(path.read_text(), filename=str(path))
+        for node in ast.walk(tree):
+            if not isinstance(node, ast.ImportFrom) or node.level or not node.module:
+                continue
+            home = _public_home(node.module)
+            if home is None or home.split(".")[0] not in PACKAGES:
+                continue
+            public = set(getattr(importlib.import_module(home), "__all__", ()))
+            for a in node.names:
+                if a.name in public:
+                    bad.append(f"{path.relative_to(ROOT)}:{node.lineno} imports {a.name} from "
+                               f"{node.module}: use {home}")
+    assert not bad, "\n".join(bad)
