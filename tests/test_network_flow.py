@@ -109,3 +109,31 @@ def test_isolated_free_pore_is_an_error():
     A = sp.csr_array(np.array([[0.0]]))
     with pytest.raises(ValueError, match="prune"):
         solve_pressure(A, np.array([1.0]))
+
+
+def test_amg_solver_builds_once_and_keeps_evolution():
+    """AMGSolver (issue 12): a second right-hand side reuses the hierarchy (no setup time, one
+    build); under 1e12 contrast the evolution hierarchy, once built, is kept for later solves."""
+    from network.flow import AMGSolver
+    idx, c = grid_network(10, 10, 10)
+    A = assemble_laplacian(idx.size, c, np.ones(len(c)))
+    A_ii, b_i, free, _ = apply_pressure_bc(A, np.zeros(idx.size), idx[:, :, [0, -1]].ravel(),
+                                           np.r_[np.ones(100), np.zeros(100)])
+    amg = AMGSolver(A_ii)
+    x1, i1 = amg.solve(b_i)
+    x2, i2 = amg.solve(2 * b_i)
+    assert amg.builds == 1 and i1.setup_s > 0 and i2.setup_s == 0.0
+    np.testing.assert_allclose(x2, 2 * x1, rtol=1e-8)
+    x_ref, _ = solve_pressure(A_ii, b_i)
+    np.testing.assert_array_equal(x1, x_ref)            # solve_pressure is one AMGSolver solve
+    rng = np.random.default_rng(11)
+    idx, c = grid_network(14, 14, 14)
+    g = 10.0 ** rng.uniform(0, 12, len(c))
+    A = assemble_laplacian(idx.size, c, g)
+    A_ii, b_i, _, _ = apply_pressure_bc(A, np.zeros(idx.size), idx[:, :, [0, -1]].ravel(),
+                                        np.r_[np.ones(196), np.zeros(196)])
+    amg = AMGSolver(A_ii)
+    _, i1 = amg.solve(b_i)
+    assert i1.converged and amg.strength == "evolution" and amg.builds == 2
+    _, i2 = amg.solve(b_i + 1e-3 * rng.standard_normal(b_i.size))
+    assert i2.converged and amg.builds == 2 and i2.iterations < i1.iterations

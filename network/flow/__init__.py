@@ -5,6 +5,7 @@ assemble → boundary conditions → solve (pyamg SA-PCG) → verify (:mod:`._li
 permeability; the empirical laws (Ergun, Kozeny-Carman, ASABE D272) set beside it; VTK output.
 """
 
+from ._amg import AMGSolver
 from ._darcy import core_permeability, darcy_permeability
 from ._empirical import (ASABE_SOYBEAN_A, ASABE_SOYBEAN_B, asabe_d272_gradient, ergun_gradient,
                          kozeny_carman_gradient)
@@ -15,7 +16,7 @@ from ._pipeline import (CORE_MARGIN_DIAMETERS, CORE_MIN_DIAMETERS, DEFAULT_DEPTH
 from ._result import FlowResult, combined_summary
 from ._vtk import read_vtu_arrays, write_network_vtu
 
-__all__ = ["ASABE_SOYBEAN_A", "ASABE_SOYBEAN_B", "CORE_MARGIN_DIAMETERS", "CORE_MIN_DIAMETERS",
+__all__ = ["AMGSolver", "ASABE_SOYBEAN_A", "ASABE_SOYBEAN_B", "CORE_MARGIN_DIAMETERS", "CORE_MIN_DIAMETERS",
            "DEFAULT_DEPTH_M", "DEFAULT_VELOCITY_M_S", "FlowResult", "SolveInfo",
            "apply_pressure_bc", "asabe_d272_gradient", "assemble_laplacian", "boundary_flows",
            "combined_summary", "core_permeability", "darcy_permeability", "ergun_gradient",

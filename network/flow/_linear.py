@@ -26,8 +26,9 @@ import time
 from typing import Callable
 
 import numpy as np
-from threadpoolctl import threadpool_limits
 import scipy.sparse as sp
+
+from ._amg import AMGSolver, SolveInfo
 
 
 __all__ = [
@@ -136,25 +137,6 @@ def apply_pressure_bc(A, b, pores, values):
     return sp.csr_array(A_ii), b_i, free, p
 
 
-@dataclasses.dataclass
-class SolveInfo:
-    """What :func:`solve_pressure` did.
-
-    Attributes: ``converged`` (bool), ``iterations`` (int), ``residual`` (final relative residual
-    ‖b − Ax‖/‖b‖ of the unscaled system), ``residuals`` (history of the preconditioned CG,
-    relative), ``setup_s`` and ``solve_s`` (s), ``method`` (str).
-    """
-
-    converged: bool
-    iterations: int
-    residual: float
-    residuals: list
-    setup_s: float
-    solve_s: float
-    method: str
-    assemble_s: float = 0.0
-
-
 def solve_pressure(A, b, *, tol: float = 1e-10, maxiter: int = 500,
                    solver: Callable | None = None) -> tuple[np.ndarray, SolveInfo]:
     r"""Solve the condensed SPD system with AMG-preconditioned CG (or a given solver).
@@ -190,7 +172,8 @@ def solve_pressure(A, b, *, tol: float = 1e-10, maxiter: int = 500,
     not converged after 150 iterations (random contrast over many decades defeats the classical
     strength measure), the hierarchy is rebuilt with ``strength='evolution'`` and CG continues
     from its last iterate (a 14³ grid with log-uniform conductances over 12 decades then
-    converges in ~120 more iterations; tested).
+    converges in ~120 more iterations; tested). One call builds one :class:`AMGSolver`; to
+    solve several right-hand sides with one hierarchy, hold an :class:`AMGSolver` instead.
     """
     A = sp.csr_array(A)
     b = np.asarray(b, dtype=float)
@@ -209,55 +192,7 @@ def solve_pressure(A, b, *, tol: float = 1e-10, maxiter: int = 500,
                             getattr(solver, "__name__", "custom"))
     if bnorm == 0:
         return np.zeros(n), SolveInfo(True, 0, 0.0, [], 0.0, 0.0, "zero rhs")
-    import pyamg
-    
-    d = A.diagonal()
-    if np.any(d <= 0):
-        raise ValueError("matrix has a non-positive diagonal entry: a free pore with no "
-                         "conducting throat (prune disconnected pores first)")
-    s = 1.0 / np.sqrt(d)
-    S = sp.diags_array(s)
-    As = sp.csr_matrix(S @ A @ S)
-    bs = s * b
-    # near-null space of the scaled Laplacian: D^(1/2) 1 (the constant pressure, scaled)
-    B = np.sqrt(d)[:, None]
-    hist: list[float] = []
-    bsn = np.linalg.norm(bs)
-    # plain SA first; strong random contrast (log-uniform over many decades) defeats its
-    # strength-of-connection measure, then the evolution measure is used from where CG stopped
-    y = np.zeros(n)
-    flag, levels, setup, solve_t, method = 1, 0, 0.0, 0.0, "pyamg-sa-pcg"
-    for strength, limit in (("symmetric", min(maxiter, 150)), ("evolution", maxiter)):
-        with threadpool_limits(limits=1, user_api="blas"):
-            t0 = time.perf_counter()
-            ml = pyamg.smoothed_aggregation_solver(As, B=B, symmetry="symmetric",
-                                                   strength=strength, max_coarse=500,
-                                                   coarse_solver="splu")
-            t1 = time.perf_counter()
-            res_abs: list[float] = []
-            y = ml.solve(bs, x0=y, tol=tol, maxiter=limit, accel="cg", residuals=res_abs)
-            t2 = time.perf_counter()
-        hist.extend(r / bsn for r in res_abs[1:])    # res_abs[0] is the initial residual
-        setup += t1 - t0
-        solve_t += t2 - t1
-        levels = len(ml.levels)
-        if np.linalg.norm(bs - As @ y) <= tol * bsn * 1.0000001:
-            flag = 0
-            break
-        method = "pyamg-sa(evolution)-pcg"
-        log.info("SA-PCG not converged after %d iterations (residual %.2e): rebuilding with "
-                 "evolution strength", len(hist), hist[-1] if hist else float("nan"))
-    x = s * y
-    res = float(np.linalg.norm(b - A @ x) / bnorm)
-    info = SolveInfo(converged=flag == 0, iterations=len(hist), residual=res, residuals=hist,
-                     setup_s=setup, solve_s=solve_t, method=method)
-    if flag != 0:
-        log.warning("CG did not converge after %d iterations, residual %.3g",
-                    len(hist), hist[-1] if hist else float("nan"))
-    else:
-        log.info("%s: %d unknowns, %d levels, %d iterations, setup %.3f s, solve %.3f s",
-                 method, n, levels, len(hist), setup, solve_t)
-    return x, info
+    return AMGSolver(A).solve(b, tol=tol, maxiter=maxiter)
 
 
 def boundary_flows(throat_conns, g, p, inlet, outlet):
