@@ -74,3 +74,63 @@ def test_packing_shape_checks():
         Packing(np.zeros((4, 2)), np.ones(4))
     with pytest.raises(ValueError, match="radii must have shape"):
         Packing(np.zeros((4, 3)), np.ones(3))
+
+
+def _rows(sep):
+    return [sep.join(repr(float(v)) for v in (*C[i], R[i])) for i in range(12)]
+
+
+@pytest.mark.parametrize("sep", [" ", "\t", ";", "  \t "])
+def test_whitespace_tab_and_semicolon_files(tmp_path, sep):
+    p = tmp_path / "a.txt"
+    p.write_text("\n".join(_rows(sep)) + "\n")
+    pk = read_packing(p)
+    np.testing.assert_array_equal(pk.centers, C)
+    np.testing.assert_array_equal(pk.radii, R)
+
+
+def test_yade_export_text(tmp_path):
+    # YADE's yade.export.text writes '#format x_y_z_r' and rows "x y z r" separated by spaces
+    p = tmp_path / "yade.txt"
+    p.write_text("#format x_y_z_r\n" + "\n".join(_rows(" ")) + "\n")
+    np.testing.assert_array_equal(read_packing(p).radii, R)
+
+
+def test_diameter_header_is_halved_and_units_scale_to_metres(tmp_path):
+    p = tmp_path / "d.tsv"
+    lines = ["id\tdiameter\tx\ty\tz"] + [
+        f"{i}\t{2 * float(R[i])!r}\t{float(C[i, 0])!r}\t{float(C[i, 1])!r}\t{float(C[i, 2])!r}"
+        for i in range(12)]
+    p.write_text("\n".join(lines) + "\n")
+    np.testing.assert_allclose(read_packing(p).radii, R, rtol=1e-15)
+    mm = read_packing(p, units="mm")
+    np.testing.assert_allclose(mm.radii, R * 1e-3, rtol=1e-15)
+    np.testing.assert_allclose(mm.centers, C * 1e-3, rtol=1e-15)
+    with pytest.raises(ValueError, match="unknown length unit 'in'"):
+        read_packing(p, units="in")
+
+
+def test_scale_warning_suggests_units():
+    from network.packing import scale_warning
+
+    assert scale_warning(Packing(C * 1e-3, np.full(12, 3e-3))) is None        # 6 mm grains
+    msg = scale_warning(Packing(C, np.full(12, 3.0)))                          # 6 mm in "m"
+    assert "6 m is outside 0.5-50 mm" in msg and "--units mm" in msg
+
+
+@pytest.mark.parametrize("content, match", [
+    (b"garbage", "not a .npz \\(zip\\) archive"),
+])
+def test_bad_npz_names_the_formats(tmp_path, content, match):
+    p = tmp_path / "x.npz"
+    p.write_bytes(content)
+    with pytest.raises(ValueError, match=match) as e:
+        read_packing(p)
+    assert "formats read" in str(e.value)
+
+
+def test_binary_file_is_refused(tmp_path):
+    p = tmp_path / "x.dat"
+    p.write_bytes(b"\x00\x01\x02abc")
+    with pytest.raises(ValueError, match="binary file, not a packing"):
+        read_packing(p)

@@ -6,12 +6,13 @@ the regular arrays whose exact permeability is known.
 """
 
 from ._generate import SOYBEAN_DEFAULT, periodic_copies, random_packing, soybean_default_scene
-from ._io import (MIN_SPHERES, Packing, default_packing_path, read_container, read_packing,
+from ._io import (FORMATS, MIN_SPHERES, PLAUSIBLE_DIAMETER_M, UNITS, Packing,
+                  default_packing_path, read_container, read_packing, scale_warning,
                   write_packing_csv)
 from ._lattices import (LATTICES, SPHERES_PER_CELL, TOUCHING_FRACTION, lattice_basis,
                         lattice_packing, lattice_radius)
 
-__all__ = ["LATTICES", "MIN_SPHERES", "SOYBEAN_DEFAULT", "SPHERES_PER_CELL", "TOUCHING_FRACTION",
+__all__ = ["FORMATS", "LATTICES", "MIN_SPHERES", "PLAUSIBLE_DIAMETER_M", "UNITS", "SOYBEAN_DEFAULT", "SPHERES_PER_CELL", "TOUCHING_FRACTION",
            "Packing", "default_packing_path", "lattice_basis", "lattice_packing",
            "lattice_radius", "periodic_copies", "random_packing", "read_container",
-           "read_packing", "soybean_default_scene", "write_packing_csv"]
+           "read_packing", "scale_warning", "soybean_default_scene", "write_packing_csv"]

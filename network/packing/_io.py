@@ -1,7 +1,7 @@
-"""Reading sphere packings: CSV ``x,y,z,r``, ``.npz`` and LAMMPS/LIGGGHTS ``dump custom``.
+"""Reading sphere packings: delimited text ``x,y,z,r``, ``.npz`` and LAMMPS/LIGGGHTS dumps.
 
-A packing is a table of sphere centres (N, 3) and radii (N,), in metres unless the caller
-says otherwise (the readers never rescale). Every reader validates at the door and names the
+A packing is a table of sphere centres (N, 3) and radii (N,), in metres: a file in mm or cm
+is read with ``units``. Every reader validates at the door and names the
 offending line (1-based, as an editor shows it) in its ``ValueError``.
 """
 
@@ -10,12 +10,13 @@ from __future__ import annotations
 import dataclasses
 import logging
 import os
+import zipfile
 from pathlib import Path
 
 import numpy as np
 
 __all__ = ["Packing", "read_packing", "write_packing_csv", "MIN_SPHERES", "default_packing_path",
-           "read_container"]
+           "read_container", "scale_warning", "UNITS", "FORMATS", "PLAUSIBLE_DIAMETER_M"]
 
 log = logging.getLogger(__name__)
 
@@ -119,38 +120,66 @@ def _parse_rows(rows, ncols, first_line, source):
     return out
 
 
+#: Header names of the radius column (``diameter`` names are halved).
+_RADIUS_NAMES = ("r", "radius", "rad")
+_DIAMETER_NAMES = ("d", "diameter", "diam")
+
+
+def _delimiter(line: str):
+    """',' or ';' when the line holds one, else None (any run of spaces or tabs)."""
+    for d in (",", ";"):
+        if d in line:
+            return d
+    return None
+
+
+def _split(line: str, delim):
+    return [f.strip() for f in (line.split(delim) if delim else line.split())]
+
+
 def _read_csv(path: Path) -> Packing:
+    """Delimited text: comma, semicolon, or spaces/tabs (YADE's ``export.text``: ``#`` comment
+    lines, then ``x y z r`` rows); an optional header names x, y, z and r/radius/diameter."""
     src = str(path)
-    text = path.read_text().splitlines()
+    text = path.read_text(errors="replace").splitlines()
     lines = [(i + 1, ln.strip()) for i, ln in enumerate(text)]
     lines = [(i, ln) for i, ln in lines if ln and not ln.startswith("#")]
     if not lines:
-        raise ValueError(f"{src}: empty file")
+        raise ValueError(f"{src}: empty file (no data line)")
     head_no, head = lines[0]
-    names = [h.strip().lower() for h in head.split(",")]
+    delim = _delimiter(head)
+    names = [h.lower() for h in _split(head, delim)]
+    scale = 1.0
     if any(not _isfloat(h) for h in names):
-        missing = [c for c in ("x", "y", "z", "r") if c not in names]
+        rname = [c for c in _RADIUS_NAMES + _DIAMETER_NAMES if c in names]
+        missing = [c for c in ("x", "y", "z") if c not in names] + ([] if rname else ["r"])
         if missing:
             raise ValueError(f"{src}: line {head_no}: header {head!r} lacks column(s) "
-                             f"{missing}; expected x,y,z,r")
-        cols = [names.index(c) for c in ("x", "y", "z", "r")]
+                             f"{missing}; expected x, y, z and r (or radius, or diameter)")
+        cols = [names.index(c) for c in ("x", "y", "z")] + [names.index(rname[0])]
+        scale = 0.5 if rname[0] in _DIAMETER_NAMES else 1.0
         body = lines[1:]
-    else:  # no header: x,y,z,r in that order
+        if not body:
+            raise ValueError(f"{src}: no data line after the header")
+    else:  # no header: x, y, z, r in that order
         cols = [0, 1, 2, 3]
-        names = ["x", "y", "z", "r"]
         body = lines
+    ncols = len(names)
+    if ncols < 4:
+        raise ValueError(f"{src}: line {head_no}: expected at least 4 columns (x y z r), got "
+                         f"{ncols}: {head!r}")
     fast = None
     try:
-        fast = np.loadtxt([ln for _, ln in body], delimiter=",", ndmin=2)
+        fast = np.loadtxt([ln for _, ln in body], delimiter=delim, ndmin=2)
     except ValueError:
         fast = None
-    if fast is None or fast.shape[1] != len(names):
-        fast = _parse_rows([[f.strip() for f in ln.split(",")] for _, ln in body], len(names),
+    if fast is None or fast.shape[1] != ncols:
+        fast = _parse_rows([_split(ln, delim) for _, ln in body], ncols,
                            [i for i, _ in body], src)
     data = fast[:, cols]
     lineno = np.array([i for i, _ in body])
-    _validate(data[:, :3], data[:, 3], lineno, src)
-    return Packing(data[:, :3], data[:, 3], source=src)
+    _validate(data[:, :3], data[:, 3] * scale, lineno, src)
+    return Packing(data[:, :3], data[:, 3] * scale, source=src)
 
 
 def _isfloat(s: str) -> bool:
@@ -222,21 +251,25 @@ def _read_dump(path: Path) -> Packing:
     return Packing(c, r, source=src)
 
 
-def read_packing(path: str | os.PathLike) -> Packing:
-    """Read a sphere packing from a file.
+def read_packing(path: str | os.PathLike, *, units: str = "m") -> Packing:
+    """Read a sphere packing from a file, in metres.
 
     Parameters
     ----------
     path : str or path-like
-        ``*.csv``: header ``x,y,z,r`` (any column order, extra columns ignored; without a header
-        the columns are x,y,z,r), ``#`` comments allowed. ``*.npz``: arrays ``centers`` (N, 3) and
-        ``radii`` (N,). Anything whose text contains ``ITEM: ATOMS`` (LAMMPS/LIGGGHTS
-        ``dump custom`` with ``x y z radius`` columns, the last snapshot is used).
+        Formats (:data:`FORMATS`): delimited text (``*.csv``, ``*.txt``, ...: comma, semicolon,
+        or spaces/tabs, as YADE's ``export.text`` writes; an optional header naming x, y, z and
+        r, radius or diameter in any order, extra columns ignored; without a header the columns
+        are x, y, z, r; ``#`` comments allowed); ``*.npz`` with arrays ``centers`` (N, 3) and
+        ``radii`` (N,); LAMMPS/LIGGGHTS ``dump custom`` text (``x y z radius`` columns, the
+        last snapshot).
+    units : {'m', 'mm', 'cm'}, keyword-only
+        Unit of the file's lengths (default metres); the packing is returned in metres.
 
     Returns
     -------
     Packing
-        Centres and radii in the file's unit (metres by convention).
+        Centres and radii, m.
 
     Raises
     ------
@@ -246,23 +279,59 @@ def read_packing(path: str | os.PathLike) -> Packing:
         Malformed content, NaN/inf, non-positive radii, duplicate centres or fewer than
         ``MIN_SPHERES`` spheres; the message names the file and line.
     """
+    if units not in UNITS:
+        raise ValueError(f"unknown length unit {units!r}; choose one of {', '.join(UNITS)}")
     p = Path(path)
     if not p.is_file():
         raise FileNotFoundError(f"packing file not found: {p}")
     suffix = p.suffix.lower()
     if suffix == ".npz":
-        pk = _read_npz(p)
-    elif suffix == ".csv":
-        pk = _read_csv(p)
+        if not zipfile.is_zipfile(p):
+            raise ValueError(f"{p}: not a .npz (zip) archive; formats read: {'; '.join(FORMATS)}")
+        try:
+            pk = _read_npz(p)
+        except (OSError, EOFError, zipfile.BadZipFile) as e:
+            raise ValueError(f"{p}: not a readable .npz file ({e}); formats read: "
+                             f"{'; '.join(FORMATS)}") from e
     else:
-        with open(p, errors="replace") as f:
+        with open(p, "rb") as f:
             head = f.read(65536)
-        if "ITEM: ATOMS" in head or "ITEM: TIMESTEP" in head:
+        if b"\0" in head:
+            raise ValueError(f"{p}: a binary file, not a packing; formats read: "
+                             f"{'; '.join(FORMATS)}")
+        if b"ITEM: ATOMS" in head or b"ITEM: TIMESTEP" in head:
             pk = _read_dump(p)
         else:
             pk = _read_csv(p)
+    if units != "m":
+        f = UNITS[units]
+        pk = Packing(pk.centers * f, pk.radii * f, source=f"{pk.source} ({units})")
     log.info("read %d spheres from %s", pk.n, p)
     return pk
+
+
+#: Length units a packing file may be written in, with their factor to metres.
+UNITS = {"m": 1.0, "cm": 1e-2, "mm": 1e-3}
+#: Formats :func:`read_packing` reads, for error messages.
+FORMATS = ("delimited text x,y,z,r (comma, semicolon, spaces or tabs; YADE export.text)",
+           ".npz with centers and radii", "LAMMPS/LIGGGHTS dump custom")
+#: Mean grain diameters (m) outside which a packing is probably not in metres.
+PLAUSIBLE_DIAMETER_M = (0.5e-3, 50e-3)
+
+
+def scale_warning(packing: Packing) -> str | None:
+    """A one-line warning when the mean diameter is outside 0.5-50 mm (not metres?), else None.
+
+    >>> scale_warning(Packing(np.eye(3) * 10, np.full(3, 3.3)))[:40]
+    'mean grain diameter 6.6 m is outside 0.5'
+    """
+    d = packing.mean_diameter
+    lo, hi = PLAUSIBLE_DIAMETER_M
+    if lo <= d <= hi:
+        return None
+    return (f"mean grain diameter {d:.3g} m is outside 0.5-50 mm, the range of grains: if the "
+            f"file is not in metres, give --units mm or --units cm (a dimensionless packing "
+            f"is fine with --viscosity 1)")
 
 
 def read_container(path: str | os.PathLike) -> dict | None:

@@ -10,8 +10,8 @@ import dataclasses
 
 import numpy as np
 
-__all__ = ["AXES", "axis_index", "Region", "default_region", "sample_region", "OUTSIDE_BED_DIAMETERS",
-           "MIN_INTERIOR_DIAMETERS"]
+__all__ = ["AXES", "MIN_INTERIOR_DIAMETERS", "OUTSIDE_BED_DIAMETERS", "Region", "axis_index",
+           "check_inside_bed", "default_region", "sample_region"]
 
 AXES = {"x": 0, "y": 1, "z": 2}
 
@@ -160,12 +160,36 @@ def sample_region(packing, *, box=None, margin: float | None = None, cylinder: b
     """
     ax = axis_index(axis)
     if box is None:
-        return default_region(packing, margin=margin, cylinder=cylinder, container=container,
-                              axis=ax)
-    b = np.asarray(box, dtype=float)
-    if b.shape != (6,):
-        raise ValueError(f"a sample box is 6 numbers (xmin xmax ymin ymax zmin zmax), got {box!r}")
-    reg = Region(b[0::2], b[1::2])
-    if cylinder:
-        reg = Region(reg.lo, reg.hi, 0.5 * float(np.min(np.delete(reg.hi - reg.lo, ax))))
+        reg = default_region(packing, margin=margin, cylinder=cylinder, container=container,
+                             axis=ax)
+    else:
+        b = np.asarray(box, dtype=float)
+        if b.shape != (6,):
+            raise ValueError(f"a sample box is 6 numbers (xmin xmax ymin ymax zmin zmax), got "
+                             f"{box!r}")
+        reg = Region(b[0::2], b[1::2])
+        if cylinder:
+            reg = Region(reg.lo, reg.hi, 0.5 * float(np.min(np.delete(reg.hi - reg.lo, ax))))
+    if packing is not None:
+        check_inside_bed(packing, reg)
     return reg
+
+
+def check_inside_bed(packing, region: Region, *, tolerance: float = 1e-9) -> None:
+    """ValueError, naming the bed's extent, when ``region`` reaches outside the packed bed.
+
+    The bed is the bounding box of the spheres, :math:`[\min(x - r), \max(x + r)]` per axis.
+    Outside it there are no grains: a sample reaching there takes in the hull's empty
+    tetrahedra (measured: porosity 0.945 and a pressure drop 12 times too high on the bundled
+    scene), so it is refused rather than solved.
+    """
+    lo = (packing.centers - packing.radii[:, None]).min(axis=0)
+    hi = (packing.centers + packing.radii[:, None]).max(axis=0)
+    tol = tolerance * float(np.max(hi - lo))
+    out = np.flatnonzero((region.lo < lo - tol) | (region.hi > hi + tol))
+    if out.size:
+        k = int(out[0])
+        raise ValueError(
+            f"the sample {'xyz'[k]} {region.lo[k]:.6g}..{region.hi[k]:.6g} reaches outside the "
+            f"packed bed, which spans x {lo[0]:.6g}..{hi[0]:.6g}, y {lo[1]:.6g}..{hi[1]:.6g}, "
+            f"z {lo[2]:.6g}..{hi[2]:.6g} (same unit as the packing): give a sample inside it")

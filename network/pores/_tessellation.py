@@ -159,6 +159,21 @@ def _circumcenters(p: np.ndarray) -> np.ndarray:
     return out
 
 
+def _local_frame(centers):
+    """Centres to tessellate and the origin to add back (None: used as given).
+
+    Coordinates far from the origin (site coordinates, an offset of 1e6 m) lose digits in
+    Qhull and in the circumcentres; when the packing's bounding-box centre lies farther from
+    the origin than the packing is wide, the points are shifted to it. A packing near the
+    origin is tessellated as given, so its results do not move by a rounding.
+    """
+    lo, hi = centers.min(axis=0), centers.max(axis=0)
+    mid = 0.5 * (lo + hi)
+    if np.max(np.abs(mid)) <= np.max(hi - lo):
+        return centers, None
+    return centers - mid, mid
+
+
 def tessellate(packing: Packing, *, qhull_options: str = QHULL_OPTIONS,
                flat_tol: float = 1e-6, tie_tol: float = 1e-6) -> Tessellation:
     r"""Delaunay tessellation of the sphere centres into pores and throats.
@@ -208,7 +223,7 @@ def tessellate(packing: Packing, *, qhull_options: str = QHULL_OPTIONS,
     """
     if not isinstance(packing, Packing):
         raise TypeError(f"packing must be a Packing, got {type(packing).__name__}")
-    pts = packing.centers
+    pts, origin = _local_frame(packing.centers)
     try:
         dt = Delaunay(pts, qhull_options=qhull_options)
     except QhullError as e:
@@ -286,6 +301,10 @@ def tessellate(packing: Packing, *, qhull_options: str = QHULL_OPTIONS,
                     "Qhull precision)", coplanar.size)
     log.info("tessellated %d spheres: %d pores (%d flat), %d throats (%d on the hull, %d tied)",
              packing.n, n_p, int(flat.sum()), n_t, int((~inner).sum()), int(tied.sum()))
+    if origin is not None:
+        centroid += origin
+        circ += origin
+        tcent += origin
     return Tessellation(
         packing=packing, pore_vertices=simp, pore_neighbors=neigh, pore_throats=pore_throats,
         pore_centroid=centroid, pore_volume=volume, pore_circumcenter=circ,
