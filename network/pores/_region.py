@@ -176,7 +176,7 @@ def sample_region(packing, *, box=None, margin: float | None = None, cylinder: b
 
 
 def check_inside_bed(packing, region: Region, *, tolerance: float = 1e-9) -> None:
-    """ValueError, naming the bed's extent, when ``region`` reaches outside the packed bed.
+    r"""ValueError, naming the bed's extent, when ``region`` reaches outside the packed bed.
 
     The bed is the bounding box of the spheres, :math:`[\min(x - r), \max(x + r)]` per axis.
     Outside it there are no grains: a sample reaching there takes in the hull's empty
