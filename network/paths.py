@@ -14,9 +14,12 @@ Delaunay tessellation); ``maximin`` is the optimal widest (maximin-bottleneck) p
 plane normal to ``--axis`` (the other two axes in x, y, z order); ``--entries N`` draws N at
 random (``--seed``) away from the walls. The branched-path model (Table 4.4 layout, then the
 Table 4.5 comparison with ASABE D272 and Ergun) is evaluated on every widest/narrowest path at
-each ``--velocity``; ``--pressure`` solves the network model (``network._pipeline.solve_network``)
+each ``--velocity``; ``--pressure`` solves the network model (``network.flow.solve_network``)
 and prints the pressure drop along every path that lies on the tessellation (thesis 4.2.3).
-Timings, load average and platform go into the JSON.
+Timings, load average and platform go into the JSON. ``--standin LX LY LZ`` replaces PACKING
+by a geometric stand-in from ``network.packing.random_packing`` (no gravity) at porosity 0.408.
+A bad input (no packing, an unreadable file, a bad option value) exits with status 2 and one
+line on stderr.
 """
 
 from __future__ import annotations
@@ -30,14 +33,11 @@ import time
 
 import numpy as np
 
-from .airpaths._paths import (
-    _relaxed_packing,
-    bed_depth,
-    branched_table,
-    face_graph,
-    random_entry_points,
-    trace_paths,
-)
+from .airpaths import (bed_depth, branched_table, face_graph, plot_paths, pore_pressure_array,
+                       pressure_along_path, random_entry_points, trace_paths)
+from .flow import asabe_d272_gradient, ergun_gradient, solve_network
+from .packing import Packing, random_packing, read_packing
+from .pores import Region, tessellate, tie_groups
 
 _ALL = ("widest", "narrowest", "maximin", "shortest")
 #: Thesis values (Tables 4.1-4.5) printed beside ours.
@@ -79,38 +79,65 @@ def _parser():
     p.add_argument("--plot", metavar="OUT.png")
     p.add_argument("--standin", nargs=3, type=float, metavar=("LX", "LY", "LZ"),
                    help="instead of PACKING, a geometric stand-in packing in this box (m): "
-                        "diameters 5.5-7.5 mm, porosity 0.408, by overlap relaxation (--seed)")
+                        "diameters 5.5-7.5 mm, porosity 0.408, by network.packing.random_packing "
+                        "(--seed)")
     return p
+
+
+#: Stand-in packing (``--standin``): soybean diameters (thesis Table 3.1) and the thesis's bin
+#: porosity.
+STANDIN_DIAMETERS_M = (5.5e-3, 7.5e-3)
+STANDIN_POROSITY = 0.408
+
+
+def standin_packing(box_m, *, rng=None):
+    """Geometric stand-in packing of about the box ``box_m`` (m): (centers, radii).
+
+    As many spheres (diameters uniform in :data:`STANDIN_DIAMETERS_M`) as give porosity
+    :data:`STANDIN_POROSITY` in the box, packed by ``network.packing.random_packing`` with the
+    box's aspect ratio; its box has the volume of the drawn spheres at that porosity, so it
+    differs from ``box_m`` by the sampling error of the mean sphere volume.
+    """
+    box = np.asarray(box_m, dtype=float)
+    if box.shape != (3,) or not np.all(box > 0):
+        raise ValueError(f"--standin needs three box sides > 0 (m), got {box_m}")
+    d0, d1 = STANDIN_DIAMETERS_M
+    mean_vol = np.pi / 6.0 * (d1**4 - d0**4) / (4.0 * (d1 - d0))  # E[pi d^3 / 6], d uniform
+    n = int(round((1.0 - STANDIN_POROSITY) * box.prod() / mean_vol))
+    pk = random_packing(n, diameter_range_m=STANDIN_DIAMETERS_M,
+                        solid_fraction=1.0 - STANDIN_POROSITY, aspect=box, rng=rng)
+    return np.asarray(pk.centers), np.asarray(pk.radii)
 
 
 def main(argv=None) -> int:
     args = _parser().parse_args(argv)
     t0 = time.perf_counter()
-    if args.standin:
-        x, r = _relaxed_packing(args.standin, rng=args.seed)
-        source = f"stand-in {args.standin} seed {args.seed}"
-    elif args.packing:
-        from .packing import read_packing
-
-        pk = read_packing(args.packing)
-        x, r = np.asarray(pk.centers), np.asarray(pk.radii)
-        source = str(args.packing)
-    else:
-        print("error: give PACKING or --standin LX LY LZ", file=sys.stderr)
+    try:
+        if args.standin:
+            x, r = standin_packing(args.standin, rng=args.seed)
+            source = f"stand-in {args.standin} seed {args.seed}"
+        elif args.packing:
+            pk = read_packing(args.packing)
+            x, r = np.asarray(pk.centers), np.asarray(pk.radii)
+            source = str(args.packing)
+        else:
+            raise ValueError("give PACKING or --standin LX LY LZ")
+        if any(u <= 0 for u in args.velocity):
+            raise ValueError(f"--velocity must be > 0 m/s, got {args.velocity}")
+        t_read = time.perf_counter() - t0
+        if args.entry:
+            xy = np.array(args.entry, dtype=float)
+        else:
+            xy = random_entry_points(x, r, 3 if args.entries is None else args.entries,
+                                     axis=args.axis, rng=args.seed)
+    except (OSError, ValueError) as e:
+        print(f"error: {e}", file=sys.stderr)
         return 2
-    t_read = time.perf_counter() - t0
-    if args.entry:
-        xy = np.array(args.entry, dtype=float)
-    else:
-        xy = random_entry_points(x, r, args.entries or 3, axis=args.axis, rng=args.seed)
     kinds = _ALL if args.kind == "all" else (args.kind,)
     need_graph = any(k in ("maximin", "shortest") for k in kinds) or args.method == "delaunay"
     graph = tess = None
     t1 = time.perf_counter()
     if need_graph or args.pressure:
-        from .packing import Packing
-        from .pores import tessellate
-
         tess = tessellate(Packing(x, r, source))
         graph = face_graph(tess)
     t_graph = time.perf_counter() - t1
@@ -199,8 +226,6 @@ def main(argv=None) -> int:
         with open(args.json, "w") as f:
             json.dump(out, f, indent=1)
     if args.plot:
-        from .airpaths import plot_paths
-
         plot_paths(x, paths, args.plot, axis=args.axis, title=source)
     return 0
 
@@ -208,8 +233,6 @@ def main(argv=None) -> int:
 def _table_4_5(x, r, depth, velocities, branched):
     """Pressure drops over the bed depth (Pa): measured (thesis), branched model (ours, mean of
     the MFx3 average-width paths), ASABE D272 and Ergun at the bed's porosity (thesis 4.2.2)."""
-    from .flow import asabe_d272_gradient, ergun_gradient
-
     lo, hi = (x - r[:, None]).min(axis=0), (x + r[:, None]).max(axis=0)
     porosity = 1.0 - float(np.sum(4.0 / 3.0 * np.pi * r**3) / np.prod(hi - lo))
     us = [f"{u:g}" for u in velocities]
@@ -226,14 +249,7 @@ def _table_4_5(x, r, depth, velocities, branched):
 
 def _pressure_along(args, x, r, source, tess, graph, paths):
     """Network-model pressures along the paths that lie on the tessellation."""
-    from .packing import Packing
-    from .airpaths import pore_pressure_array, pressure_along_path
-    from .flow import solve_network
-    from .pores import tie_groups
-
     t = time.perf_counter()
-    from .pores import Region
-
     # sample: 1.5 mean diameters from the side walls (less in a thin bin), 4 mean diameters
     # (the thesis's 0.026 m) from the floor and from the highest centre, so a loose top surface
     # still leaves outlet pores

@@ -1,24 +1,25 @@
 """Airflow paths (thesis 3.4, Eqs. 3.24-3.27; Appendices D-E): analytic and lattice checks."""
 
+import dataclasses
 import json
 
 import numpy as np
 import pytest
 
 from network import Packing, tessellate
-from network.packing import lattice_packing
-from network.airpaths._paths import (
+from network.airpaths import (
     EXIT_FACES,
-    _eq323_negative,
-    _relaxed_packing,
     bed_depth,
     branched_path_pressure_drop,
     build_paths,
+    entry_faces,
+    eq323_negative,
     face_areas,
     face_graph,
     interior_angles,
     maximin_paths,
     path_length,
+    pore_pressure_array,
     pore_quality,
     pressure_along_path,
     shortest_paths,
@@ -28,6 +29,8 @@ from network.airpaths._paths import (
     turning_angles,
     walk_paths,
 )
+from network.packing import lattice_packing, random_packing
+from network.paths import main
 
 
 # ------------------------------------------------------------------ Eqs. 3.25-3.27
@@ -95,15 +98,11 @@ def test_maximin_follows_the_only_wide_channel(lattice):
     # maximin path must be that chain, and its tortuosity that of the chain
     c, r, tess, g = lattice
     xy = np.array([[9.75e-3, 9.75e-3]])
-    from network.airpaths import entry_faces
-
     f0, p0 = entry_faces(g, xy)
     (chain,), ok = shortest_paths(g, f0, p0)
     assert ok[0] and chain.size > 10
     area = np.where(g.throat_open_area > 0, 1e-6, 0.0)
     area[chain] = 1e-5
-    import dataclasses
-
     g2 = dataclasses.replace(g, throat_open_area=area)
     for tiebreak in ("tree", "shortest"):
         (faces,), ok, bott = maximin_paths(g2, f0, p0, tiebreak=tiebreak)
@@ -131,7 +130,7 @@ def test_built_paths_obey_the_step_rule(lattice, kind):
         assert h[-1] >= c[:, 2].max() - r.mean()
         tri = p.tetra_vertices[:, EXIT_FACES]  # (n, 3, 3)
         _, op = face_areas(c, r, tri)
-        op = np.where(_eq323_negative(c, r, tri), 0.0, op)
+        op = np.where(eq323_negative(c, r, tri), 0.0, op)
         base_h = c[p.tetra_vertices[:, :3]].mean(axis=1)[:, 2]
         allowed = (op > 0) & (c[tri].mean(axis=2)[:, :, 2] > base_h[:, None])
         chosen = op[np.arange(p.n_tetrahedra), p.exit_local]
@@ -145,8 +144,6 @@ def test_built_paths_obey_the_step_rule(lattice, kind):
 def test_walked_paths_and_network_pressure(lattice):
     c, r, tess, g = lattice
     xy = np.array([[9.75e-3, 9.75e-3]])
-    from network.airpaths import entry_faces
-
     f0, p0 = entry_faces(g, xy)
     (faces,), status, _, _ = walk_paths(g, f0, p0, kind="widest")
     assert status[0] == "ok"
@@ -173,9 +170,9 @@ def test_branched_model_on_a_path_is_linear_in_velocity(lattice):
 
 # ------------------------------------------------------------------ CLI
 def test_cli_json_and_plot(tmp_path):
-    from network.paths import main
-
-    x, r = _relaxed_packing((0.04, 0.04, 0.06), iters=300, rng=5)
+    pk = random_packing(386, solid_fraction=0.592, aspect=(0.04, 0.04, 0.06), rng=5,
+                        max_sweeps=300)
+    x, r = pk.centers, pk.radii
     csv = tmp_path / "p.csv"
     np.savetxt(csv, np.column_stack([x, r]), delimiter=",", header="x,y,z,r", comments="")
     out, png = tmp_path / "o.json", tmp_path / "o.png"
@@ -191,8 +188,6 @@ def test_cli_json_and_plot(tmp_path):
 
 
 def test_pore_pressure_array_maps_sample_and_groups():
-    from network.airpaths import pore_pressure_array
-
     # tetrahedra 0-4; the sample solved bodies 1 and 3; tetrahedra 3 and 4 form body 3
     p = pore_pressure_array(5, [1, 3], [2.0, 7.0], labels=[0, 1, 2, 3, 3])
     np.testing.assert_array_equal(np.isnan(p), [True, False, True, False, False])

@@ -21,19 +21,8 @@ The branches use :math:`F = 2100` (Lee et al. 2007) times a multiplier of the br
 divides in proportion to the daughter cross-sections (Eq. 3.38), so all daughters carry the same
 velocity :math:`Q_0 / \sum_j \pi D_j^2/4`.
 
-Choices that the thesis leaves open, stated here:
-
-* ``branches='path'`` (default) keeps only the daughter the path leaves through, as Eq. 3.28
-  is written; ``branches='all'`` sums the losses of the three daughters, as the script of
-  Appendix F does. (On a 5027-sphere stand-in of the thesis's bin, 'path' with the maximum
-  width gives 1.97 Pa at 0.013 m/s against the thesis's 1.4-2.0 Pa; 'all' gives 3.3 x that.)
-* A daughter whose diameter is 0 (a closed face, open area <= 0) carries no flow. When only
-  one daughter is open the flow does not divide: that daughter is a straight pipe
-  (:math:`F = 64`, no multiplier), so a chain of tetrahedra with one open exit each is exactly
-  Hagen–Poiseuille over the total length.
-* The local flow-path width (LFPW, Eq. 3.24, :math:`d = 2\sqrt{S/\pi}`) is taken from the full
-  triangle area (``'max'``), the open area between the three grains (``'min'``, Eq. 3.23), or
-  the arithmetic mean of those two diameters (``'average'``), section 3.5.1.
+Choices the thesis leaves open (which daughters count, closed and lone daughters, the three
+local widths) and what they give on a stand-in packing: docs/airpaths-branched.md.
 
 Functions
 ---------
