@@ -14,6 +14,21 @@ from ._branched import BranchedResult, branched_pressure_drop, local_width
 from ._geometry import EXIT_FACES, as_points, face_areas
 
 
+def _path_faces(points, radii, path):
+    """Faces of a path's tetrahedra (inlet face, then the three exits) as the model needs them.
+
+    Returns full and open areas (m², (m, 4); NaN open areas as 0), face centroids (m, 4, 3)
+    and tetrahedron centroids (m, 3), m.
+    """
+    x = as_points(points)
+    tet = path.tetra_vertices
+    if tet.shape[0] == 0:
+        raise ValueError("path has no tetrahedra")
+    faces = np.concatenate([tet[:, None, :3], tet[:, EXIT_FACES]], axis=1)  # (m, 4, 3)
+    full, opened = face_areas(x, radii, faces)
+    return full, np.nan_to_num(opened, nan=0.0), x[faces].mean(axis=2), x[tet].mean(axis=1)
+
+
 def branched_path_pressure_drop(points, radii, path, *, superficial_velocity_m_s=None,
                                 q0_m3_s=None, width="average", multiplier="MFx3",
                                 branches="path", mu_pa_s=MU_AIR_PA_S) -> BranchedResult:
@@ -35,29 +50,23 @@ def branched_path_pressure_drop(points, radii, path, *, superficial_velocity_m_s
     q0_m3_s : float, optional
         Overrides :math:`Q_0`.
     width : {'min', 'max', 'average'}
-        Local flow-path width, see :func:`network._branched.local_width`.
+        Local flow-path width, see :func:`local_width`.
     multiplier : {'MFx3', 'MFx2'}
     branches : {'all', 'path'}
-        See :func:`network._branched.branched_pressure_drop`.
+        See :func:`branched_pressure_drop`.
     mu_pa_s : float
 
     Returns
     -------
     BranchedResult
     """
-    x = as_points(points)
-    tet = path.tetra_vertices
-    if tet.shape[0] == 0:
-        raise ValueError("path has no tetrahedra")
-    faces = np.concatenate([tet[:, None, :3], tet[:, EXIT_FACES]], axis=1)  # (m, 4, 3)
-    full, opened = face_areas(x, radii, faces)
-    d = local_width(full, np.nan_to_num(opened, nan=0.0), width)
-    cent = x[faces].mean(axis=2)  # (m, 4, 3)
+    full, opened, cent, c_tet = _path_faces(points, radii, path)
+    d = local_width(full, opened, width)
     if q0_m3_s is None:
         if superficial_velocity_m_s is None:
             raise ValueError("give superficial_velocity_m_s or q0_m3_s")
         q0_m3_s = float(superficial_velocity_m_s) * float(np.mean(full))
-    return branched_pressure_drop(cent[:, 0], x[tet].mean(axis=1), cent[:, 1:], d[:, 0],
+    return branched_pressure_drop(cent[:, 0], c_tet, cent[:, 1:], d[:, 0],
                                   d[:, 1:], path.exit_local, q0_m3_s, multiplier=multiplier,
                                   branches=branches, mu_pa_s=mu_pa_s)
 
@@ -130,15 +139,7 @@ def branched_table(points, radii, path, *, velocities_m_s=(0.013, 0.027),
         ``table[width][multiplier][f"{velocity:g}"] -> float`` (Pa), plus ``"q0_per_u_m2"``
         (the :math:`S_0` that multiplies the velocity) and ``"branches"``.
     """
-    x = as_points(points)
-    tet = path.tetra_vertices
-    if tet.shape[0] == 0:
-        raise ValueError("path has no tetrahedra")
-    faces = np.concatenate([tet[:, None, :3], tet[:, EXIT_FACES]], axis=1)
-    full, opened = face_areas(x, radii, faces)
-    opened = np.nan_to_num(opened, nan=0.0)
-    cent = x[faces].mean(axis=2)
-    c_tet = x[tet].mean(axis=1)
+    full, opened, cent, c_tet = _path_faces(points, radii, path)
     s0 = float(np.mean(full))
     out = {"q0_per_u_m2": s0, "branches": branches}
     for w in widths:
