@@ -16,6 +16,8 @@ precompute_throats(store, radii, sides, *, rtol, workers, retry_failed, ...)
     Solve and store what a table lacks, one transaction per batch.
 precompute_grid(store, spec, *, rtol, ...)
     Register an interpolation grid (``GRIDS[name]``) and solve its nodes.
+dask_executor(address, *, workers) / DaskConnectError
+    Run precompute batches on Dask (optional extra ``grainflow[dask]``).
 open_store(path) / ThroatStore
     The SQLite file (WAL, format-checked; :class:`CacheFileError` on corrupt/foreign files).
 default_db_path()
@@ -34,6 +36,7 @@ meshes or solves itself: it calls ``throats``.
 """
 
 from ._build import PrecomputeSummary, precompute_grid, precompute_throats
+from ._dask import DaskConnectError, dask_executor
 from ._interp import GRIDS, GridSpec, GridTable, grid_coordinates
 from ._lookup import (POLICIES, Lookup, default_db_path, export_grid, load_grid_table,
                       lookup_qstar, shipped_grid_path)
@@ -43,4 +46,5 @@ from ._store import CacheFileError, ThroatStore, open_store
 __all__ = ["signature", "shape_keys", "QUANTUM", "lookup_qstar", "Lookup", "POLICIES",
            "default_db_path", "precompute_throats", "precompute_grid", "PrecomputeSummary", "open_store",
            "ThroatStore", "CacheFileError", "GridSpec", "GridTable", "GRIDS",
-           "grid_coordinates", "load_grid_table", "export_grid", "shipped_grid_path"]
+           "grid_coordinates", "load_grid_table", "export_grid", "shipped_grid_path",
+           "dask_executor", "DaskConnectError"]

@@ -16,6 +16,7 @@ reason; a rerun skips them unless ``retry_failed=True``.
 
 from __future__ import annotations
 
+import concurrent.futures as cf
 import logging
 import time
 from dataclasses import dataclass, field
@@ -101,9 +102,42 @@ def _solve_chunk(solver, radii, sides, rtol):
     return out
 
 
+def _drain(pool, chunks, window, solve_args, write, stop):
+    """Solve ``chunks`` on ``pool`` (any ``concurrent.futures.Executor``: a process pool or a
+    Dask client's executor) with at most ``window`` batches in flight; ``write(chunk, result)``
+    runs here, in the one writing process, as each batch finishes; after ``stop()`` is true no
+    batch is submitted.  On Ctrl-C the batches already finished are written, the others
+    cancelled, and KeyboardInterrupt goes on up."""
+    pending = {}
+    it = iter(chunks)
+
+    def submit_next():
+        nxt = next(it, None)
+        if nxt is not None:
+            pending[pool.submit(_solve_chunk, *solve_args(nxt))] = nxt
+
+    try:
+        for _ in range(window):
+            submit_next()
+        while pending:
+            done, _ = cf.wait(pending, return_when=cf.FIRST_COMPLETED)
+            for fut in done:
+                write(pending.pop(fut), fut.result())
+                if not stop():
+                    submit_next()
+    except KeyboardInterrupt:
+        for fut, chunk in list(pending.items()):
+            if fut.done() and not fut.cancelled() and fut.exception() is None:
+                write(pending.pop(fut), fut.result())
+        raise
+    finally:
+        for fut in pending:
+            fut.cancel()
+
+
 def precompute_throats(store, radii, sides, *, rtol=1e-3, solver=None, solver_version=None,
                        workers=1, batch_size=16, retry_failed=False, progress=False,
-                       max_seconds=None):
+                       max_seconds=None, executor=None):
     """Solve every shape of ``(radii, sides)`` that ``store`` lacks and store the results.
 
     Parameters
@@ -120,19 +154,31 @@ def precompute_throats(store, radii, sides, *, rtol=1e-3, solver=None, solver_ve
     solver_version : str, optional
         Defaults to ``throats.SOLVER_VERSION`` (or the injected solver's ``SOLVER_VERSION``).
     workers : int, keyword-only, default 1
-        Local processes; 1 solves in this process.
+        Local processes (1: this process); with ``executor``, its number of parallel slots
+        (``2 * workers`` batches are kept in flight).
     batch_size : int, keyword-only, default 16
-        Solves per transaction (a kill loses at most ``workers`` batches).
+        Solves per task and per transaction.
     retry_failed : bool, keyword-only, default False
         Solve again the shapes recorded as failed/invalid.
     progress : bool, keyword-only, default False
         tqdm progress bar with rate and ETA on stderr.
     max_seconds : float, optional
         Stop submitting new batches after this many seconds (what is done is stored).
+    executor : concurrent.futures.Executor, optional
+        Where the batches run instead of a local process pool, e.g. a Dask client's
+        ``get_executor()`` (:func:`cache.dask_executor`); results come back here and only this
+        process writes the table.
 
     Returns
     -------
     PrecomputeSummary
+
+    Notes
+    -----
+    Each finished batch is stored at once in one transaction, so an interruption loses only
+    the batches still being solved (and at most the one being written, never part of it);
+    a rerun solves only the shapes not stored.  Ctrl-C stores the batches already finished
+    and returns the summary with ``extra['interrupted'] = True``.
     """
     t0 = time.perf_counter()
     r, s = as_throats(radii, sides)
@@ -207,32 +253,24 @@ def precompute_throats(store, radii, sides, *, rtol=1e-3, solver=None, solver_ve
     def out_of_time():
         return max_seconds is not None and time.perf_counter() - t0 > max_seconds
 
+    def solve_args(chunk):
+        return solver, canon_r[chunk], canon_s[chunk], rtol
+
     try:
-        if workers == 1:
+        if executor is None and workers == 1:
             for chunk in chunks:
                 if out_of_time():
                     break
-                write(chunk, _solve_chunk(solver, canon_r[chunk], canon_s[chunk], rtol))
-        else:
-            import concurrent.futures as cf
-
+                write(chunk, _solve_chunk(*solve_args(chunk)))
+        elif executor is None:
             with cf.ProcessPoolExecutor(max_workers=workers) as pool:
-                pending = {}
-                it = iter(chunks)
-                for chunk in it:  # keep 2 batches per worker in flight
-                    pending[pool.submit(_solve_chunk, solver, canon_r[chunk], canon_s[chunk],
-                                        rtol)] = chunk
-                    if len(pending) >= 2 * workers:
-                        break
-                while pending:
-                    done, _ = cf.wait(pending, return_when=cf.FIRST_COMPLETED)
-                    for fut in done:
-                        write(pending.pop(fut), fut.result())
-                        if not out_of_time():
-                            nxt = next(it, None)
-                            if nxt is not None:
-                                pending[pool.submit(_solve_chunk, solver, canon_r[nxt],
-                                                    canon_s[nxt], rtol)] = nxt
+                _drain(pool, chunks, 2 * workers, solve_args, write, out_of_time)
+        else:
+            _drain(executor, chunks, 2 * workers, solve_args, write, out_of_time)
+    except KeyboardInterrupt:
+        summary.extra["interrupted"] = True
+        logger.warning("interrupted: %d solved shapes stored in this run; rerun to resume",
+                       summary.solved + summary.failed)
     finally:
         if bar is not None:
             bar.close()
