@@ -14,6 +14,7 @@ import numpy as np
 import pytest
 
 from network import bench
+from network.benchmarks import references_table
 from network.validation import lattice_sample_permeability, random_sample_permeability
 from network.validation import beetstra_permeability, lattice_permeability
 
@@ -99,7 +100,7 @@ def test_fe_on_random_packings_only_when_asked(report):
     summ = report["references"]["summary"]
     assert summ["conduit/fe-only"]["max_abs_error_random"] is None
     assert summ["conduit/fe-only"]["n_cases_run"] == 1
-    table = "\n".join(bench._references_table(report["references"]))
+    table = "\n".join(references_table(report["references"]))
     row = next(line for line in table.splitlines() if line.startswith("rand e=0.45"))
     assert row.split("|")[1].split().count("-") == 2   # the two fe-only cells
 
