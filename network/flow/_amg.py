@@ -161,8 +161,7 @@ class AMGSolver:
         Ms = ml.aspreconditioner(cycle="V")
         s = self._s
 
-        def apply(r):
-            with threadpool_limits(limits=1, user_api="blas"):
-                return s * Ms.matvec(s * np.ravel(r))
+        def apply(r):           # callers limit BLAS threads around the whole CG
+            return s * Ms.matvec(s * np.ravel(r))
 
         return spla.LinearOperator((self.n, self.n), matvec=apply, dtype=float)

@@ -21,12 +21,13 @@ from typing import Callable
 
 import numpy as np
 
-from .._air import MU_AIR_PA_S, check_positive, check_viscosity
-from ..conductance import check_model, check_policy, throat_conductance
+from .._air import MU_AIR_PA_S, RHO_AIR_KG_M3, check_density, check_positive, check_viscosity
+from ..conductance import check_model, check_policy, inertial_coefficients, throat_conductance
 from ..packing import Packing
 from ..pores import (Region, Tessellation, axis_index, default_region, merge_pores,
                      prune_disconnected, region_porosity, select_sample, tessellate, tie_groups)
 from ._darcy import core_permeability, darcy_permeability
+from ._inertial import solve_inertial
 from ._linear import solve_fixed_pressure
 from ._result import FlowResult
 
@@ -52,7 +53,9 @@ def solve_network(packing: Packing, *, axis="z", region: Region | None = None,
                   trace_memory: bool = False, merge_ties: bool = True,
                   porosity: tuple | None = None, container: dict | None = None,
                   qstar_fn: Callable | None = None, model_options: dict | None = None,
-                  core_margin_m: float | None = None) -> FlowResult:
+                  core_margin_m: float | None = None, inertia: bool = False,
+                  density_kg_m3: float = RHO_AIR_KG_M3,
+                  curve_velocities_m_s=None) -> FlowResult:
     """Permeability and pressure drop of a packing by the Delaunay network model.
 
     Parameters
@@ -104,6 +107,14 @@ def solve_network(packing: Packing, *, axis="z", region: Region | None = None,
         Margin of the core permeability: default 2 mean diameters, reported only when the
         core is 5 diameters wide; given, the core estimate is always made (and its failure
         raised), as the lattice validation cases need.
+    inertia : bool
+        Also solve the nonlinear network (:mod:`network.flow._inertial`, conduit model only)
+        at ``velocity_m_s`` and at ``curve_velocities_m_s``; the result's ``inertial`` holds
+        the points (default False: Stokes only, as before).
+    density_kg_m3 : float
+        ρ of the inertial loss (default 1.20 kg/m³).
+    curve_velocities_m_s : sequence of float, optional
+        More superficial velocities (m/s, > 0) for the resistance curve.
 
     Returns
     -------
@@ -120,6 +131,11 @@ def solve_network(packing: Packing, *, axis="z", region: Region | None = None,
         check_policy(policy)
     if core_margin_m is not None:
         core_margin_m = check_positive("core_margin_m", core_margin_m)
+    density_kg_m3 = check_density(density_kg_m3)
+    curve_u = [check_positive("velocity_m_s", u) for u in (curve_velocities_m_s or [])]
+    if inertia and (conductance is not None or conductance_model != "conduit"):
+        raise ValueError("inertia needs the conduit model (its window and body areas); "
+                         f"got {conductance_model if conductance is None else 'custom'}")
     times: dict = {}
     peaks: dict = {}
 
@@ -153,11 +169,22 @@ def solve_network(packing: Packing, *, axis="z", region: Region | None = None,
                                       db=db, workers=workers, progress=progress,
                                       qstar_fn=qstar_fn, **model_opts)
             g, qstats = cres.g, cres.stats
+    throats_before = sample.throats
     with stage("prune"):
         sample, g = prune_disconnected(sample, tess, g)
     with stage("solve"):
         p, info, check = solve_fixed_pressure(sample.n_pores, sample.conns, g, sample.inlet,
                                               sample.outlet, p_in=1.0, p_out=0.0, solver=solver)
+    inertial = None
+    if inertia:
+        with stage("inertial"):
+            K = inertial_coefficients(tess, throats_before, cres.h_m, internal=cres.internal,
+                                      density_kg_m3=density_kg_m3)
+            K = K[np.searchsorted(throats_before, sample.throats)]
+            us = [velocity_m_s] + curve_u
+            pts = solve_inertial(sample.n_pores, sample.conns, g, K, sample.inlet,
+                                 sample.outlet, np.asarray(us) * sample.area_m2)
+            inertial = {"density_kg_m3": density_kg_m3, "velocities_m_s": us, "points": pts}
     times["assemble"] = info.assemble_s
     times["solve"] -= info.assemble_s
     if not check["ok"]:
@@ -205,7 +232,7 @@ def solve_network(packing: Packing, *, axis="z", region: Region | None = None,
         timings_s=times, pressure_pa=p * scale, throat_flow_m3_s=check["throat_flow"] * scale,
         throat_conductance=g, pore_ids=sample.pores, throat_ids=sample.throats,
         conns=sample.conns, pore_xyz=sample.pore_xyz, pore_groups=sample.groups,
-        permeability_core_m2=k_core, core_margin_m=core_margin)
+        permeability_core_m2=k_core, core_margin_m=core_margin, inertial=inertial)
 
 
 #: Core margin of :func:`_core_estimate`, in mean sphere diameters.

@@ -61,6 +61,31 @@ class FlowResult:
     #: or a core too small), m²; see :func:`network.flow.core_permeability`.
     permeability_core_m2: float | None = None
     core_margin_m: float | None = None
+    #: Nonlinear (inertial) solves when asked (:func:`network.flow.solve_network` with
+    #: ``inertia=True``): ``density_kg_m3``, ``velocities_m_s`` (the first is
+    #: ``velocity_m_s``) and their :class:`network.flow.InertialPoint` ``points``.
+    inertial: dict | None = dataclasses.field(default=None, repr=False)
+
+    def reynolds_particle(self, velocity_m_s: float, density_kg_m3: float) -> float:
+        """Re_p = ρ U d32 / μ (DESIGN.md), dimensionless."""
+        return density_kg_m3 * velocity_m_s * self.sauter_diameter_m / self.viscosity_pa_s
+
+    def curve_points(self) -> list[dict]:
+        """The inertial points as JSON-ready dicts (issue 14 keys), ascending velocity."""
+        if self.inertial is None:
+            return []
+        rho = self.inertial["density_kg_m3"]
+        rows = []
+        for u, pt in zip(self.inertial["velocities_m_s"], self.inertial["points"]):
+            grad = pt.dp_pa / self.length_m
+            rows.append({"velocity_m_s": float(u),
+                         "reynolds_particle": self.reynolds_particle(u, rho),
+                         "pressure_gradient_pa_per_m": float(grad),
+                         "apparent_permeability_m2": float(self.viscosity_pa_s * u / grad),
+                         "converged": bool(pt.converged), "newton_iterations": pt.iterations,
+                         "cg_iterations": pt.cg_iterations, "residual": pt.residual,
+                         "seconds": pt.seconds})
+        return sorted(rows, key=lambda r: r["velocity_m_s"])
 
     @property
     def k_over_d2(self) -> float:
@@ -134,7 +159,24 @@ class FlowResult:
             "qstar": self.qstar_stats,
             "comparisons": self.comparisons(),
             "seconds": self.timings_s,
-        }
+        } | self._inertial_summary()
+
+    def _inertial_summary(self) -> dict:
+        """Inertial value at ``velocity_m_s`` with the Stokes values beside it (issue 14)."""
+        if self.inertial is None:
+            return {}
+        pt = self.inertial["points"][0]
+        grad = pt.dp_pa / self.length_m
+        return {"pressure_gradient_pa_per_m": grad,
+                "pressure_drop_pa": grad * self.depth_m,
+                "pressure_gradient_stokes_pa_per_m": self.pressure_gradient_pa_per_m,
+                "pressure_drop_stokes_pa": self.pressure_drop_pa,
+                "reynolds_particle": self.reynolds_particle(self.velocity_m_s,
+                                                            self.inertial["density_kg_m3"]),
+                "density_kg_m3": self.inertial["density_kg_m3"],
+                "inertial_solver": {"converged": pt.converged, "newton_iterations": pt.iterations,
+                                    "cg_iterations": pt.cg_iterations, "residual": pt.residual,
+                                    "seconds": pt.seconds}}
 
 
 def combined_summary(results, *, seconds: dict | None = None) -> dict:
