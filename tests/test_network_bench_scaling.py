@@ -1,0 +1,77 @@
+"""Part 2 of ``python -m network.bench``: time and memory per stage against packing size.
+
+Two tiny periodic packings (300 and 600 spheres, shape-factor Q*, so no table is needed) through
+the command line: each size runs in its own ``--one`` subprocess; the JSON holds a row per size
+with every stage time positive and finite, the solver's iterations, memory peaks and the
+exponent of wall time ~ N^a, and the packing files are kept for the next run.
+"""
+
+import json
+import math
+
+import pytest
+
+from network import bench
+from network.benchmarks import packing_file, scaling_exponent
+from network.packing import read_packing
+
+SIZES = (300, 600)
+ROW_KEYS = {"wall_s", "read_s", "stages_s", "iterations", "n_unknowns", "solver_setup_s",
+            "solver_solve_s", "n_pores", "n_throats", "permeability_m2", "mass_balance_ok",
+            "qstar_sources", "traced_peak_mb", "max_rss_mb", "n_spheres", "policy",
+            "conductance_model", "repeats", "subprocess_s", "loadavg_1min_before"}
+
+
+@pytest.fixture(scope="module")
+def run(tmp_path_factory):
+    tmp = tmp_path_factory.mktemp("bench-scaling")
+    out = tmp / "scaling.json"
+    rc = bench.main(["--sizes", *map(str, SIZES), "--skip-policies", "--skip-references",
+                     "--policy", "shape-factor", "--repeats", "1", "--workdir", str(tmp),
+                     "--json", str(out)])
+    assert rc == 0
+    return tmp, json.loads(out.read_text())
+
+
+def test_json_layout(run):
+    _, report = run
+    assert set(report) == {"machine_start", "machine_end", "scaling_policy", "scaling_model",
+                           "scaling", "scaling_exponent"}
+    assert report["scaling_policy"] == "shape-factor" and report["scaling_model"] == "conduit"
+    rows = report["scaling"]
+    assert [r["n_spheres"] for r in rows] == list(SIZES)
+    for r in rows:
+        assert set(r) == ROW_KEYS, set(r) ^ ROW_KEYS
+        assert r["policy"] == "shape-factor" and r["repeats"] == 1
+        assert r["mass_balance_ok"] is True
+
+
+def test_times_are_positive_and_finite(run):
+    _, report = run
+    for r in report["scaling"]:
+        for key in ("wall_s", "subprocess_s", "solver_solve_s"):
+            assert math.isfinite(r[key]) and r[key] > 0, key
+        for stage in ("tessellate", "conductance", "assemble", "solve"):
+            assert math.isfinite(r["stages_s"][stage]) and r["stages_s"][stage] >= 0, stage
+        assert r["subprocess_s"] > r["wall_s"]          # the child's imports are outside wall_s
+        assert r["iterations"] > 0 and r["n_unknowns"] > 0
+        assert r["permeability_m2"] > 0 and r["max_rss_mb"] > 0
+    assert math.isfinite(report["scaling_exponent"])
+    assert report["scaling_exponent"] == scaling_exponent(report["scaling"])[0]
+
+
+def test_packings_are_kept_and_reused(run):
+    tmp, report = run
+    for n in SIZES:
+        path = packing_file(n, tmp, 1)   # exists: returned without generating again
+        mtime = path.stat().st_mtime_ns
+        assert read_packing(path).n == n
+        assert packing_file(n, tmp, 1).stat().st_mtime_ns == mtime
+
+
+def test_exponent_needs_two_sizes():
+    assert scaling_exponent([{"n_spheres": 300, "wall_s": 1.0}, {"n_spheres": 600,
+                                                                "error": "timeout"}]) is None
+    slope, lo, hi = scaling_exponent([{"n_spheres": 1000, "wall_s": 1.0},
+                                      {"n_spheres": 8000, "wall_s": 8.0}])
+    assert slope == pytest.approx(1.0) and (lo, hi) == (1000, 8000)
