@@ -50,7 +50,8 @@ def test_straight_path_has_no_turns_and_tortuosity_one():
     assert path.tortuosity == pytest.approx((1 + (n - 1) * F180) / n, rel=1e-12)
     summary = path.summary()
     assert summary["turning_below_30deg"] == 1.0
-    assert summary["mean_width_m"] == summary["bottleneck_width_m"] == 2e-3
+    assert summary["bottleneck_width_m"] == 2e-3
+    assert summary["mean_width_m"] == pytest.approx(2e-3, rel=1e-15)
 
 
 def test_right_angle_staircase():
