@@ -1,0 +1,214 @@
+"""``python -m network.curve``: the airflow-resistance curve of a packing, Stokes to drying speeds.
+
+Examples
+--------
+    python -m network.curve                                   # the bundled soybean scene
+    python -m network.curve bed.csv --velocities 0.01:0.3:8 --json c.json --plot curve.png
+    python -m network.curve --velocities 0.005,0.013,0.027 --csv c.csv
+
+Per velocity: Re_p, the pressure gradient with inertia (:mod:`network.flow._inertial`) and
+the apparent permeability μU/(ΔP/L); fits over the run: Darcy-Forchheimer, ASABE D272 and
+Ergun refitted (:func:`network.flow.fit_curve`). Exit 0 done, 1 a velocity did not converge
+(its point is written with ``converged: false``), 2 bad input.
+"""
+
+from __future__ import annotations
+
+import argparse
+import csv
+import json
+import logging
+import sys
+import time
+from pathlib import Path
+
+import numpy as np
+
+from ._air import MU_AIR_PA_S, RHO_AIR_KG_M3, check_positive
+from .conductance import POLICIES
+from .flow import (ASABE_SOYBEAN_A, ASABE_SOYBEAN_B, DEFAULT_DEPTH_M, GRAINS,
+                   asabe_d272_gradient, ergun_gradient, fit_curve, solve_network)
+from .packing import default_packing_path, read_container, read_packing
+from .pores import sample_region
+
+#: Default: 12 velocities spaced logarithmically over aeration and drying, m/s.
+DEFAULT_VELOCITIES = "0.005:0.3:12"
+#: D272 constants by grain (Pa s²/m³, m² s/m³): only those with a source in the package.
+D272 = {"soybeans": (ASABE_SOYBEAN_A, ASABE_SOYBEAN_B)}
+#: Thesis section 4.2.3: measured drops over 0.25 m of soybeans, (m/s, Pa/m).
+THESIS_POINTS = [(0.013, 2.44 / 0.25), (0.027, 6.80 / 0.25)]
+KEYS = ["velocity_m_s", "reynolds_particle", "pressure_gradient_pa_per_m",
+        "apparent_permeability_m2", "converged"]
+
+
+def parse_velocities(text: str) -> list[float]:
+    """``'a,b,c'`` or ``'start:stop:n'`` (n log-spaced points) → velocities, m/s (> 0).
+
+    >>> parse_velocities("0.01:1:3")
+    [0.01, 0.1, 1.0]
+    """
+    try:
+        if ":" in text:
+            a, b, n = text.split(":")
+            start, stop = check_positive("--velocities start", a), check_positive(
+                "--velocities stop", b)
+            if int(n) < 1:
+                raise ValueError(f"--velocities needs n >= 1, got {n!r}")
+            vals = [float(v) for v in np.geomspace(start, stop, int(n))]
+        else:
+            vals = [float(v) for v in text.split(",") if v.strip()]
+    except ValueError as exc:
+        raise ValueError(f"--velocities {text!r}: {exc}") from exc
+    if not vals:
+        raise ValueError(f"--velocities {text!r} is empty")
+    for v in vals:
+        check_positive(f"--velocities value {v!r}", v)
+    return [round(v, 15) for v in vals]
+
+
+def build_parser() -> argparse.ArgumentParser:
+    ap = argparse.ArgumentParser(prog="python -m network.curve",
+                                 description="Pressure gradient against airflow with inertia "
+                                             "(per-conduit contraction/expansion losses).")
+    ap.add_argument("packing", nargs="?", default=None,
+                    help=f"CSV/.npz/dump (default: the bundled {default_packing_path().name})")
+    ap.add_argument("--axis", default="z", choices=["x", "y", "z"])
+    ap.add_argument("--sample", nargs=6, type=float,
+                    metavar=("XMIN", "XMAX", "YMIN", "YMAX", "ZMIN", "ZMAX"))
+    ap.add_argument("--margin", type=float, default=None)
+    ap.add_argument("--cylinder", action="store_true")
+    ap.add_argument("--viscosity", type=float, default=MU_AIR_PA_S,
+                    help=f"Pa s (default {MU_AIR_PA_S})")
+    ap.add_argument("--density", type=float, default=RHO_AIR_KG_M3,
+                    help=f"kg/m^3 (default {RHO_AIR_KG_M3})")
+    ap.add_argument("--velocities", default=DEFAULT_VELOCITIES,
+                    help="a,b,c or start:stop:n (log-spaced), m/s (default 0.005:0.3:12)")
+    ap.add_argument("--depth", type=float, default=DEFAULT_DEPTH_M)
+    ap.add_argument("--grain", default="soybeans", help="D272 line to compare with "
+                    f"(known: {', '.join(D272)})")
+    ap.add_argument("--policy", default="table-only", choices=POLICIES)
+    ap.add_argument("--rtol", type=float, default=1e-3)
+    ap.add_argument("--db", default=None)
+    ap.add_argument("--json", dest="json_out", default=None)
+    ap.add_argument("--csv", dest="csv_out", default=None)
+    ap.add_argument("--plot", default=None, help="write the D272-style log-log plot (png)")
+    ap.add_argument("--quiet", "-q", action="store_true")
+    return ap
+
+
+def plot_curve(path, points, *, grain, porosity, diameter_m, viscosity_pa_s, density_kg_m3):
+    """Log-log ΔP/L against U: our points, D272 and Ergun for the grain, the thesis points."""
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    u = np.array([p["velocity_m_s"] for p in points])
+    gr = np.array([p["pressure_gradient_pa_per_m"] for p in points])
+    uu = np.geomspace(u.min() / 1.5, u.max() * 1.5, 100)
+    fig, ax = plt.subplots(figsize=(5.5, 4.2))
+    ax.loglog(u, gr, "o-", label="network (inertial)")
+    a, b = D272[grain]
+    ax.loglog(uu, [asabe_d272_gradient(v, a=a, b=b) for v in uu], "--", label=f"ASABE D272 {grain}")
+    if 0 < porosity < 1:
+        ax.loglog(uu, [ergun_gradient(v, porosity=porosity, diameter_m=diameter_m,
+                                      viscosity_pa_s=viscosity_pa_s,
+                                      density_kg_m3=density_kg_m3) for v in uu], ":",
+                  label="Ergun")
+    if grain == "soybeans":
+        tu, tg = zip(*THESIS_POINTS)
+        ax.loglog(tu, tg, "ks", label="thesis measured")
+    ax.set_xlabel("airflow U (m/s)")
+    ax.set_ylabel("pressure gradient (Pa/m)")
+    ax.grid(True, which="both", alpha=0.3)
+    ax.legend()
+    fig.tight_layout()
+    fig.savefig(path, dpi=120)
+    plt.close(fig)
+
+
+def _check_options(args) -> list[float]:
+    for name in ("viscosity", "density", "depth", "rtol"):
+        check_positive(f"--{name}", getattr(args, name))
+    if args.grain not in D272:
+        raise ValueError(f"--grain {args.grain!r} unknown; known grains: {', '.join(GRAINS)}")
+    if args.margin is not None and not args.margin >= 0:
+        raise ValueError(f"--margin must be >= 0, got {args.margin!r}")
+    return parse_velocities(args.velocities)
+
+
+def main(argv=None) -> int:
+    args = build_parser().parse_args(argv)
+    if not args.quiet:
+        logging.basicConfig(level=logging.INFO, format="[%(relativeCreated)7.0f ms] %(message)s",
+                            stream=sys.stderr)
+    t0 = time.perf_counter()
+    path = Path(args.packing) if args.packing else default_packing_path()
+    try:
+        us = _check_options(args)
+        packing = read_packing(path)
+        container = None if args.sample else read_container(path)
+        region = sample_region(packing, box=args.sample, margin=args.margin,
+                               cylinder=args.cylinder, container=container, axis=args.axis)
+    except (OSError, ValueError) as e:
+        print(f"error: {e}", file=sys.stderr)
+        return 2
+    try:
+        res = solve_network(packing, axis=args.axis, region=region, policy=args.policy,
+                            viscosity_pa_s=args.viscosity, velocity_m_s=us[0],
+                            depth_m=args.depth, rtol=args.rtol, db=args.db, inertia=True,
+                            density_kg_m3=args.density, curve_velocities_m_s=us[1:])
+    except (ValueError, RuntimeError, NotImplementedError) as e:
+        print(f"error: {e}", file=sys.stderr)
+        return 1
+    pts = [{k: p[k] for k in KEYS} | {"newton_iterations": p["newton_iterations"],
+                                      "cg_iterations": p["cg_iterations"]}
+           for p in res.curve_points()]
+    ok = [p for p in pts if p["converged"]]
+    fits = fit_curve([p["velocity_m_s"] for p in ok],
+                     [p["pressure_gradient_pa_per_m"] for p in ok],
+                     viscosity_pa_s=args.viscosity, density_kg_m3=args.density,
+                     porosity=res.porosity, diameter_m=res.sauter_diameter_m) if ok else {}
+    print(f"packing {path} ({packing.n} spheres), axis {args.axis}: k (Stokes) = "
+          f"{res.permeability_m2:.4e} m2, porosity {res.porosity:.4f}, d32 "
+          f"{res.sauter_diameter_m:.4g} m")
+    print(f"{'U m/s':>9} {'Re_p':>8} {'dP/L Pa/m':>11} {'k_app m2':>11} {'k/k_app':>8} "
+          f"{'Newton':>6} {'CG':>5}  converged")
+    for p in pts:
+        print(f"{p['velocity_m_s']:9.4g} {p['reynolds_particle']:8.3g} "
+              f"{p['pressure_gradient_pa_per_m']:11.5g} {p['apparent_permeability_m2']:11.4e} "
+              f"{res.permeability_m2 / p['apparent_permeability_m2']:8.4f} "
+              f"{p['newton_iterations']:6d} {p['cg_iterations']:5d}  {p['converged']}")
+    for k, v in fits.items():
+        print(f"  {k} = {v:.5g}" if isinstance(v, float) else f"  {k} = {v}")
+    total = time.perf_counter() - t0
+    print(f"total {total:.2f} s")
+    out = {"packing": str(path), "n_spheres": packing.n, "axis": args.axis, "grain": args.grain,
+           "density_kg_m3": args.density, "viscosity_pa_s": args.viscosity,
+           "porosity": res.porosity, "sauter_diameter_m": res.sauter_diameter_m,
+           "permeability_stokes_m2": res.permeability_m2, "points": pts} | fits | {
+           "seconds": dict(res.timings_s, wall=total)}
+    if args.json_out:
+        with open(args.json_out, "w") as f:
+            json.dump(out, f, indent=2)
+        print(f"wrote {args.json_out}")
+    if args.csv_out:
+        with open(args.csv_out, "w", newline="") as f:
+            w = csv.DictWriter(f, fieldnames=KEYS)
+            w.writeheader()
+            for p in pts:
+                w.writerow({k: p[k] for k in KEYS})
+        print(f"wrote {args.csv_out}")
+    if args.plot and ok:
+        plot_curve(args.plot, ok, grain=args.grain, porosity=res.porosity,
+                   diameter_m=res.sauter_diameter_m, viscosity_pa_s=args.viscosity,
+                   density_kg_m3=args.density)
+        print(f"wrote {args.plot}")
+    bad = [p["velocity_m_s"] for p in pts if not p["converged"]]
+    if bad:
+        print(f"error: the nonlinear solve did not converge at U = {bad} m/s "
+              "(marked converged: false)", file=sys.stderr)
+        return 1
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
