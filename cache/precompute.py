@@ -28,6 +28,7 @@ import argparse
 import contextlib
 import json
 import logging
+import os
 import sys
 
 from ._build import precompute_grid, precompute_throats, resolve_solver
@@ -62,6 +63,7 @@ def build_parser():
 def main(argv=None) -> int:
     args = build_parser().parse_args(argv)
     logging.basicConfig(level=logging.INFO, format="%(levelname)s %(name)s: %(message)s")
+    os.environ.setdefault("DASK_LOGGING__DISTRIBUTED", "warning")   # Dask's cluster chatter
     if args.workers < 1 or args.batch_size < 1:
         print("error: --workers and --batch-size must be >= 1", file=sys.stderr)
         return 2
