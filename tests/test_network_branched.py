@@ -103,3 +103,30 @@ def test_bad_input_raises():
     with pytest.raises(ValueError, match="branches"):
         branched_pressure_drop(np.zeros((1, 3)), np.ones((1, 3)), np.ones((1, 3, 3)), [1.0],
                                [[1.0, 0.0, 0.0]], [0], 1.0, branches="some")
+
+
+def test_unequal_daughters_split_by_cross_section():
+    # Eq. 3.38: Q_i = Q0 D_i^2 / sum D_j^2, so daughters of 2d and d (third closed) carry
+    # 4/5 and 1/5 of Q0 at one velocity; each loses f(theta) 2 * 2100 mu Q_i L_i / (pi D_i^4)
+    # (Eqs. 3.36-3.39), the closed one nothing; 'all' sums both, 'path' keeps the exit's
+    q, d, seg = 2e-7, 1.5e-3, 1e-3
+    c_in = np.array([[0.0, 0.0, -seg]])
+    c_tet = np.zeros((1, 3))
+    c_out = np.array([[[0.0, 0.0, seg], [seg, 0.0, 0.0], [0.0, seg, 0.0]]])  # 0 and 90 deg
+    d_out = np.array([[2 * d, d, 0.0]])
+    res = branched_pressure_drop(c_in, c_tet, c_out, [2 * d], d_out, [1], q, mu_pa_s=MU,
+                                 branches="all")
+    b0 = 1.0 * 2 * 2100 * MU * (0.8 * q) * seg / (np.pi * (2 * d) ** 4)   # straight on: f = 1
+    b1 = 3.0 * 2 * 2100 * MU * (0.2 * q) * seg / (np.pi * d**4)           # 90 deg: MFx3 = 3
+    np.testing.assert_allclose(res.dp_branch_pa[0], [b0, b1, 0.0], rtol=1e-12)
+    np.testing.assert_allclose(res.theta_rad[0, :2], [0.0, np.pi / 2], atol=1e-12)
+    straight = laminar_pipe_dp(q, seg, 2 * d, mu_pa_s=MU)
+    assert res.total_pa == pytest.approx(straight + b0 + b1, rel=1e-12)
+    path = branched_pressure_drop(c_in, c_tet, c_out, [2 * d], d_out, [1], q, mu_pa_s=MU)
+    assert path.total_pa == pytest.approx(straight + b1, rel=1e-12)
+    # a series of M identical tetrahedra loses M times one
+    m = 7
+    rep = branched_pressure_drop(np.repeat(c_in, m, 0), np.repeat(c_tet, m, 0),
+                                 np.repeat(c_out, m, 0), np.full(m, 2 * d),
+                                 np.repeat(d_out, m, 0), np.ones(m, int), q, mu_pa_s=MU)
+    assert rep.total_pa == pytest.approx(m * path.total_pa, rel=1e-12)
