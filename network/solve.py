@@ -21,7 +21,7 @@ from pathlib import Path
 
 import numpy as np
 
-from ._air import MU_AIR_PA_S, check_positive
+from ._air import MU_AIR_PA_S, RHO_AIR_KG_M3, check_positive
 from .conductance import MODELS, POLICIES
 from .flow import (DEFAULT_DEPTH_M, DEFAULT_VELOCITY_M_S, combined_summary, solve_axes,
                    write_network_vtu)
@@ -54,6 +54,11 @@ def build_parser() -> argparse.ArgumentParser:
                     help=f"dynamic viscosity, Pa s (default {MU_AIR_PA_S})")
     ap.add_argument("--velocity", type=float, default=DEFAULT_VELOCITY_M_S,
                     help=f"superficial velocity, m/s (default {DEFAULT_VELOCITY_M_S})")
+    ap.add_argument("--density", type=float, default=RHO_AIR_KG_M3,
+                    help=f"air density for the inertial loss, kg/m^3 (default {RHO_AIR_KG_M3})")
+    ap.add_argument("--stokes", action="store_true",
+                    help="Stokes (linear) answer only; default: pressure gradient and drop "
+                         "with inertia (conduit model), the Stokes values beside them")
     ap.add_argument("--depth", type=float, default=DEFAULT_DEPTH_M,
                     help=f"bed depth for the pressure drop, m (default {DEFAULT_DEPTH_M})")
     ap.add_argument("--policy", default="table-only", choices=POLICIES,
@@ -96,6 +101,11 @@ def _print_result(res, out):
               file=out)
     print(f"  at v = {s['velocity_m_s']:g} m/s: gradient {s['pressure_gradient_pa_per_m']:.4g} "
           f"Pa/m, drop over {s['depth_m']:g} m = {s['pressure_drop_pa']:.4g} Pa", file=out)
+    if "pressure_drop_stokes_pa" in s:
+        print(f"    with inertia (Re_p {s['reynolds_particle']:.3g}; Stokes "
+              f"{s['pressure_gradient_stokes_pa_per_m']:.4g} Pa/m, "
+              f"{s['pressure_drop_stokes_pa']:.4g} Pa; "
+              f"{s['inertial_solver']['newton_iterations']} Newton iterations)", file=out)
     print(f"    Ergun {c['ergun']['pressure_drop_pa']:.4g} Pa, Kozeny-Carman "
           f"{c['kozeny_carman']['pressure_drop_pa']:.4g} Pa, ASABE D272 (soybeans) "
           f"{c['asabe_d272']['pressure_drop_pa']:.4g} Pa", file=out)
@@ -113,7 +123,7 @@ def _print_result(res, out):
 
 def _check_options(args) -> None:
     """Every numeric option checked before any work (ValueError names the option)."""
-    for name in ("viscosity", "velocity", "depth", "rtol"):
+    for name in ("viscosity", "velocity", "depth", "rtol", "density"):
         check_positive(f"--{name}", getattr(args, name))
     if args.margin is not None and not args.margin >= 0:
         raise ValueError(f"--margin must be >= 0, got {args.margin!r}")
@@ -146,7 +156,9 @@ def main(argv=None) -> int:
         results = solve_axes(
             packing, regions, conductance_model=args.conductance_model, policy=args.policy,
             viscosity_pa_s=args.viscosity, velocity_m_s=args.velocity, depth_m=args.depth,
-            rtol=args.rtol, db=args.db, workers=args.workers, progress=not args.quiet)
+            rtol=args.rtol, db=args.db, workers=args.workers, progress=not args.quiet,
+            inertia=not args.stokes and args.conductance_model == "conduit",
+            density_kg_m3=args.density)
     except (ValueError, RuntimeError, NotImplementedError) as e:
         print(f"error: {e}", file=sys.stderr)
         return 1

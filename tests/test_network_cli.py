@@ -44,8 +44,9 @@ def test_solve_default_scene(default_run, capsys):
     assert out["mass_balance"]["ok"] and out["mass_balance"]["balance_error"] < 1e-8
     # the reported numbers are consistent with Darcy's law
     k, mu, v = out["permeability_m2"], out["viscosity_pa_s"], out["velocity_m_s"]
-    assert np.isclose(out["pressure_gradient_pa_per_m"], mu * v / k)
-    assert np.isclose(out["pressure_drop_pa"], 0.25 * mu * v / k)
+    assert np.isclose(out["pressure_gradient_stokes_pa_per_m"], mu * v / k)
+    assert np.isclose(out["pressure_drop_stokes_pa"], 0.25 * mu * v / k)
+    assert out["pressure_drop_pa"] > out["pressure_drop_stokes_pa"]        # inertia (issue 14)
     # ASABE D272 soybeans at 0.013 m/s over 0.25 m: 2.28 Pa (thesis 4.2.3)
     assert round(out["comparisons"]["asabe_d272"]["pressure_drop_pa"], 2) == 2.28
     assert vtu["pressure"].shape == (out["n_pores"],)

@@ -1,0 +1,99 @@
+"""Inertial network flow, network.curve and network.solve with inertia (issue 14)."""
+
+import json
+
+import numpy as np
+import pytest
+
+from network import curve
+from network.conductance import contraction_coefficient, expansion_coefficient
+from network.flow import conduit_flow, fit_curve, solve_inertial, solve_network
+from network.packing import default_packing_path, read_packing
+
+
+def test_chain_of_conduits_exact():
+    """Two conduits in series, dp = q + 0.5 q^2 each: Q = 1 -> 3 Pa, Q = 100 -> 10200 Pa."""
+    pts = solve_inertial(3, [[0, 1], [1, 2]], [1.0, 1.0], np.full((2, 2), 0.5), [0], [2],
+                         [100.0, 1.0])
+    assert [p.dp_pa for p in pts] == pytest.approx([10200.0, 3.0], rel=1e-9)
+    assert all(p.converged and p.iterations <= 30 for p in pts)
+
+
+def test_signed_flow_and_loss_coefficients():
+    q, w = conduit_flow(np.array([-1.5, 0.0]), np.ones(2), np.array([[9.0, 0.5], [1.0, 1.0]]))
+    assert q.tolist() == [-1.0, 0.0] and w.tolist() == [0.5, 1.0]     # reverse uses K[:, 1]
+    assert contraction_coefficient(1.0) == 0.0 and expansion_coefficient(1.0) == 0.0
+
+
+@pytest.fixture(scope="module")
+def scene():
+    pk = read_packing(default_packing_path())
+    return solve_network(pk, inertia=True, porosity_points=0,
+                         curve_velocities_m_s=[1e-7, 0.027, 0.3])
+
+
+def test_stokes_limit_mass_balance_and_iterations(scene):
+    """U -> 0 gives the Stokes gradient to 1e-6; every pore balances to 1e-10 of Q; <= 30 it."""
+    rows = scene.curve_points()
+    assert rows[0]["apparent_permeability_m2"] == pytest.approx(scene.permeability_m2, rel=1e-6)
+    for u, pt in zip(scene.inertial["velocities_m_s"], scene.inertial["points"]):
+        assert pt.converged and pt.iterations <= 30 and pt.residual <= 1e-10
+        Q = u * scene.area_m2
+        c, q = scene.conns, pt.throat_flow_m3_s
+        net = np.bincount(c[:, 0], q, scene.n_pores) - np.bincount(c[:, 1], q, scene.n_pores)
+        net[np.concatenate([np.arange(scene.n_pores)[:0]])] = 0
+        assert abs(pt.dp_pa) > 0
+        fixed = np.zeros(scene.n_pores, bool)
+        inl = np.isclose(pt.pressure_pa, pt.dp_pa)
+        fixed[inl] = True
+        fixed[pt.pressure_pa == 0] = True
+        assert np.max(np.abs(net[~fixed])) <= 1e-10 * Q
+    # resistance grows with Re (commit numbers: k/k_app 1.09 at 0.027 m/s, 1.91 at 0.3 m/s)
+    ratio = [scene.permeability_m2 / r["apparent_permeability_m2"] for r in rows]
+    assert ratio[0] == pytest.approx(1.0, abs=1e-6) and 1.0 < ratio[2] < ratio[3]
+
+
+def test_solve_reports_inertia_and_stokes_keeps_old_answer(tmp_path):
+    out_i, out_s = tmp_path / "i.json", tmp_path / "s.json"
+    from network import solve
+    assert solve.main(["-q", "--json", str(out_i)]) == 0
+    assert solve.main(["-q", "--stokes", "--json", str(out_s)]) == 0
+    i, s = json.loads(out_i.read_text()), json.loads(out_s.read_text())
+    assert s["permeability_m2"] == pytest.approx(4.2023528e-08, rel=1e-7)
+    assert s["pressure_drop_pa"] == pytest.approx(1.4941630, rel=1e-7)
+    assert i["permeability_m2"] == pytest.approx(s["permeability_m2"], rel=1e-12)
+    assert i["pressure_drop_stokes_pa"] == pytest.approx(s["pressure_drop_pa"], rel=1e-12)
+    assert i["pressure_drop_pa"] > i["pressure_drop_stokes_pa"]
+    assert i["reynolds_particle"] == pytest.approx(5.34, abs=0.01)
+
+
+def test_fit_curve_recovers_forchheimer():
+    u = np.geomspace(0.005, 0.3, 12)
+    gr = 1.932e-5 * u / 4e-8 + 1000.0 * 1.2 * u**2
+    f = fit_curve(u, gr, viscosity_pa_s=1.932e-5, density_kg_m3=1.2, porosity=0.4,
+                  diameter_m=0.0066)
+    assert f["permeability_m2"] == pytest.approx(4e-8, rel=1e-9)
+    assert f["forchheimer_beta_per_m"] == pytest.approx(1000.0, rel=1e-9)
+    assert f["forchheimer_residual"] < 1e-12 and f["d272_residual"] < 0.05
+
+
+@pytest.mark.parametrize("argv, match", [
+    (["--velocities", "0,0.1"], "0.0"), (["--velocities", "nan"], "nan"),
+    (["--velocities", ""], "empty"), (["--density", "0"], "--density"),
+    (["--viscosity", "-1"], "--viscosity"), (["--grain", "wheat"], "soybeans")])
+def test_curve_bad_input_exit_2(argv, match, capsys):
+    assert curve.main(["-q"] + argv) == 2
+    err = capsys.readouterr().err
+    assert match in err and "Traceback" not in err and len(err.strip().splitlines()) == 1
+
+
+def test_curve_writes_points_fits_and_plot(tmp_path):
+    js, png = tmp_path / "c.json", tmp_path / "c.png"
+    assert curve.main(["-q", "--velocities", "0.005,0.05,0.3", "--json", str(js),
+                       "--plot", str(png), "--csv", str(tmp_path / "c.csv")]) == 0
+    d = json.loads(js.read_text())
+    assert [set(p) >= set(curve.KEYS) for p in d["points"]] == [True] * 3
+    for k in ("permeability_m2", "forchheimer_beta_per_m", "d272_a", "d272_b", "ergun_A",
+              "ergun_B"):
+        assert np.isfinite(d[k])
+    assert png.stat().st_size > 1000
