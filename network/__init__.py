@@ -11,7 +11,8 @@ Each layer imports only the layers above it in this list (``tests/test_layers.py
 ``validation``         reference permeabilities and validation cases through the one pipeline
 CLIs                   ``python -m network.solve`` (permeability and pressure drop; the bundled
                        soybean scene by default), ``network.throats``, ``network.paths``,
-                       ``network.bench``: parse, call the pipeline, print
+                       ``network.curve`` (the resistance curve with inertia), ``network.bench``:
+                       parse, call the pipeline, print
 
 The names below (``__all__``) are the public API; the subpackages export more.
 """
@@ -20,7 +21,8 @@ from ._air import MU_AIR_PA_S, RHO_AIR_KG_M3
 from .airpaths import AirflowPath, BranchedResult, branched_pressure_drop, trace_paths
 from .conductance import (MODELS, POLICIES, ConductanceResult, QstarResult, thesis_conductance,
                           throat_conductance, throat_qstar)
-from .flow import (FlowResult, SolveInfo, apply_pressure_bc, asabe_d272_gradient,
+from .flow import (AMGSolver, FlowResult, InertialPoint, SolveInfo, apply_pressure_bc,
+                   asabe_d272_gradient, fit_curve, solve_inertial,
                    assemble_laplacian, darcy_permeability, ergun_gradient, kozeny_carman_gradient,
                    solve_fixed_pressure, solve_network, solve_pressure, verify_solution,
                    write_network_vtu)
@@ -35,11 +37,12 @@ __all__ = [
     "Packing", "read_packing", "write_packing_csv", "default_packing_path", "read_container",
     "Tessellation", "tessellate", "tie_groups", "QHULL_OPTIONS",
     "Region", "SampleNetwork", "default_region", "select_sample", "prune_disconnected",
-    "MU_AIR_PA_S", "RHO_AIR_KG_M3", "POLICIES", "MODELS", "QstarResult", "ConductanceResult", "thesis_conductance", "throat_qstar",
+    "MU_AIR_PA_S", "RHO_AIR_KG_M3", "POLICIES", "MODELS", "QstarResult", "ConductanceResult",
+    "thesis_conductance", "throat_qstar",
     "throat_conductance",
     "SolveInfo", "assemble_laplacian", "apply_pressure_bc", "solve_pressure",
     "solve_fixed_pressure", "verify_solution",
-    "FlowResult", "solve_network",
+    "FlowResult", "solve_network", "AMGSolver", "InertialPoint", "solve_inertial", "fit_curve",
     "ergun_gradient", "kozeny_carman_gradient", "asabe_d272_gradient", "darcy_permeability",
     "region_porosity", "random_packing", "sample_throats", "write_network_vtu",
     "lattice_packing", "lattice_radius",

@@ -8,6 +8,7 @@ Rules (issue 12):
   packages below or beside it;
 * inside a package, subpackages form layers (``LAYERS``): a module imports only its own layer
   and the layers before it; the module import graph has no cycle;
+* inside ``network`` only the ``conductance`` layer imports ``cache``;
 * no import of a project module inside a function (matplotlib and other optional libraries may
   stay lazy); no import of another module's ``_private`` name;
 * no library module over ``MAX_LINES`` lines, no module docstring over ``MAX_DOC_LINES`` lines.
@@ -27,6 +28,8 @@ MAY_IMPORT = {"throats": set(), "cache": {"throats"}, "network": {"throats", "ca
               "dem": set()}
 BENCH_MAY_IMPORT = {"throats": {"network"}, "cache": {"throats", "network"},
                     "network": {"throats", "cache"}, "dem": set()}
+#: inside network, only the conductance layer talks to the Q* table (cache)
+ONLY_FROM = {"cache": "network.conductance"}
 #: layers inside a package, lowest first; a module's layer is its first path component
 #: below the package (a subpackage name, or the module name for top-level modules)
 LAYERS = {
@@ -37,7 +40,8 @@ LAYERS = {
         {"flow"},
         {"airpaths"},
         {"validation"},
-        {"__init__", "solve", "throats", "paths", "curve", "report", "bench", "__main__"},
+        {"__init__", "solve", "throats", "paths", "curve", "report", "bench", "benchmarks",
+         "__main__"},
     ],
 }
 MAX_LINES = 450
@@ -104,6 +108,10 @@ def test_packages_import_only_what_they_may(package):
         allowed = BENCH_MAY_IMPORT[package] if is_bench else MAY_IMPORT[package]
         if top not in allowed or (is_bench and target != top):
             bad.append(f"{path.relative_to(ROOT)}:{line} imports {target}")
+        elif top in ONLY_FROM and package == ONLY_FROM[top].split(".")[0] \
+                and not module.startswith(ONLY_FROM[top]):
+            bad.append(f"{path.relative_to(ROOT)}:{line} imports {target}: only "
+                       f"{ONLY_FROM[top]} may")
     assert not bad, "\n".join(bad)
 
 

@@ -10,10 +10,11 @@ from ._inertial import (contraction_coefficient, expansion_coefficient,
 from ._models import MODELS, check_model, throat_conductance
 from ._qstar import POLICIES, QstarResult, check_policy, qstar_from_function, throat_qstar
 from ._result import ConductanceResult
+from ._table import default_table, has_grid, table_totals
 from ._thesis import thesis_conductance
 
 __all__ = ["MODELS", "POLICIES", "SECTION_MODES", "ConductanceResult", "QstarResult",
            "check_model", "check_policy", "conduit_conductance", "contraction_coefficient",
-           "expansion_coefficient", "inertial_coefficients", "qstar_from_function",
-           "section_estimate", "side_resistance", "thesis_conductance", "throat_conductance",
-           "throat_qstar"]
+           "default_table", "expansion_coefficient", "has_grid", "inertial_coefficients",
+           "qstar_from_function", "section_estimate", "side_resistance", "table_totals",
+           "thesis_conductance", "throat_conductance", "throat_qstar"]

@@ -18,9 +18,11 @@ from ._pipeline import (CORE_MARGIN_DIAMETERS, CORE_MIN_DIAMETERS, DEFAULT_DEPTH
 from ._result import FlowResult, combined_summary
 from ._vtk import read_vtu_arrays, write_network_vtu
 
-__all__ = ["AMGSolver", "ASABE_SOYBEAN_A", "ASABE_SOYBEAN_B", "CORE_MARGIN_DIAMETERS", "CORE_MIN_DIAMETERS",
-           "DEFAULT_DEPTH_M", "DEFAULT_VELOCITY_M_S", "FlowResult", "GRAINS", "InertialPoint", "SolveInfo",
-           "apply_pressure_bc", "asabe_d272_gradient", "assemble_laplacian", "boundary_flows",
-           "combined_summary", "conduit_flow", "core_permeability", "darcy_permeability", "ergun_gradient", "fit_curve",
-           "kozeny_carman_gradient", "read_vtu_arrays", "solve_fixed_pressure", "solve_network",
-           "solve_axes", "solve_inertial", "solve_pressure", "verify_solution", "write_network_vtu"]
+__all__ = ["AMGSolver", "ASABE_SOYBEAN_A", "ASABE_SOYBEAN_B", "CORE_MARGIN_DIAMETERS",
+           "CORE_MIN_DIAMETERS", "DEFAULT_DEPTH_M", "DEFAULT_VELOCITY_M_S", "FlowResult",
+           "GRAINS", "InertialPoint", "SolveInfo", "apply_pressure_bc", "asabe_d272_gradient",
+           "assemble_laplacian", "boundary_flows", "combined_summary", "conduit_flow",
+           "core_permeability", "darcy_permeability", "ergun_gradient", "fit_curve",
+           "kozeny_carman_gradient", "read_vtu_arrays", "solve_axes", "solve_fixed_pressure",
+           "solve_inertial", "solve_network", "solve_pressure", "verify_solution",
+           "write_network_vtu"]
