@@ -1,7 +1,10 @@
 r"""Linear spring–dashpot contact law with Coulomb friction (PFC3D linear model).
 
 The contact law is a pure function of the contact kinematics: it knows nothing of
-neighbour lists, containers or the integrator (STYLE.md item 11).
+neighbour lists, containers or the integrator (STYLE.md item 11). It is written once, as the
+numba-compiled scalar function :func:`contact_law` of one contact; the time-step kernels
+(:mod:`dem._kernels`) call it for every pair and wall contact, and
+:func:`linear_contact_forces` applies it to arrays of contacts.
 
 Conventions (one row per contact): ``normal`` is the unit vector from particle *i*
 towards its partner *j* (or towards the wall), ``overlap`` δ = r_i + r_j − |x_j − x_i| > 0,
@@ -11,6 +14,7 @@ returned force acts on *i*; *j* receives its negative.
 
 from __future__ import annotations
 
+import numba
 import numpy as np
 
 __all__ = [
@@ -18,6 +22,7 @@ __all__ = [
     "damping_coefficient",
     "restitution_coefficient",
     "linear_contact_forces",
+    "contact_law",
 ]
 
 
@@ -68,8 +73,51 @@ def restitution_coefficient(beta):
     return np.exp(-np.pi * beta / np.sqrt(1.0 - beta**2))
 
 
-def _dot(a, b):
-    return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
+@numba.njit(inline="always", cache=True, error_model="numpy")
+def contact_law(overlap, nx, ny, nz, vx, vy, vz, xx, xy, xz, kn, ks, cn, ct, mu, dt):
+    """One contact of :func:`linear_contact_forces` (same arguments, scalars; see there).
+
+    Returns ``(fx, fy, fz, fn, ftx, fty, ftz, xix, xiy, xiz)``: force on *i*, normal force,
+    tangential force on *i*, updated spring. The operations are those of the array form, in
+    the same order (no fused multiply-add), so both give the same bits.
+    """
+    vn = vx * nx + vy * ny + vz * nz
+    fn = kn * overlap
+    fn += cn * vn
+    if fn < 0.0:
+        fn = 0.0
+    vtx = vx - vn * nx
+    vty = vy - vn * ny
+    vtz = vz - vn * nz
+    sn = xx * nx + xy * ny + xz * nz
+    xix = xx - sn * nx + vtx * dt
+    xiy = xy - sn * ny + vty * dt
+    xiz = xz - sn * nz + vtz * dt
+    ftx = xix * (-ks) - ct * vtx
+    fty = xiy * (-ks) - ct * vty
+    ftz = xiz * (-ks) - ct * vtz
+    ft_mag = np.sqrt(ftx * ftx + fty * fty + ftz * ftz)
+    limit = mu * fn
+    if ft_mag > limit:
+        scale = limit / ft_mag
+        ftx *= scale
+        fty *= scale
+        ftz *= scale
+        inv = -1.0 / ks
+        xix = (ftx + ct * vtx) * inv
+        xiy = (fty + ct * vty) * inv
+        xiz = (ftz + ct * vtz) * inv
+    return ftx - fn * nx, fty - fn * ny, ftz - fn * nz, fn, ftx, fty, ftz, xix, xiy, xiz
+
+
+@numba.njit(cache=True, error_model="numpy")
+def _contact_loop(overlap, normal, v_rel, shear, kn, ks, cn, ct, mu, dt, force, fn, ft, xi):
+    for c in range(overlap.shape[0]):
+        out = contact_law(overlap[c], normal[0, c], normal[1, c], normal[2, c], v_rel[0, c], v_rel[1, c],
+                          v_rel[2, c], shear[0, c], shear[1, c], shear[2, c], kn, ks, cn[c], ct[c], mu, dt)
+        force[0, c], force[1, c], force[2, c], fn[c] = out[0], out[1], out[2], out[3]
+        ft[0, c], ft[1, c], ft[2, c] = out[4], out[5], out[6]
+        xi[0, c], xi[1, c], xi[2, c] = out[7], out[8], out[9]
 
 
 def linear_contact_forces(overlap, normal, v_rel, shear_disp, *, kn, ks, cn, ct, mu, dt):
@@ -121,23 +169,14 @@ def linear_contact_forces(overlap, normal, v_rel, shear_disp, *, kn, ks, cn, ct,
     shear_disp : (3, Nc) array, m
         Updated spring displacement (a new array).
     """
-    vn = _dot(v_rel, normal)
-    fn = kn * overlap
-    fn += cn * vn
-    np.maximum(fn, 0.0, out=fn)
-    vt = v_rel - vn * normal
-    xi = shear_disp - _dot(shear_disp, normal) * normal
-    xi += vt * dt
-    ft = xi * (-ks)
-    ft -= ct * vt
-    ft_mag = np.sqrt(_dot(ft, ft))
-    limit = mu * fn
-    slide = np.flatnonzero(ft_mag > limit)
-    if len(slide):
-        scale = limit[slide] / ft_mag[slide]
-        fts = ft[:, slide] * scale
-        ft[:, slide] = fts
-        ct_s = ct[slide] if np.ndim(ct) else ct
-        xi[:, slide] = (fts + ct_s * vt[:, slide]) * (-1.0 / ks)
-    force = ft - fn * normal
+    overlap = np.ascontiguousarray(overlap, dtype=float)
+    nc = overlap.shape[0]
+    arrays = [np.ascontiguousarray(a, dtype=float) for a in (normal, v_rel, shear_disp)]
+    if overlap.ndim != 1 or any(a.shape != (3, nc) for a in arrays):
+        raise ValueError(f"need overlap (Nc,) and (3, Nc) vectors, got {overlap.shape}, "
+                         f"{[a.shape for a in arrays]}")
+    cn_a, ct_a = (np.ascontiguousarray(np.broadcast_to(np.asarray(c, dtype=float), (nc,))) for c in (cn, ct))
+    force, ft, xi = np.empty((3, nc)), np.empty((3, nc)), np.empty((3, nc))
+    fn = np.empty(nc)
+    _contact_loop(overlap, *arrays, float(kn), float(ks), cn_a, ct_a, float(mu), float(dt), force, fn, ft, xi)
     return force, fn, ft, xi

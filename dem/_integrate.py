@@ -1,9 +1,10 @@
 r"""Soft-sphere DEM state and time integration (the four-step loop of STYLE.md item 11).
 
-Each step: (1) candidate pairs from the Verlet list (rebuilt when a particle moved more
-than skin/2); (2) the linear contact law of :mod:`dem._contacts` for particle–particle and
-particle–wall contacts; (3) forces and torques accumulated with :func:`numpy.bincount`;
-(4) semi-implicit (symplectic) Euler update of velocities, spins and positions:
+Each step: (1) candidate pairs from the Verlet list (:mod:`dem._neighbors`, rebuilt when a
+particle moved more than skin/2); (2) the linear contact law of :mod:`dem._contacts` for
+particle–particle and particle–wall contacts; (3) forces and torques summed per particle in a
+fixed order; (4) semi-implicit (symplectic) Euler update of velocities, spins and positions.
+Steps 2–4 are the two compiled loops of :mod:`dem._kernels`:
 
 .. math::
 
@@ -31,9 +32,11 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ._contacts import damping_coefficient, linear_contact_forces, series_stiffness
+from ._contacts import series_stiffness
+from ._kernels import pair_damping, pair_forces, particle_update
 from ._neighbors import VerletList, remap_history
-from ._walls import wall_contacts
+from ._threads import ThreadChooser
+from ._walls import CylinderWall, PlaneWall
 
 __all__ = ["Material", "Simulation", "DemInstabilityError", "SOYBEAN"]
 
@@ -101,15 +104,6 @@ class Material:
 SOYBEAN = Material()
 
 
-def _cross(a, b):
-    """Cross product of two component-first (3, Nc) arrays."""
-    return np.stack([
-        a[1] * b[2] - a[2] * b[1],
-        a[2] * b[0] - a[0] * b[2],
-        a[0] * b[1] - a[1] * b[0],
-    ])
-
-
 def _dot(a, b):
     return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
 
@@ -117,8 +111,8 @@ def _dot(a, b):
 class Simulation:
     """State of N spheres in a set of walls, advanced by :meth:`step` / :meth:`run`.
 
-    Internally vectors are stored component-first, (3, N); the attributes ``centers``,
-    ``velocities`` and ``spins`` are (N, 3) views of them (writable).
+    The attributes ``centers``, ``velocities`` and ``spins`` are the (N, 3) state arrays
+    themselves (writable); forces are returned component-first, (3, N) views.
 
     Parameters
     ----------
@@ -136,10 +130,13 @@ class Simulation:
         Verlet skin; default 0.1 · r_max.
     bounds_m : (2, 3) array | None
         Box that every centre must stay in; leaving it raises DemInstabilityError.
+    threads : int | None
+        Threads of the step kernels; None chooses by timing (:class:`dem._threads.ThreadChooser`).
+        The result is the same for any count.
     """
 
     def __init__(self, centers, radii, walls, material=SOYBEAN, *, gravity_m_s2=9.81, mass_scale=1.0,
-                 dt_safety=0.25, skin_m=None, bounds_m=None):
+                 dt_safety=0.25, skin_m=None, bounds_m=None, threads=None):
         centers = np.array(centers, dtype=float)
         radii = np.array(radii, dtype=float)
         n = len(radii)
@@ -153,7 +150,6 @@ class Simulation:
             raise ValueError(f"mass_scale must be >= 1, got {mass_scale}")
         if not 0 < dt_safety <= 1:
             raise ValueError(f"dt_safety must be in (0, 1], got {dt_safety}")
-        self.walls = list(walls)
         self.material = material
         self.gravity_m_s2 = float(gravity_m_s2)
         self.mass_scale = float(mass_scale)
@@ -164,34 +160,37 @@ class Simulation:
         self.z_offset_m = 0.0
         self.wall_vz_m_s = 0.0
         self.stats = {"rebuilds": 0}
-        self._x = np.ascontiguousarray(centers.T)
-        self._v = np.zeros((3, n))
-        self._w = np.zeros((3, n))
+        self._x = np.ascontiguousarray(centers)
+        self._v = np.zeros((n, 3))
+        self._w = np.zeros((n, 3))
+        self._force = np.zeros((n, 3))
+        self._torque = np.zeros((n, 3))
         skin = skin_m if skin_m is not None else 0.1 * float(radii.max())
         self.verlet = VerletList(skin)
-        self.shear = np.zeros((3, 0))
-        self._pi = self._pj = np.empty(0, dtype=np.int64)
-        self.wall_shear = np.zeros((len(self.walls), 3, n))
-        self._wall_prev = None
+        self._set_pairs(np.zeros((0, 4)))
         self._set_radii(radii)
-        self._contact_index = np.empty(0, dtype=np.int64)
-        self.contact_fn = np.empty(0)
-        self.last_wall_fn = np.empty(0)
+        self.set_walls(walls)
+        self.threads = ThreadChooser(n, threads=threads)
 
     # ------------------------------------------------------------------ state
-    centers = property(lambda self: self._x.T, lambda self, v: self._x.__setitem__(slice(None), np.asarray(v).T))
-    velocities = property(lambda self: self._v.T, lambda self, v: self._v.__setitem__(slice(None), np.asarray(v).T))
-    spins = property(lambda self: self._w.T, lambda self, v: self._w.__setitem__(slice(None), np.asarray(v).T))
+    centers = property(lambda self: self._x, lambda self, v: self._x.__setitem__(slice(None), v))
+    velocities = property(lambda self: self._v, lambda self, v: self._v.__setitem__(slice(None), v))
+    spins = property(lambda self: self._w, lambda self, v: self._w.__setitem__(slice(None), v))
 
     def _set_radii(self, radii):
         self.radii = np.asarray(radii, dtype=float)
         m = self.material
         self.mass = m.density_kg_m3 * 4.0 / 3.0 * np.pi * self.radii**3
         self.inertia = 0.4 * self.mass * self.radii**2
-        self._coef_valid = False
         self._dt = self.dt_safety * float(
             np.sqrt(self.mass_scale * self.mass.min() / max(self.material.kn_n_m, self.material.ks_n_m))
         )
+        # per-particle factors of the kernels (scaled masses, weight, dt / mass, dt / inertia)
+        self._ms = self.mass * self.mass_scale
+        self._gforce = self.mass * (self.mass_scale * self.gravity_m_s2)
+        self._inv_m = self._dt / (self.mass * self.mass_scale)
+        self._inv_i = self._dt / (self.inertia * self.mass_scale)
+        self._coef_valid = False
 
     def set_radii(self, radii):
         """Change radii (radius expansion); masses follow at fixed density."""
@@ -200,8 +199,37 @@ class Simulation:
     def set_walls(self, walls):
         """Replace the walls (e.g. remove the lid); wall contact history is dropped."""
         self.walls = list(walls)
-        self.wall_shear = np.zeros((len(self.walls), 3, self.n))
-        self._wall_prev = None
+        nw, n = len(self.walls), self.n
+        self._wall_kind = np.zeros(nw, dtype=np.int64)
+        self._wall_normal = np.zeros((nw, 3))
+        self._wall_cyl = np.zeros((nw, 3))
+        self._wall_moves = np.zeros(nw, dtype=np.bool_)
+        for k, wall in enumerate(self.walls):
+            if isinstance(wall, PlaneWall):
+                self._wall_normal[k] = wall.normal
+            elif isinstance(wall, CylinderWall):
+                self._wall_kind[k] = 1
+                self._wall_cyl[k] = (*wall.center_xy_m, wall.radius_m)
+            else:
+                raise TypeError(f"unknown wall type {type(wall).__name__}")
+            self._wall_moves[k] = wall.moves
+        self._wall_offset_at = None
+        self.wall_shear = np.zeros((nw, n, 3))
+        self._wall_fn = np.zeros((nw, n))
+        self._wall_touch = np.zeros((nw, n), dtype=np.uint8)
+
+    def _wall_offsets(self):
+        """Plane offsets -p·n with the moving planes shifted by ``z_offset_m`` (cached)."""
+        if self._wall_offset_at != self.z_offset_m:
+            off = np.zeros(len(self.walls))
+            for k, wall in enumerate(self.walls):
+                if isinstance(wall, PlaneWall):
+                    p = np.asarray(wall.point_m, dtype=float).copy()
+                    if wall.moves:
+                        p[2] += self.z_offset_m
+                    off[k] = -float(p @ np.asarray(wall.normal, dtype=float))
+            self._wall_offset, self._wall_offset_at = off, self.z_offset_m
+        return self._wall_offset
 
     def set_material(self, material):
         """Replace the material (e.g. restore friction after packing)."""
@@ -219,123 +247,77 @@ class Simulation:
 
     def kinetic_energy(self):
         """Translational + rotational kinetic energy with physical (unscaled) masses, J."""
-        return float(0.5 * np.sum(self.mass * _dot(self._v, self._v)) + 0.5 * np.sum(self.inertia * _dot(self._w, self._w)))
+        v, w = self._v.T, self._w.T
+        return float(0.5 * np.sum(self.mass * _dot(v, v)) + 0.5 * np.sum(self.inertia * _dot(w, w)))
 
     # ------------------------------------------------------------------ forces
-    def _rebuild(self):
-        old_keys = self.verlet.build(self.centers, self.radii)
-        self.shear = remap_history(old_keys, self.shear.T, self.verlet.keys).T.copy()
+    def _set_pairs(self, history):
+        """Per-pair arrays for the current Verlet pairs; ``history`` (Np, 4) holds each pair's
+        shear spring (m) and whether it touched at the last evaluation."""
         p = self.verlet.pairs
         self._pi, self._pj = p[:, 0].copy(), p[:, 1].copy()
+        self.shear = np.ascontiguousarray(history[:, :3])
+        self._touch = history[:, 3].astype(np.uint8)
+        self._f_pair = np.zeros((len(p), 3))
+        self._t_pair = np.zeros((len(p), 3))
+        self._fn_pair = np.zeros(len(p))
+        self._cn = np.zeros(len(p))
+        self._ct = np.zeros(len(p))
         self._coef_valid = False
+
+    def _rebuild(self):
+        old_keys = self.verlet.build(self._x, self.radii)
+        history = np.column_stack([self.shear, self._touch])
+        self._set_pairs(remap_history(old_keys, history, self.verlet.keys))
         self.stats["rebuilds"] += 1
 
-    def _pair_coefficients(self):
-        mat = self.material
-        ms = self.mass * self.mass_scale
-        mi, mj = ms[self._pi], ms[self._pj]
-        meff = mi * mj / (mi + mj)
-        self._cn = damping_coefficient(mat.damping_ratio, meff, mat.kn_pp)
-        self._ct = damping_coefficient(mat.damping_ratio, meff, mat.ks_pp)
-        self._rsum = self.radii[self._pi] + self.radii[self._pj]
-        self._coef_valid = True
+    def _evaluate(self, advance):
+        if self.verlet.needs_rebuild(self._x, self.radii):
+            self._rebuild()
+        mat, dt, vl = self.material, self._dt, self.verlet
+        t0 = time.perf_counter()
+        if not self._coef_valid:
+            pair_damping(self._ms, self._pi, self._pj, mat.damping_ratio, mat.kn_pp, mat.ks_pp, self._cn, self._ct)
+            self._coef_valid = True
+        pair_forces(self._x, self._v, self._w, self.radii, self._pi, self._pj, self._cn, self._ct, self.shear,
+                    mat.kn_pp, mat.ks_pp, mat.friction, dt, self._f_pair, self._t_pair, self._fn_pair, self._touch)
+        particle_update(self._x, self._v, self._w, self.radii, self._ms, self._gforce, vl.first_start,
+                        vl.second_start, vl.by_second, self._f_pair, self._t_pair, self._touch, self._wall_kind,
+                        self._wall_normal, self._wall_offsets(), self._wall_cyl, self._wall_moves,
+                        self.wall_vz_m_s, self.wall_shear, self._wall_fn, self._wall_touch, mat.kn_pw, mat.ks_pw,
+                        mat.damping_ratio, mat.wall_friction, dt, self._inv_m, self._inv_i, self._force,
+                        self._torque, advance)
+        self.threads.record(time.perf_counter() - t0)
 
     def forces(self):
-        """Net force and torque on every particle, both (3, N) component-first (scaled masses)."""
-        if self.verlet.needs_rebuild(self.centers, self.radii):
-            self._rebuild()
-        if not self._coef_valid:
-            self._pair_coefficients()
-        mat = self.material
-        n = self.n
-        X, V, W, r = self._x, self._v, self._w, self.radii
-        dt = self._dt
-        pi, pj = self._pi, self._pj
+        """Net force and torque on every particle, both (3, N) component-first (scaled masses).
 
-        # 1. candidate pairs -> touching pairs
-        d = X.take(pj, axis=1)
-        d -= X.take(pi, axis=1)
-        dist2 = _dot(d, d)
-        rsum = self._rsum
-        c = np.flatnonzero(dist2 < rsum * rsum)
-        ci, cj = pi[c], pj[c]
-        dist = np.sqrt(dist2[c])
-        nrm = d[:, c] / dist
-        RW = W * r
-        v_rel = V.take(ci, axis=1)
-        v_rel -= V.take(cj, axis=1)
-        v_rel += _cross(RW.take(ci, axis=1) + RW.take(cj, axis=1), nrm)
-        # 2. contact law
-        f, fn, ft, xi = linear_contact_forces(
-            rsum[c] - dist, nrm, v_rel, self.shear[:, c],
-            kn=mat.kn_pp, ks=mat.ks_pp, cn=self._cn[c], ct=self._ct[c], mu=mat.friction, dt=dt,
-        )
-        shear = np.zeros_like(self.shear)
-        shear[:, c] = xi
-        self.shear = shear
-        self._contact_index = c
-        self.contact_fn = fn
-        # 3. accumulate: +f on i, -f on j; torque r_i n x ft on i, r_j n x ft on j
-        nxft = _cross(nrm, ft)
-        idx = np.concatenate([ci, cj])
-        rr = r[idx]
-        force = np.empty((3, n))
-        torque = np.empty((3, n))
-        for k in range(3):
-            force[k] = np.bincount(idx, np.concatenate([f[k], -f[k]]), minlength=n)
-            torque[k] = np.bincount(idx, np.concatenate([nxft[k], nxft[k]]) * rr, minlength=n)
+        Evaluating the forces advances the contacts' shear springs (as a step does)."""
+        self._evaluate(False)
+        return self._force.T, self._torque.T
 
-        # walls (same contact law)
-        if self.walls:
-            widx, p, ov, wn, moves = wall_contacts(self.walls, X, r, self.z_offset_m)
-            self._clear_wall_history()
-            if len(p):
-                wall_v = np.zeros((3, len(p)))
-                wall_v[2, moves] = self.wall_vz_m_s
-                v_rel_w = V[:, p] - wall_v + _cross(RW[:, p], wn)
-                ms = self.mass[p] * self.mass_scale
-                fw, fnw, ftw, xiw = linear_contact_forces(
-                    ov, wn, v_rel_w, self.wall_shear[widx, :, p].T,
-                    kn=mat.kn_pw, ks=mat.ks_pw,
-                    cn=damping_coefficient(mat.damping_ratio, ms, mat.kn_pw),
-                    ct=damping_coefficient(mat.damping_ratio, ms, mat.ks_pw),
-                    mu=mat.wall_friction, dt=dt,
-                )
-                self.wall_shear[widx, :, p] = xiw.T
-                self._wall_prev = (widx, p)
-                rnxf = _cross(wn, ftw) * r[p]
-                for k in range(3):
-                    force[k] += np.bincount(p, fw[k], minlength=n)
-                    torque[k] += np.bincount(p, rnxf[k], minlength=n)
-                self.last_wall_fn = fnw
-            else:
-                self.last_wall_fn = np.empty(0)
-        if self.gravity_m_s2:
-            force[2] -= self.mass * (self.mass_scale * self.gravity_m_s2)
-        return force, torque
+    @property
+    def contact_fn(self):
+        """(Nc,) normal forces of the touching particle pairs at the last evaluation, N."""
+        return self._fn_pair[self._touch.view(bool)]
 
-    def _clear_wall_history(self):
-        prev = self._wall_prev
-        if prev is not None:
-            self.wall_shear[prev[0], :, prev[1]] = 0.0
-            self._wall_prev = None
+    @property
+    def last_wall_fn(self):
+        """(Nw,) normal forces of the wall contacts at the last evaluation (wall by wall), N."""
+        return self._wall_fn[self._wall_touch.view(bool)]
 
     @property
     def touching_pairs(self):
         """(Nc, 2) pairs in contact at the last force evaluation."""
-        return self.verlet.pairs[self._contact_index]
+        return self.verlet.pairs[self._touch.view(bool)]
 
     # ------------------------------------------------------------------ stepping
     def step(self):
         """Advance one time step; returns the net force, (3, N) component-first, N."""
-        force, torque = self.forces()
-        dt = self._dt
-        self._v += force * (dt / (self.mass * self.mass_scale))
-        self._w += torque * (dt / (self.inertia * self.mass_scale))
-        self._x += self._v * dt
-        self.time_s += dt
+        self._evaluate(True)
+        self.time_s += self._dt
         self.steps += 1
-        return force
+        return self._force.T
 
     def unbalanced_force_ratio(self, force):
         r"""Mean unbalanced-force ratio :math:`\overline{|F_{net}|} / \overline{F_n}`.
@@ -355,7 +337,7 @@ class Simulation:
                 f"non-finite positions/velocities at t = {self.time_s:.4g} s (step {self.steps}); "
                 "reduce dt_safety or mass_scale"
             )
-        vmax = float(np.sqrt(np.max(_dot(self._v, self._v))))
+        vmax = float(np.sqrt(np.max(_dot(self._v.T, self._v.T))))
         if vmax > max_speed_m_s:
             raise DemInstabilityError(
                 f"particle speed {vmax:.3g} m/s exceeds {max_speed_m_s} m/s at t = {self.time_s:.4g} s "

@@ -26,7 +26,7 @@ from ._procedures import pack_bed
 from ._perf import tune_malloc
 
 
-def lattice_simulation(n, *, rng=0, mass_scale=100.0):
+def lattice_simulation(n, *, rng=0, mass_scale=100.0, threads=None):
     """N spheres (r = 3.25 mm) on a simple cubic lattice in a closed box (benchmark scene)."""
     rng = np.random.default_rng(rng)
     a = 0.0065
@@ -38,12 +38,14 @@ def lattice_simulation(n, *, rng=0, mass_scale=100.0):
     x[:, 0] -= nx * a / 2
     x[:, 1] -= ny * a / 2
     c = Container("box", (nx * a, ny * a), nz * a)
-    return make_simulation(c, x, np.full(len(x), a / 2 * (1 + 1e-4)), lid=True, mass_scale=mass_scale)
+    return make_simulation(c, x, np.full(len(x), a / 2 * (1 + 1e-4)), lid=True, mass_scale=mass_scale,
+                           threads=threads)
 
 
-def rate(n, *, steps=None, repeat=3):
-    """Particle-steps per second for N (min/median over ``repeat`` timings)."""
-    sim = lattice_simulation(n)
+def rate(n, *, steps=None, repeat=3, threads=None):
+    """Particle-steps per second for N (min/median over ``repeat`` timings); ``threads`` None
+    lets the simulation choose (the steps each thread count ran are in ``steps_by_threads``)."""
+    sim = lattice_simulation(n, threads=threads)
     for _ in range(5):
         sim.step()
     steps = steps or max(20, int(2e6 / n))
@@ -62,6 +64,7 @@ def rate(n, *, steps=None, repeat=3):
         "ms_per_step_best": float(1e3 * times.min() / steps),
         # per second of this process's CPU time: what an idle core would give (shared machine)
         "rate_per_cpu_s_best": float(n * steps / min(cpu)), "cpu_seconds": cpu,
+        "steps_by_threads": {str(k): v for k, v in sim.threads.steps_by_threads.items()},
     }
 
 
@@ -93,6 +96,8 @@ def main(argv=None) -> int:
     p.add_argument("--n", type=int, nargs="+", default=[1000, 2000, 5000, 10000, 20000, 50000])
     p.add_argument("--repeat", type=int, default=3)
     p.add_argument("--steps", type=int, default=None)
+    p.add_argument("--threads", type=int, default=None,
+                   help="threads of the step kernels (default: chosen by timing, see dem._threads)")
     p.add_argument("--mass-scale-study", action="store_true")
     p.add_argument("--scales", type=float, nargs="+", default=[1.0, 10.0, 100.0])
     p.add_argument("--json", default="dem_bench.json")
@@ -105,13 +110,14 @@ def main(argv=None) -> int:
         result["mass_scale_study"] = mass_scale_study(tuple(args.scales))
     else:
         print(f"{'N':>7} {'pairs':>8} {'contacts':>9} {'ms/step':>8} {'p-steps/s best':>15} {'median':>12} "
-              f"{'per CPU-s':>12}")
+              f"{'per CPU-s':>12} {'threads':>8}")
         rows = []
         for n in args.n:
-            r = rate(n, steps=args.steps, repeat=args.repeat)
+            r = rate(n, steps=args.steps, repeat=args.repeat, threads=args.threads)
             rows.append(r)
             print(f"{r['n']:7d} {r['pairs']:8d} {r['contacts']:9d} {r['ms_per_step_best']:8.2f} "
-                  f"{r['rate_best']:15.3e} {r['rate_median']:12.3e} {r['rate_per_cpu_s_best']:12.3e}", flush=True)
+                  f"{r['rate_best']:15.3e} {r['rate_median']:12.3e} {r['rate_per_cpu_s_best']:12.3e} "
+                  f"{max(r['steps_by_threads'], key=r['steps_by_threads'].get):>8}", flush=True)
         result["rates"] = rows
     meta["loadavg_after"] = os.getloadavg()
     print(f"load average before {meta['loadavg_before']}, after {meta['loadavg_after']}; {meta['cpu_count']} CPUs")

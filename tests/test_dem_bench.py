@@ -51,9 +51,9 @@ def test_bench_json_has_what_it_prints(tmp_path, capsys):
     data = json.loads(out.read_text())
     assert [row["n"] for row in data["rates"]] == [N, 64]
     for row in data["rates"]:
-        # one key per printed column: N, pairs, contacts, ms/step, best, median, per CPU-s
+        # one key per printed column: N, pairs, contacts, ms/step, best, median, per CPU-s, threads
         assert {"n", "pairs", "contacts", "ms_per_step_best", "rate_best", "rate_median",
-                "rate_per_cpu_s_best"} <= set(row)
+                "rate_per_cpu_s_best", "steps_by_threads"} <= set(row)
     meta = data["meta"]
     assert {"loadavg_before", "loadavg_after", "cpu_count", "platform", "numpy", "timestamp"} <= set(meta)
     assert len(meta["loadavg_before"]) == 3
