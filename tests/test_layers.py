@@ -40,7 +40,7 @@ LAYERS = {
         {"flow"},
         {"airpaths"},
         {"validation"},
-        {"__init__", "solve", "throats", "paths", "curve", "report", "bench", "benchmarks",
+        {"__init__", "_cli", "solve", "throats", "paths", "curve", "report", "bench", "benchmarks",
          "__main__"},
     ],
 }
