@@ -3,13 +3,13 @@ r"""Vectorised Q* lookup for N throats: exact hits, grid interpolation, FE on de
 Policies
 --------
 ==============  ===============================================================================
-``table-only``  interpolation in the grid table for every row it covers, with its error
-                estimate; rows the grid cannot serve (outside the box, next to invalid or
-                closed nodes) take an exact hit if the store has one, else the shape-factor
-                estimate (``source='shape-factor'``).  Never runs FE.
-``table+fe``    as ``table-only``, but every row whose error estimate exceeds ``rtol`` is
-                answered by an exact hit (a stored FE solve with tolerance <= ``rtol``) or
-                else solved by FE (``throats.solve_fem``) and stored.
+``table-only``  an exact hit where ``db`` stores the shape (an FE solve with tolerance
+                <= ``rtol``), else interpolation in the grid table for every row it covers,
+                with its error estimate; rows the grid cannot serve (outside the box, next
+                to invalid or closed nodes) take the shape-factor estimate
+                (``source='shape-factor'``).  Never runs FE.
+``table+fe``    as ``table-only``, but every interpolated row whose error estimate exceeds
+                ``rtol`` is solved by FE (``throats.solve_fem``) and stored.
 ``fe-only``     exact hits, FE for the rest (stored); no interpolation.
 ``shape-factor`` ``throats.shape_factor_qstar`` for every row (no table).
 ==============  ===============================================================================
@@ -258,6 +258,9 @@ def lookup_qstar(radii, sides, *, db=None, policy="table+fe", rtol=1e-3, workers
         elif solver_version is None:
             solver_version = _build.default_solver()[1]
         if policy in ("table-only", "table+fe"):
+            # FE values already stored in the table beat interpolation (issue 13 item 3)
+            pending = _stored_first(r, s, pending, q, err, src, msg, db=db, rtol=rtol,
+                                    solver_version=solver_version)
             if table is None:
                 table = load_grid_table(db, grid=grid, solver_version=solver_version)
             if table is None:
@@ -286,6 +289,23 @@ def lookup_qstar(radii, sides, *, db=None, policy="table+fe", rtol=1e-3, workers
     stats["hit_rate"] = (stats["n_exact"] + stats["n_interp"]) / n_valid
     stats["seconds"] = time.perf_counter() - t0
     return Lookup(q, err, src.astype(str), stats, msg)
+
+
+def _stored_first(r, s, rows, q, err, src, msg, *, db, rtol, solver_version):
+    """Answer ``rows`` stored in ``db`` (tolerance <= rtol) exactly, in place; returns the rest.
+
+    Costs a signature per row and one indexed join, only when ``db`` exists and is not empty.
+    """
+    path = Path(db) if db is not None else default_db_path()
+    if not len(rows) or not path.exists() or path.stat().st_size == 0:
+        return rows
+    with open_store(path, create=False, check=False) as store:
+        if store.count() == 0:
+            return rows
+        found = _exact(store, shape_keys(signature(r[rows], s[rows])), rtol, solver_version)
+    hit = found["found"]
+    _assign_exact(rows[hit], found, hit, q, err, src, msg, "exact")
+    return rows[~hit]
 
 
 def _settle(r, s, rows, q, err, src, msg, stats, *, db, policy, rtol, workers, progress, solver,

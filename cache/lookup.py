@@ -4,9 +4,18 @@ Example::
 
     python -m cache.lookup --db throats.sqlite --csv IN.csv --out OUT.csv --policy table+fe --rtol 1e-3
 
-Writes the input columns plus ``qstar, open_area, contact_type, error_estimate`` (as
-``python -m throats.solve --csv``) and ``source, message``; Q* is in mean-radius units.
-Invalid rows are reported on stderr with their row number and written with empty values.
+Writes the input columns plus ``qstar, open_area, contact_type, error_estimate`` (the columns
+of ``python -m throats.solve --csv``, with the same meanings) and ``source, message``:
+
+* ``qstar``: dimensionless Q*, in units of the mean radius (g = Q* r̄⁴/(μL));
+* ``open_area``: open (fluid) area of the cross-section in the input's length unit squared
+  (m² for a CSV in metres), not scaled by r̄;
+* ``error_estimate``: relative error estimate of ``qstar`` (empty for the shape factor);
+* ``source``: exact (stored FE value), interp (grid table), fe, shape-factor, closed, failed.
+
+Default policy ``table+fe``; ``table-only`` and ``table+fe`` use values already stored in
+``--db`` before interpolating.  Invalid rows are reported on stderr with their row number
+(header = row 1) and written with empty values.
 """
 
 from __future__ import annotations
@@ -30,9 +39,15 @@ def build_parser():
     p.add_argument("--db", default=None, help="throat table (default: cache.default_db_path())")
     p.add_argument("--csv", required=True, help="input, columns r1,r2,r3,l12,l13,l23")
     p.add_argument("--out", required=True, help="output CSV")
-    p.add_argument("--policy", choices=POLICIES, default="table+fe")
-    p.add_argument("--rtol", type=float, default=1e-3)
-    p.add_argument("--workers", type=int, default=1)
+    p.add_argument("--policy", choices=POLICIES, default="table+fe",
+                   help="where Q* comes from (default table+fe): table+fe = stored value, else "
+                        "the grid table, else FE where the table's error estimate exceeds "
+                        "--rtol (FE results stored in --db); table-only = stored value, else the "
+                        "grid table, else the shape factor (never FE); fe-only = stored value, "
+                        "else FE; shape-factor = closed-form estimate (median error ~20%%)")
+    p.add_argument("--rtol", type=float, default=1e-3,
+                   help="relative tolerance of table+fe and of FE solves (default 1e-3)")
+    p.add_argument("--workers", type=int, default=1, help="processes for FE (default 1)")
     p.add_argument("--grid", default=None, help="grid name (default: newest in --db, else shipped)")
     p.add_argument("--quiet", action="store_true")
     return p
@@ -52,8 +67,7 @@ def main(argv=None) -> int:
     area = np.full(len(rows), np.nan)
     ctype = np.full(len(rows), "", dtype=object)
     if ok.any():
-        rbar = radii[ok].mean(axis=1)
-        area[ok] = throats.open_area(radii[ok], sides[ok]) / rbar**2
+        area[ok] = throats.open_area(radii[ok], sides[ok])        # input units squared
         ctype[ok] = throats.contact_type(radii[ok], sides[ok])
     for i in np.flatnonzero(~ok):
         print(f"row {i + 2}: {res.message[i]}", file=sys.stderr)  # +2: header, 1-based

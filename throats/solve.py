@@ -9,9 +9,14 @@ A CSV of throats with columns ``r1,r2,r3,l12,l13,l23`` (any consistent length un
 
     python -m throats.solve --csv IN.csv --out OUT.csv [--method ...] [--rtol ...] [--workers N]
 
-writes the input columns back with ``qstar`` (always in mean-radius units, r̄⁴),
-``open_area`` (input units²), ``contact_type``, ``error_estimate``, ``status`` and
-``message`` added.  A bad row (unparsable, NaN, non-positive radius, impossible or collinear
+writes the input columns back with ``qstar, open_area, contact_type, error_estimate, status,
+message`` added (the columns of ``python -m cache.lookup``, with the same meanings):
+
+* ``qstar``: dimensionless Q*, in units of the mean radius (g = Q* r̄⁴/(μL));
+* ``open_area``: open (fluid) area of the cross-section in the input's length unit squared
+  (m² for a CSV in metres), not scaled by r̄.
+
+Default method ``fem``.  A bad row (unparsable, NaN, non-positive radius, impossible or collinear
 triangle) is reported on stderr with its row and line number; the valid rows are still
 written.  Exit status: 0 when every row is 'ok' or 'closed', 1 when some row is invalid or
 failed, 2 for usage errors.
@@ -50,7 +55,8 @@ def _parser():
                    help="side lengths between the sphere centres (with --radii)")
     p.add_argument("--out", metavar="OUT.csv", help="output CSV (with --csv)")
     p.add_argument("--method", choices=METHODS, default="fem",
-                   help="fem (default) or shape-factor")
+                   help="fem (default: finite elements to --rtol) or shape-factor (closed-form "
+                        "estimate, median error ~20%%)")
     p.add_argument("--rtol", type=float, default=1e-3,
                    help="relative tolerance of the FE solve (default 1e-3)")
     p.add_argument("--workers", type=int, default=1, help="processes for FE (default 1)")
