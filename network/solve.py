@@ -6,13 +6,15 @@ Examples
     python -m network.solve bed.csv --axis all --policy shape-factor --json out.json
     python -m network.solve bed.csv --sample 0.01 0.09 0.01 0.09 0.02 0.2 --vtk bed.vtu
 
-Lengths are in the packing's own unit (metres by default); ``--sample`` overrides the automatic
-interior box (packing extent less ``--margin`` on every side, default 1.5 mean diameters).
+The packing is read in ``--units`` (m, cm or mm; default m) and converted to metres; ``--sample``
+and ``--margin`` are in that unit too; ``--sample`` overrides the automatic interior box (packing
+extent less ``--margin`` on every side, default 1.5 mean diameters). ``--pores-csv`` and
+``--throats-csv`` write the per-pore and per-throat tables, ``--vtk`` the ParaView file. Exit 0
+done, 1 the computation failed, 2 bad input: one ``error:`` line (docs/cli.md).
 """
 
 from __future__ import annotations
 
-import argparse
 import json
 import logging
 import sys
@@ -21,67 +23,76 @@ from pathlib import Path
 
 import numpy as np
 
-from ._air import MU_AIR_PA_S, RHO_AIR_KG_M3, check_positive
-from .conductance import MODELS, POLICIES
+from ._cli import (CliError, CliParser, add_air, add_packing, add_sample, bad_input, check_common,
+                   check_outputs, computing, load_packing, run, sample_box_m)
+from .conductance import MODELS, POLICIES, throat_qstar
 from .flow import (DEFAULT_DEPTH_M, DEFAULT_VELOCITY_M_S, combined_summary, solve_axes,
                    write_network_vtu)
-from .packing import default_packing_path, read_container, read_packing
-from .pores import sample_region
+from .packing import read_container
+from .pores import sample_region, tessellate
 
 # Thesis section 4.2.3 and Table 4.5: pressure drop over 0.25 m at 0.013 m/s (Pa)
 THESIS_LSV = {"measured": 2.44, "measured_sd": 0.20, "asabe_d272": 2.28, "thesis_network": 2.20,
               "ergun": 1.27, "branched_model": 2.74}
+PORES_HEADER = "pore,x_m,y_m,z_m,volume_m3,pressure_pa"
+THROATS_HEADER = "throat,pore1,pore2,area_m2,qstar,conductance_m3_per_pa_s,flow_m3_s"
 
 
-def build_parser() -> argparse.ArgumentParser:
-    ap = argparse.ArgumentParser(
+def build_parser() -> CliParser:
+    ap = CliParser(
         prog="python -m network.solve",
         description="Permeability, pressure gradient and pressure drop of a sphere packing by "
-                    "the Delaunay pore-network model (thesis 3.5.2), solved with pyamg.")
-    ap.add_argument("packing", nargs="?", default=None,
-                    help="CSV x,y,z,r / .npz / LIGGGHTS dump (default: the bundled soybean "
-                         f"scene {default_packing_path().name})")
-    ap.add_argument("--axis", default="z", choices=["x", "y", "z", "all"],
-                    help="flow direction; 'all' solves x, y and z (default z)")
-    ap.add_argument("--sample", nargs=6, type=float, metavar=("XMIN", "XMAX", "YMIN", "YMAX",
-                                                              "ZMIN", "ZMAX"),
-                    help="sample box (packing units); default: the interior box")
-    ap.add_argument("--margin", type=float, default=None,
-                    help="wall margin of the default box (default 1.5 mean diameters)")
-    ap.add_argument("--cylinder", action="store_true",
-                    help="use the cylinder inscribed in the sample box (axis = flow axis)")
-    ap.add_argument("--viscosity", type=float, default=MU_AIR_PA_S,
-                    help=f"dynamic viscosity, Pa s (default {MU_AIR_PA_S})")
+                    "the Delaunay pore-network model (thesis 3.5.2), solved with pyamg. Exit "
+                    "status 0 done, 1 the computation failed, 2 bad input (docs/cli.md).")
+    add_packing(ap)
+    ap.add_argument("--axis", default="z", type=str.lower, choices=["x", "y", "z", "all"],
+                    help="flow direction, any case; 'all' solves x, y and z")
+    add_sample(ap)
+    add_air(ap)
     ap.add_argument("--velocity", type=float, default=DEFAULT_VELOCITY_M_S,
-                    help=f"superficial velocity, m/s (default {DEFAULT_VELOCITY_M_S})")
-    ap.add_argument("--density", type=float, default=RHO_AIR_KG_M3,
-                    help=f"air density for the inertial loss, kg/m^3 (default {RHO_AIR_KG_M3})")
+                    help="superficial air velocity, m/s, > 0")
     ap.add_argument("--stokes", action="store_true",
                     help="Stokes (linear) answer only; default: pressure gradient and drop "
                          "with inertia (conduit model), the Stokes values beside them")
     ap.add_argument("--depth", type=float, default=DEFAULT_DEPTH_M,
-                    help=f"bed depth for the pressure drop, m (default {DEFAULT_DEPTH_M})")
+                    help="bed depth for the pressure drop, m, > 0 (the thesis's comparison "
+                         "is printed only at 0.25 m and 0.013 m/s)")
     ap.add_argument("--policy", default="table-only", choices=POLICIES,
-                    help="Q* source: table-only (default: the precomputed table, the "
+                    help="Q* source: table-only (the precomputed table, the "
                          "shape-factor estimate where it cannot answer; never runs FE), "
                          "table+fe (FE for rows the table cannot answer to --rtol), fe-only, "
                          "shape-factor (fast closed form)")
     ap.add_argument("--conductance-model", default="conduit", choices=MODELS,
-                    help="throat conductance model (default conduit; thesis = Eq. 3.41, L = 2 r̄)")
-    ap.add_argument("--rtol", type=float, default=1e-3, help="Q* relative tolerance (1e-3)")
-    ap.add_argument("--db", default=None, help="throat table (default: the cache's default)")
-    ap.add_argument("--workers", type=int, default=1, help="processes for FE solves")
-    ap.add_argument("--json", dest="json_out", default=None, help="write every number here")
-    ap.add_argument("--vtk", default=None,
-                    help="write pores (pressure) and throats (flow, conductance) as .vtu "
-                         "(with --axis all: one file per axis, suffixed _x/_y/_z)")
+                    help="throat conductance model (thesis = Eq. 3.41, L = 2 r̄)")
+    ap.add_argument("--rtol", type=float, default=1e-3,
+                    help="Q* relative tolerance of table+fe and fe-only, > 0")
+    ap.add_argument("--db", default=None,
+                    help="throat table, SQLite (default: the cache's default database)")
+    ap.add_argument("--workers", type=int, default=1, help="processes for FE solves, >= 1")
+    ap.add_argument("--json", dest="json_out", default=None, metavar="OUT.json",
+                    help="write every number here (default: not written)")
+    ap.add_argument("--vtk", default=None, metavar="OUT.vtu",
+                    help="VTK XML unstructured grid (.vtu; a legacy .vtk name is refused): "
+                         "pores (pressure Pa, volume m^3) and throats (signed flow m^3/s, "
+                         "conductance, area m^2, Q*), and the spheres (radius m) in "
+                         "OUT_spheres.vtu; with --axis all one file per axis, _x/_y/_z "
+                         "(default: not written)")
+    ap.add_argument("--pores-csv", default=None, metavar="OUT.csv",
+                    help=f"per-pore table {PORES_HEADER} (m, m^3, Pa of the Stokes "
+                         "flow-imposed field); suffixed _x/_y/_z with --axis all "
+                         "(default: not written)")
+    ap.add_argument("--throats-csv", default=None, metavar="OUT.csv",
+                    help=f"per-throat table {THROATS_HEADER} (pore ids as in --pores-csv; "
+                         "area of the throat triangle; Q* of its window in mean-radius units; "
+                         "flow > 0 from pore1 to pore2, Stokes field); suffixed with --axis "
+                         "all (default: not written)")
     ap.add_argument("--quiet", "-q", action="store_true", help="no stage progress on stderr")
     return ap
 
 
-def _vtk_path(base: str, axis: str, multi: bool) -> Path:
+def _per_axis(base, axis: str, multi: bool, suffix: str) -> Path:
     p = Path(base)
-    return p.with_name(f"{p.stem}_{axis}{p.suffix or '.vtu'}") if multi else p
+    return p.with_name(f"{p.stem}_{axis}{p.suffix or suffix}") if multi else p
 
 
 def _print_result(res, out):
@@ -121,62 +132,117 @@ def _print_result(res, out):
                                      if isinstance(v, float)), file=out)
 
 
-def _check_options(args) -> None:
-    """Every numeric option checked before any work (ValueError names the option)."""
-    for name in ("viscosity", "velocity", "depth", "rtol", "density"):
-        check_positive(f"--{name}", getattr(args, name))
-    if args.margin is not None and not args.margin >= 0:
-        raise ValueError(f"--margin must be >= 0, got {args.margin!r}")
-    if args.workers < 1:
-        raise ValueError(f"--workers must be >= 1, got {args.workers!r}")
+def _check_inputs(args, axes) -> None:
+    """Every option and output path, before any work (ValueError names the option)."""
+    check_common(args)
+    if args.vtk and Path(args.vtk).suffix.lower() not in ("", ".vtu"):
+        raise ValueError(f"--vtk {args.vtk}: the writer makes VTK XML (.vtu, read by ParaView "
+                         f"and meshio), not legacy VTK; name the file "
+                         f"{Path(args.vtk).with_suffix('.vtu')}")
+    multi = len(axes) > 1
+    for ax in axes:
+        vtu = args.vtk and _per_axis(args.vtk, ax, multi, ".vtu")
+        check_outputs(json=args.json_out, vtk=vtu,
+                      vtk_spheres=vtu and vtu.with_name(f"{vtu.stem}_spheres.vtu"),
+                      pores_csv=args.pores_csv and _per_axis(args.pores_csv, ax, multi, ".csv"),
+                      throats_csv=args.throats_csv
+                      and _per_axis(args.throats_csv, ax, multi, ".csv"))
+
+
+def _pore_volume(res, tess):
+    """(Ns,) volume of each sample pore (its tetrahedra, spheres included), m³."""
+    if res.pore_groups is None:
+        return tess.pore_volume[res.pore_ids]
+    return np.bincount(res.pore_groups, weights=tess.pore_volume)[res.pore_ids]
+
+
+def _throat_qstar(res, tess, args):
+    """(Ms,) window Q* of the sample throats, r̄ units: the result's own when it carries them,
+    else the same policy asked again (the table answers at once; FE rows come from --db)."""
+    q = getattr(res, "throat_qstar", None)
+    if q is not None:
+        return np.asarray(q)
+    ids = res.throat_ids
+    return throat_qstar(tess.throat_radii[ids], tess.throat_sides[ids], policy=args.policy,
+                        rtol=args.rtol, db=args.db, workers=args.workers).qstar
+
+
+def _write_tables(res, tess, args, multi):
+    """--vtk, --pores-csv, --throats-csv of one axis; the paths written."""
+    out = []
+    ids, conns = res.throat_ids, res.conns
+    volume = _pore_volume(res, tess)
+    qstar = _throat_qstar(res, tess, args) if args.vtk or args.throats_csv else None
+    if args.vtk:
+        p = _per_axis(args.vtk, res.axis, multi, ".vtu")
+        write_network_vtu(p, res.pore_xyz, conns,
+                          point_data={"pressure": res.pressure_pa, "volume": volume},
+                          cell_data={"flow": res.throat_flow_m3_s,
+                                     "conductance": res.throat_conductance,
+                                     "area": tess.throat_area[ids], "qstar": qstar})
+        sp = p.with_name(f"{p.stem}_spheres.vtu")
+        pk = tess.packing
+        write_network_vtu(sp, pk.centers, np.zeros((0, 2), dtype=np.int64),
+                          point_data={"radius": pk.radii})
+        out += [p, sp]
+    if args.pores_csv:
+        p = _per_axis(args.pores_csv, res.axis, multi, ".csv")
+        np.savetxt(p, np.column_stack([res.pore_ids, res.pore_xyz, volume, res.pressure_pa]),
+                   delimiter=",", header=PORES_HEADER, comments="",
+                   fmt=["%d"] + ["%.10g"] * 5)
+        out.append(p)
+    if args.throats_csv:
+        p = _per_axis(args.throats_csv, res.axis, multi, ".csv")
+        np.savetxt(p, np.column_stack([ids, res.pore_ids[conns], tess.throat_area[ids], qstar,
+                                       res.throat_conductance, res.throat_flow_m3_s]),
+                   delimiter=",", header=THROATS_HEADER, comments="",
+                   fmt=["%d"] * 3 + ["%.10g"] * 4)
+        out.append(p)
+    return out
 
 
 def main(argv=None) -> int:
-    args = build_parser().parse_args(argv)
+    """Run the command; exit status 0 done, 1 the computation failed, 2 bad input."""
+    return run(_main, build_parser(), argv)
+
+
+def _main(args) -> int:
     if not args.quiet:
         logging.basicConfig(level=logging.INFO, format="[%(relativeCreated)7.0f ms] %(message)s",
                             stream=sys.stderr)
     t0 = time.perf_counter()
-    path = Path(args.packing) if args.packing else default_packing_path()
     axes = ["x", "y", "z"] if args.axis == "all" else [args.axis]
-    try:
-        _check_options(args)
-        packing = read_packing(path)
-        container = None if args.sample else read_container(path)
-        regions = {ax: sample_region(packing, box=args.sample, margin=args.margin,
-                                     cylinder=args.cylinder, container=container, axis=ax)
-                   for ax in axes}
-    except (OSError, ValueError) as e:
-        print(f"error: {e}", file=sys.stderr)
-        return 2
+    with bad_input():
+        _check_inputs(args, axes)
+        path, packing = load_packing(args)
+        box, margin = sample_box_m(args)
+        container = None if box else read_container(path)
+        regions = {ax: sample_region(packing, box=box, margin=margin, cylinder=args.cylinder,
+                                     container=container, axis=ax) for ax in axes}
     t_read = time.perf_counter() - t0
     if container is not None:
         print(f"container from {container['source']}: {container['kind']} {container['size_m']}")
-    try:
+    tables = args.vtk or args.pores_csv or args.throats_csv
+    with computing():
+        tess = tessellate(packing) if tables else None
         results = solve_axes(
             packing, regions, conductance_model=args.conductance_model, policy=args.policy,
             viscosity_pa_s=args.viscosity, velocity_m_s=args.velocity, depth_m=args.depth,
             rtol=args.rtol, db=args.db, workers=args.workers, progress=not args.quiet,
             inertia=not args.stokes and args.conductance_model == "conduit",
-            density_kg_m3=args.density)
-    except (ValueError, RuntimeError, NotImplementedError) as e:
-        print(f"error: {e}", file=sys.stderr)
-        return 1
-    if args.vtk:
-        for res in results:
-            p = _vtk_path(args.vtk, res.axis, len(axes) > 1)
-            write_network_vtu(p, res.pore_xyz, res.conns,
-                              point_data={"pressure": res.pressure_pa},
-                              cell_data={"flow": np.abs(res.throat_flow_m3_s),
-                                         "conductance": res.throat_conductance})
-            print(f"wrote {p}")
+            density_kg_m3=args.density, tessellation=tess)
+        written = [p for res in results for p in (_write_tables(res, tess, args, len(axes) > 1)
+                                                  if tables else [])]
+    for p in written:
+        print(f"wrote {p}")
     total = time.perf_counter() - t0
-    print(f"packing {path} ({packing.n} spheres), model {args.conductance_model}, "
-          f"policy {args.policy}")
+    print(f"packing {path} ({packing.n} spheres, read in {args.units}), model "
+          f"{args.conductance_model}, policy {args.policy}")
     for res in results:
         _print_result(res, sys.stdout)
     out = combined_summary(results, seconds={"read": t_read, "wall": total})
     out["packing"] = str(path)
+    out["units"] = args.units
     out["n_spheres"] = packing.n
     out["thesis_lsv_reference_pa"] = THESIS_LSV
     if len(results) > 1:
@@ -197,9 +263,8 @@ def main(argv=None) -> int:
         print(f"wrote {args.json_out}")
     bad = [r.axis for r in results if not r.check["ok"]]
     if bad:
-        print(f"error: mass balance check failed along {', '.join(bad)} (see mass_balance)",
-              file=sys.stderr)
-        return 1
+        raise CliError(f"mass balance check failed along {', '.join(bad)} (see mass_balance)",
+                       1)
     return 0
 
 

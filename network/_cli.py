@@ -1,0 +1,228 @@
+"""Shared pieces of the network command-line tools (``network.solve``, ``.curve``, ``.throats``,
+``.paths``): the packing/sample/units/air arguments, output-path checks, warning capture and the
+exit-code convention (docs/cli.md).
+
+Exit codes: 0 done, 1 the computation failed, 2 bad input. A failure prints one line
+``error: ...`` on stderr naming the value, row or file, never a traceback (set
+``GRAINFLOW_DEBUG=1`` to get one). Input, output paths included, is checked before anything is
+computed or written. Numbers such as ``--viscosity -1.8e-5`` are read as values (and refused
+with the option's own message), not as options.
+
+Lengths that place something in the packing (``--sample``, ``--margin``, ``--entry``) are in
+the packing file's unit (``--units``, default m); physical quantities (``--depth``,
+``--velocity``, ``--viscosity``, ``--density``) are SI.
+"""
+
+from __future__ import annotations
+
+import argparse
+import contextlib
+import os
+import re
+import sys
+import warnings
+from pathlib import Path
+
+from ._air import MU_AIR_PA_S, RHO_AIR_KG_M3, check_positive
+from .packing import UNITS, default_packing_path, read_packing, scale_warning
+
+__all__ = ["EXIT_OK", "EXIT_FAILED", "EXIT_BAD_INPUT", "CliError", "CliParser", "bad_input",
+           "computing", "run", "add_packing", "add_sample", "add_air", "check_outputs",
+           "check_plot", "load_packing", "sample_box_m", "warn"]
+
+EXIT_OK, EXIT_FAILED, EXIT_BAD_INPUT = 0, 1, 2
+#: a number, negative ones and exponents included: argparse's own pattern misses ``-1.8e-5``
+_NUMBER = re.compile(r"^-(\d+\.?\d*|\.\d+)([eE][-+]?\d+)?$|^-(inf|infinity|nan)$", re.I)
+
+
+class CliError(Exception):
+    """One line for the user and the exit code (1 or 2) that goes with it."""
+
+    def __init__(self, message: str, code: int = EXIT_BAD_INPUT):
+        super().__init__(message)
+        self.code = code
+
+
+class _Help(argparse.HelpFormatter):
+    """Appends ``(default: X)`` to an option's help unless it says its default already or the
+    default is None/False (an output not written, a switch off)."""
+
+    def _get_help_string(self, action):
+        text = action.help or ""
+        if (action.default not in (None, False, argparse.SUPPRESS) and action.option_strings
+                and "default" not in text):
+            text += " (default: %(default)s)"
+        return text
+
+
+class CliParser(argparse.ArgumentParser):
+    """``ArgumentParser`` that reads ``-1.8e-5`` as a value and reports a bad option in one
+    line (exit 2) instead of the usage block."""
+
+    def __init__(self, *a, **kw):
+        kw.setdefault("formatter_class", _Help)
+        super().__init__(*a, **kw)
+        self._negative_number_matcher = _NUMBER
+
+    def error(self, message):
+        raise CliError(f"{message} (see {self.prog} --help)")
+
+
+def _message(exc: BaseException) -> str:
+    if isinstance(exc, OSError) and exc.filename is not None and exc.strerror:
+        return f"{exc.strerror}: {exc.filename}"
+    return str(exc) or type(exc).__name__
+
+
+@contextlib.contextmanager
+def bad_input():
+    """ValueError/OSError inside become exit 2 (the user's input is wrong)."""
+    try:
+        yield
+    except (ValueError, OSError) as exc:
+        raise CliError(_message(exc), EXIT_BAD_INPUT) from exc
+
+
+@contextlib.contextmanager
+def computing():
+    """ValueError/RuntimeError/ArithmeticError/OSError inside become exit 1 (the computation
+    or writing its output failed)."""
+    try:
+        yield
+    except (ValueError, RuntimeError, ArithmeticError, NotImplementedError, OSError) as exc:
+        raise CliError(_message(exc), EXIT_FAILED) from exc
+
+
+def warn(message: str) -> None:
+    """One ``warning:`` line on stderr."""
+    print(f"warning: {' '.join(str(message).split())}", file=sys.stderr)
+
+
+def run(body, parser: argparse.ArgumentParser, argv=None) -> int:
+    """Parse ``argv``, call ``body(args)`` with numpy/scipy warnings captured, return its exit
+    code; a :class:`CliError` (or any other exception: exit 1) becomes one ``error:`` line.
+
+    Captured warnings do not reach the terminal; when there were any, one line says how many
+    and quotes the first (the checks of the result decide whether it is good).
+    """
+    debug = os.environ.get("GRAINFLOW_DEBUG")
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        try:
+            code = body(parser.parse_args(argv))
+        except CliError as exc:
+            print(f"error: {' '.join(str(exc).split())}", file=sys.stderr)
+            code = exc.code
+        except KeyboardInterrupt:
+            print("error: interrupted; no output written after the interruption",
+                  file=sys.stderr)
+            code = EXIT_FAILED
+        except Exception as exc:  # noqa: BLE001 - the convention: one line, no traceback
+            if debug:
+                raise
+            print(f"error: {type(exc).__name__}: {_message(exc)} (an internal error; "
+                  "GRAINFLOW_DEBUG=1 shows the traceback)", file=sys.stderr)
+            code = EXIT_FAILED
+    distinct = list(dict.fromkeys(f"{w.category.__name__}: {w.message}" for w in caught))
+    if distinct:
+        warn(f"{len(caught)} numerical warning(s) from numpy/scipy suppressed "
+             f"({len(distinct)} distinct; first: {distinct[0][:160]})")
+    return code
+
+
+# ------------------------------------------------------------------ arguments
+def add_packing(ap, *, required: bool = False) -> None:
+    """The packing positional and ``--units``."""
+    ap.add_argument("packing", nargs=None if required else "?", default=None,
+                    help="sphere packing: delimited text x,y,z,r (comma, semicolon, spaces; "
+                         "header optional; r, radius or diameter), .npz (centers, radii) or a "
+                         "LAMMPS/LIGGGHTS dump" + ("" if required else
+                                                   f"; default: the bundled scene "
+                                                   f"{default_packing_path().name}"))
+    ap.add_argument("--units", default="m", type=str.lower, choices=list(UNITS),
+                    help="length unit of the packing file (and of --sample, --margin, --entry); "
+                         "a mean grain diameter outside 0.5-50 mm after conversion is warned "
+                         "about")
+
+
+def add_sample(ap, *, cylinder: bool = True) -> None:
+    """``--sample`` box, ``--margin`` (and ``--cylinder``), in the packing's unit."""
+    ap.add_argument("--sample", nargs=6, type=float,
+                    metavar=("XMIN", "XMAX", "YMIN", "YMAX", "ZMIN", "ZMAX"), default=None,
+                    help="sample box in the packing's unit (--units); it must lie inside the "
+                         "packed bed; default: the interior box, --margin in from the bed")
+    ap.add_argument("--margin", type=float, default=None,
+                    help="wall margin of the default box in the packing's unit, >= 0 "
+                         "(default: 1.5 mean diameters)")
+    if cylinder:
+        ap.add_argument("--cylinder", action="store_true",
+                        help="use the cylinder inscribed in the sample box, its axis the flow "
+                             "axis")
+
+
+def add_air(ap, *, density: bool = True) -> None:
+    """``--viscosity`` (and ``--density``), SI."""
+    ap.add_argument("--viscosity", type=float, default=MU_AIR_PA_S,
+                    help="dynamic viscosity of the air, Pa s, > 0 (thesis air)")
+    if density:
+        ap.add_argument("--density", type=float, default=RHO_AIR_KG_M3,
+                        help="air density for the inertial losses, kg/m^3, > 0")
+
+
+# ------------------------------------------------------------------ checks
+def check_outputs(**paths) -> None:
+    """ValueError unless every given output path (``option=path``; None skipped) can be
+    written: its folder exists and is writable, and it is not a folder itself."""
+    for option, p in paths.items():
+        if p is None:
+            continue
+        opt = "--" + option.replace("_", "-")
+        path = Path(p)
+        folder = path.parent if str(path.parent) else Path(".")
+        if path.is_dir():
+            raise ValueError(f"{opt} {p}: is a folder, give a file name")
+        if not folder.is_dir():
+            raise ValueError(f"{opt} {p}: folder {folder} does not exist")
+        if not os.access(folder, os.W_OK | os.X_OK):
+            raise ValueError(f"{opt} {p}: folder {folder} is not writable")
+        if path.exists() and not os.access(path, os.W_OK):
+            raise ValueError(f"{opt} {p}: file exists and is not writable")
+
+
+def check_plot(option: str = "--plot") -> None:
+    """ValueError naming the extra to install when matplotlib is missing."""
+    try:
+        import matplotlib  # noqa: F401 - optional dependency
+    except ImportError as exc:
+        raise ValueError(f"{option} needs matplotlib, which is not installed: "
+                         "pip install '.[plot]' (or pip install matplotlib)") from exc
+
+
+def check_common(args) -> None:
+    """The numeric options every command may have, checked once (ValueError names them)."""
+    for name in ("viscosity", "density", "velocity", "depth", "rtol"):
+        if getattr(args, name, None) is not None and not isinstance(getattr(args, name), list):
+            check_positive(f"--{name}", getattr(args, name))
+    if getattr(args, "margin", None) is not None and not args.margin >= 0:
+        raise ValueError(f"--margin must be >= 0 (packing units), got {args.margin!r}")
+    if getattr(args, "workers", 1) < 1:
+        raise ValueError(f"--workers must be >= 1, got {args.workers!r}")
+
+
+def load_packing(args):
+    """(path, packing in metres) of ``args.packing`` (bundled scene if None) in ``args.units``;
+    the scale warning, if any, as one stderr line."""
+    path = Path(args.packing) if args.packing else default_packing_path()
+    packing = read_packing(path, units=args.units)
+    msg = scale_warning(packing)
+    if msg:
+        warn(msg)
+    return path, packing
+
+
+def sample_box_m(args):
+    """(``--sample`` box, ``--margin``) converted to metres (None stays None)."""
+    s = UNITS[args.units]
+    box = None if args.sample is None else [v * s for v in args.sample]
+    margin = None if args.margin is None else args.margin * s
+    return box, margin
