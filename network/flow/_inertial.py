@@ -58,10 +58,14 @@ class InertialPoint:
     throat_flow_m3_s: np.ndarray = dataclasses.field(repr=False)
 
 
-def conduit_flow(dp, g, K):
+def conduit_flow(dp, g, K, *, crossover: float | None = None):
     r"""Signed conduit flows q and slopes w = dq/dΔp for pressure drops ``dp`` (module formula).
 
-    ``K`` is (Nt, 2) (direction-dependent) or (Nt,). K = 0 gives q = g Δp exactly.
+    ``K`` is (Nt, 2) (direction-dependent) or (Nt,). K = 0 gives q = g Δp exactly. With
+    ``crossover`` :math:`X_c` the inertial loss has a weak-inertia onset,
+    :math:`\Delta p = q/g + K q|q|\,X/(X_c + X)`, :math:`X = Kg|q|` (the ratio of the
+    high-Re loss to the viscous one; ``docs/inertial-flow.md``); q is found by bracketed
+    Newton between the quadratic-law flow and :math:`g\Delta p`.
 
     >>> q, w = conduit_flow(np.array([1.5, -1.5]), np.array([1.0, 1.0]), np.array([0.5, 0.5]))
     >>> q.tolist(), w.tolist()
@@ -71,13 +75,32 @@ def conduit_flow(dp, g, K):
     k = np.where(dp >= 0, K[:, 0], K[:, 1]) if K.ndim == 2 else K
     a = np.abs(dp)
     inv_g = 1.0 / g
-    q = np.sign(dp) * 2.0 * a / (inv_g + np.sqrt(inv_g**2 + 4.0 * k * a))
-    w = 1.0 / (inv_g + 2.0 * k * np.abs(q))
-    return q, w
+    q = 2.0 * a / (inv_g + np.sqrt(inv_g**2 + 4.0 * k * a))
+    if crossover is None:
+        w = 1.0 / (inv_g + 2.0 * k * q)
+        return np.sign(dp) * q, w
+    c = k * g / float(crossover)            # X / X_c = c |q|
+    lo, hi = q, g * a
+    for _ in range(60):
+        x = c * q
+        f = q * inv_g + k * q * q * x / (1.0 + x) - a
+        df = inv_g + k * q * q * c * (3.0 + 2.0 * x) / (1.0 + x) ** 2
+        lo = np.where(f < 0, q, lo)
+        hi = np.where(f > 0, q, hi)
+        qn = q - f / df
+        qn = np.where((qn > lo) & (qn < hi), qn, 0.5 * (lo + hi))
+        done = np.abs(qn - q) <= 1e-15 * np.maximum(qn, 1e-300)
+        q = qn
+        if np.all(done):
+            break
+    x = c * q
+    w = 1.0 / (inv_g + k * q * q * c * (3.0 + 2.0 * x) / (1.0 + x) ** 2)
+    return np.sign(dp) * q, w
 
 
 def solve_inertial(n_pores, conns, g, K, inlet, outlet, flows_m3_s, *, tol: float = 1e-10,
-                   maxiter: int = 30, amg: AMGSolver | None = None) -> list[InertialPoint]:
+                   maxiter: int = 30, amg: AMGSolver | None = None,
+                   crossover: float | None = None) -> list[InertialPoint]:
     """Solve the nonlinear network at every total flow (ascending), reusing one hierarchy.
 
     Parameters
@@ -98,6 +121,8 @@ def solve_inertial(n_pores, conns, g, K, inlet, outlet, flows_m3_s, *, tol: floa
         Newton iterations per flow (default 30).
     amg : AMGSolver, optional
         Hierarchy of the condensed Stokes matrix (built here when not given).
+    crossover : float, optional
+        :math:`X_c` of the weak-inertia onset (:func:`conduit_flow`); None: purely quadratic.
 
     Returns
     -------
@@ -128,7 +153,7 @@ def solve_inertial(n_pores, conns, g, K, inlet, outlet, flows_m3_s, *, tol: floa
     i, j = c[:, 0], c[:, 1]
 
     def residual(p, Q):
-        q, w = conduit_flow(p[i] - p[j], g, K)
+        q, w = conduit_flow(p[i] - p[j], g, K, crossover=crossover)
         net = np.bincount(i, q, n_pores) - np.bincount(j, q, n_pores)
         return net[free], net[inlet].sum() - Q, q, w
 

@@ -1,5 +1,8 @@
 """Validation: reference permeabilities and the cases that run the one pipeline against them."""
 
+from ._drag_laws import DRAG_LAWS, beetstra_drag, drag_ratio, hill_koch_ladd_drag
+from ._inertial_cases import (FINNEY_PATH, InertialCase, finney_inertial_case,
+                              lattice_inertial_case, random_inertial_case)
 from ._cases import ESTIMATORS, lattice_sample_permeability, random_sample_permeability
 from ._references import (STOKES_CELL_BCC, STOKES_CELL_FCC, ZICK_HOMSY_SC, beetstra_permeability,
                           beetstra_stokes_drag, computed_lattice_permeability,
@@ -7,7 +10,9 @@ from ._references import (STOKES_CELL_BCC, STOKES_CELL_FCC, ZICK_HOMSY_SC, beets
                           kozeny_carman_permeability, lattice_permeability,
                           sangani_acrivos_sc_drag, zick_homsy_sc_drag)
 
-__all__ = ["ESTIMATORS", "STOKES_CELL_BCC", "STOKES_CELL_FCC", "ZICK_HOMSY_SC",
+__all__ = ["DRAG_LAWS", "ESTIMATORS", "FINNEY_PATH", "InertialCase", "beetstra_drag",
+           "drag_ratio", "finney_inertial_case", "hill_koch_ladd_drag",
+           "lattice_inertial_case", "random_inertial_case", "STOKES_CELL_BCC", "STOKES_CELL_FCC", "ZICK_HOMSY_SC",
            "beetstra_permeability", "beetstra_stokes_drag", "computed_lattice_permeability",
            "drag_to_permeability", "ergun_viscous_permeability", "kozeny_carman_permeability",
            "lattice_permeability", "lattice_sample_permeability", "random_sample_permeability",

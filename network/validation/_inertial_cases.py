@@ -1,0 +1,187 @@
+r"""Inertial validation cases: the resistance curve of a known packing against the drag laws.
+
+Each case builds a packing, runs the one pipeline (:func:`network.solve_network` with
+``inertia=True``, conduit model) at viscosity 1 and density 1 with the superficial velocities
+:math:`U = Re/d`, so that :math:`Re_p = \rho U d/\mu` is the requested Reynolds number, and
+returns an :class:`InertialCase`: the network's :math:`k/k_{app}` (pressure gradient over its
+Darcy value, k the sample's Stokes permeability) beside the laws'
+:math:`F(\phi, Re)/F(\phi, 0)` (:mod:`._drag_laws`).
+
+``crossover`` selects the weak-inertia onset of :func:`network.flow.conduit_flow` (None: the
+purely quadratic law of the pipeline). :func:`solve_sample_curve` is that pipeline, stages timed.
+
+* :func:`random_inertial_case`: periodic random packing (:func:`network.random_packing`),
+  copied 3 x 3 x 3, the middle two periods as the sample, as
+  :func:`random_sample_permeability` does;
+* :func:`finney_inertial_case`: a cube from the centre of Finney's (1970) measured random dense
+  packing (``/work/shared/data/finney``, packing fraction about 0.636);
+* :func:`lattice_inertial_case`: simple-cubic / BCC / FCC arrays (no reference ratio: Hill,
+  Koch & Ladd's ordered-array numbers were not found in the stored references).
+
+Measured tables: ``docs/inertial-flow.md``.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+import time
+from pathlib import Path
+
+import numpy as np
+
+from ..conductance import inertial_coefficients, throat_conductance
+from ..flow import darcy_permeability, solve_fixed_pressure, solve_inertial
+from ..packing import Packing, lattice_packing, periodic_copies, random_packing, read_packing
+from ..pores import Region, merge_pores, prune_disconnected, select_sample, tessellate
+from ._drag_laws import DRAG_LAWS, drag_ratio
+
+__all__ = ["FINNEY_PATH", "InertialCase", "finney_inertial_case", "lattice_inertial_case",
+           "random_inertial_case", "solve_sample_curve"]
+
+#: Finney's packing, central subset (radius 1, lengths in sphere radii).
+FINNEY_PATH = Path("/work/shared/data/finney/finney_subset_4021.csv")
+
+
+@dataclasses.dataclass
+class InertialCase:
+    """A solved validation curve. ``reynolds`` (n,) and ``k_ratio`` (n,) = k/k_app of the
+    network; ``law_ratio`` {law: (n,)}; ``error`` {law: (n,)} = k_ratio / law_ratio - 1 (the
+    relative error of the pressure gradient); Newton ``iterations`` (n,), ``converged``;
+    ``permeability_d2`` (Stokes k / d²), ``solid_fraction``, ``seconds``."""
+
+    name: str
+    solid_fraction: float
+    reynolds: np.ndarray
+    k_ratio: np.ndarray
+    law_ratio: dict
+    error: dict
+    iterations: np.ndarray
+    converged: bool
+    permeability_d2: float
+    seconds: float
+
+    def rows(self) -> list[dict]:
+        """One JSON-ready dict per Reynolds number."""
+        out = []
+        for n, re in enumerate(self.reynolds):
+            row = {"case": self.name, "solid_fraction": self.solid_fraction,
+                   "reynolds_particle": float(re), "k_over_k_app": float(self.k_ratio[n]),
+                   "newton_iterations": int(self.iterations[n])}
+            for law in self.law_ratio:
+                row[f"{law}_ratio"] = float(self.law_ratio[law][n])
+                row[f"{law}_error"] = float(self.error[law][n])
+            out.append(row)
+        return out
+
+
+def solve_sample_curve(packing, region, velocities_m_s, *, axis=0, policy="table-only",
+                       db=None, viscosity_pa_s=1.0, density_kg_m3=1.0, crossover=None):
+    """The inertial pipeline of :func:`network.solve_network` (conduit model, bodies merged),
+    with the onset ``crossover`` of :func:`network.flow.solve_inertial` selectable:
+    ``(permeability_m2, length_m, points, seconds)``, ``seconds`` a dict by stage."""
+    t = {}
+    t0 = time.perf_counter()
+    tess = tessellate(packing)
+    merge = merge_pores(tess)
+    sample = select_sample(tess, region, axis=axis, groups=np.asarray(merge.labels))
+    t["tessellate"] = time.perf_counter() - t0
+    t0 = time.perf_counter()
+    cres = throat_conductance(tess, sample.throats, model="conduit", policy=policy, db=db,
+                              viscosity_pa_s=viscosity_pa_s, merge=merge)
+    before = sample.throats
+    sample, g = prune_disconnected(sample, tess, cres.g)
+    K = inertial_coefficients(tess, before, cres.h_m, internal=cres.internal,
+                              density_kg_m3=density_kg_m3)[np.searchsorted(before,
+                                                                           sample.throats)]
+    t["conductance"] = time.perf_counter() - t0
+    t0 = time.perf_counter()
+    _, _, check = solve_fixed_pressure(sample.n_pores, sample.conns, g, sample.inlet,
+                                       sample.outlet, p_in=1.0, p_out=0.0)
+    k = darcy_permeability(check["q_in"], 1.0, sample.length_m, sample.area_m2,
+                           viscosity_pa_s=viscosity_pa_s)
+    t["stokes"] = time.perf_counter() - t0
+    t0 = time.perf_counter()
+    pts = solve_inertial(sample.n_pores, sample.conns, g, K, sample.inlet, sample.outlet,
+                         np.asarray(velocities_m_s, dtype=float) * sample.area_m2,
+                         crossover=crossover)
+    t["inertial"] = time.perf_counter() - t0
+    return k, sample.length_m, pts, t
+
+
+def _run(name, packing, region, diameter, solid_fraction, reynolds, *, axis, policy, db,
+         laws, crossover):
+    re = np.asarray(reynolds, dtype=float)
+    if re.ndim != 1 or not re.size or np.any(~np.isfinite(re)) or np.any(re <= 0):
+        raise ValueError(f"reynolds must be a non-empty list of values > 0, got {reynolds!r}")
+    t0 = time.perf_counter()
+    us = re / diameter                      # mu = rho = 1: Re = U d
+    k, length, pts, _ = solve_sample_curve(packing, region, us, axis=axis, policy=policy,
+                                           db=db, crossover=crossover)
+    grad = np.array([p.dp_pa for p in pts]) / length
+    k_ratio = grad * k / us                 # (dP/L) / (mu U / k)
+    law_ratio = {}
+    for law in laws:
+        if law == "hill_koch_ladd" and solid_fraction < 0.4:
+            continue
+        law_ratio[law] = np.asarray(drag_ratio(law, solid_fraction, re), dtype=float)
+    error = {law: k_ratio / r - 1.0 for law, r in law_ratio.items()}
+    return InertialCase(name, float(solid_fraction), re, k_ratio, law_ratio, error,
+                        np.array([p.iterations for p in pts]),
+                        bool(all(p.converged for p in pts)), float(k / diameter**2),
+                        time.perf_counter() - t0)
+
+
+def random_inertial_case(solid_fraction: float, reynolds, *, n_spheres: int = 800, rng=1,
+                         copies: int = 3, axis: int = 0, policy: str = "table-only",
+                         db=None, laws=tuple(DRAG_LAWS), crossover=None) -> InertialCase:
+    """Periodic random packing of unit spheres at ``solid_fraction`` (<= 0.64), copied
+    ``copies``³ times; sample = all but half a period at every face (module notes)."""
+    phi = float(solid_fraction)
+    if not 0.0 < phi <= 0.64:
+        raise ValueError(f"solid_fraction must lie in (0, 0.64], got {solid_fraction!r}")
+    base = random_packing(int(n_spheres), diameter_range_m=(1.0, 1.0), solid_fraction=phi,
+                          periodic=True, rng=rng)
+    side = (math.pi / 6.0 * int(n_spheres) / phi) ** (1.0 / 3.0)
+    packing = periodic_copies(base, side, int(copies))
+    region = Region(np.full(3, 0.5 * side), np.full(3, (copies - 0.5) * side))
+    return _run(f"random phi={phi:.3f} n={n_spheres} seed={rng}", packing, region, 1.0, phi,
+                reynolds, axis=axis, policy=policy, db=db, laws=laws,
+                crossover=crossover)
+
+
+def finney_inertial_case(reynolds, *, half_side: float = 8.0, axis: int = 0,
+                         policy: str = "table-only", db=None, path=FINNEY_PATH,
+                         laws=tuple(DRAG_LAWS), crossover=None) -> InertialCase:
+    """A cube of half-side ``half_side`` (sphere radii) at the centroid of Finney's packing;
+    the law is evaluated at the cube's solid fraction (sphere volume counted by quadrature
+    of 200 000 seeded points)."""
+    packing = read_packing(Path(path))
+    c = packing.centers.mean(axis=0)
+    h = float(half_side)
+    region = Region(c - h, c + h)
+    phi = _box_solid_fraction(packing, region)
+    return _run(f"finney cube {2 * h:g} r, phi={phi:.3f}", packing, region,
+                float(2 * packing.radii.mean()), phi, reynolds, axis=axis, policy=policy,
+                db=db, laws=laws, crossover=crossover)
+
+
+def _box_solid_fraction(packing: Packing, region: Region, n_points: int = 200_000) -> float:
+    from scipy.spatial import cKDTree
+    rng = np.random.default_rng(0)
+    pts = region.lo + rng.random((n_points, 3)) * (region.hi - region.lo)
+    d, i = cKDTree(packing.centers).query(pts)
+    return float(np.mean(d <= packing.radii[i]))
+
+
+def lattice_inertial_case(kind: str, solid_fraction: float, reynolds, *, n_cells: int = 7,
+                          axis: int = 0, policy: str = "table-only", db=None,
+                          offset: float = 0.137, crossover=None) -> InertialCase:
+    """Simple-cubic / BCC / FCC array, lattice constant 1, sample box as
+    :func:`lattice_sample_permeability`; ``law_ratio`` holds the random-packing laws for
+    information only (an ordered array is not a random bed)."""
+    c, r = lattice_packing(kind, solid_fraction, n_cells=n_cells, lattice_constant_m=1.0)
+    region = Region(np.full(3, 1.0 + offset), np.full(3, n_cells - 2 + offset))
+    return _run(f"{kind} phi={float(solid_fraction):.3f}", Packing(c, r), region,
+                float(2 * r[0]), float(solid_fraction), reynolds, axis=axis, policy=policy,
+                db=db, laws=("beetstra",), crossover=crossover)
