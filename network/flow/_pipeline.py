@@ -161,6 +161,7 @@ def solve_network(packing: Packing, *, axis="z", region: Region | None = None,
         sample = select_sample(tess, reg, axis=axis, groups=labels)
     with stage("conductance"):
         qstats: dict = {}
+        window_qstar = None                  # (Nt,) window Q* of the tessellation's throats
         if conductance is not None:
             g = np.asarray(conductance(tess, sample.throats), dtype=float)
         else:
@@ -169,6 +170,8 @@ def solve_network(packing: Packing, *, axis="z", region: Region | None = None,
                                       db=db, workers=workers, progress=progress,
                                       qstar_fn=qstar_fn, **model_opts)
             g, qstats = cres.g, cres.stats
+            window_qstar = np.full(tess.n_throats, np.nan)
+            window_qstar[sample.throats] = cres.qstar
     throats_before = sample.throats
     with stage("prune"):
         sample, g = prune_disconnected(sample, tess, g)
@@ -232,7 +235,8 @@ def solve_network(packing: Packing, *, axis="z", region: Region | None = None,
         timings_s=times, pressure_pa=p * scale, throat_flow_m3_s=check["throat_flow"] * scale,
         throat_conductance=g, pore_ids=sample.pores, throat_ids=sample.throats,
         conns=sample.conns, pore_xyz=sample.pore_xyz, pore_groups=sample.groups,
-        permeability_core_m2=k_core, core_margin_m=core_margin, inertial=inertial)
+        permeability_core_m2=k_core, core_margin_m=core_margin, inertial=inertial,
+        throat_qstar=None if window_qstar is None else window_qstar[sample.throats])
 
 
 #: Core margin of :func:`_core_estimate`, in mean sphere diameters.

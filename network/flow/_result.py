@@ -61,6 +61,9 @@ class FlowResult:
     #: or a core too small), m²; see :func:`network.flow.core_permeability`.
     permeability_core_m2: float | None = None
     core_margin_m: float | None = None
+    #: Window Q* of each sample throat (mean-radius units; NaN inside a merged pore body; None
+    #: with a custom conductance function), indexed like ``throat_ids``.
+    throat_qstar: np.ndarray | None = dataclasses.field(default=None, repr=False)
     #: Nonlinear (inertial) solves when asked (:func:`network.flow.solve_network` with
     #: ``inertia=True``): ``density_kg_m3``, ``velocities_m_s`` (the first is
     #: ``velocity_m_s``) and their :class:`network.flow.InertialPoint` ``points``.
