@@ -258,3 +258,20 @@ def test_core_permeability_of_a_lattice_does_not_drift_with_sample_size():
     pk = Packing(c, r)                     # core 3.1 diameters wide: too small to report
     res = run(pk, axis="z", region=default_region(pk, margin=0.6e-3), porosity=(0.5, 0.0))
     assert res.permeability_core_m2 is None and res.summary()["permeability_core_m2"] is None
+
+
+def test_bad_options_are_refused_before_the_tessellation(small_bed, monkeypatch):
+    """Options are checked at the door (issue 12): a bad policy, model or viscosity never
+    reaches the tessellation."""
+    import network.flow._pipeline as pipeline
+
+    def no_work(*a, **k):
+        raise AssertionError("tessellated before the options were checked")
+
+    monkeypatch.setattr(pipeline, "tessellate", no_work)
+    for kw, match in ((dict(policy="fast"), "unknown Q\\* policy 'fast'"),
+                      (dict(conductance_model="magic"), "unknown conductance model 'magic'"),
+                      (dict(viscosity_pa_s=-1.0), "viscosity_pa_s must be finite and > 0"),
+                      (dict(axis="w"), "axis must be one of")):
+        with pytest.raises(ValueError, match=match):
+            solve_network(small_bed, **kw)
