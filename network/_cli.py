@@ -131,14 +131,15 @@ def run(body, parser: argparse.ArgumentParser, argv=None) -> int:
 
 
 # ------------------------------------------------------------------ arguments
-def add_packing(ap, *, required: bool = False) -> None:
-    """The packing positional and ``--units``."""
-    ap.add_argument("packing", nargs=None if required else "?", default=None,
+def add_packing(ap, *, bundled: bool = True) -> None:
+    """The optional packing positional (``bundled``: the bundled scene when left out) and
+    ``--units``."""
+    ap.add_argument("packing", nargs="?", default=None,
                     help="sphere packing: delimited text x,y,z,r (comma, semicolon, spaces; "
                          "header optional; r, radius or diameter), .npz (centers, radii) or a "
-                         "LAMMPS/LIGGGHTS dump" + ("" if required else
-                                                   f"; default: the bundled scene "
-                                                   f"{default_packing_path().name}"))
+                         "LAMMPS/LIGGGHTS dump" + (f"; default: the bundled scene "
+                                                   f"{default_packing_path().name}"
+                                                   if bundled else ""))
     ap.add_argument("--units", default="m", type=str.lower, choices=list(UNITS),
                     help="length unit of the packing file (and of --sample, --margin, --entry); "
                          "a mean grain diameter outside 0.5-50 mm after conversion is warned "

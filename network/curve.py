@@ -8,8 +8,9 @@ Examples
 
 Per velocity: Re_p, the pressure gradient with inertia (:mod:`network.flow._inertial`) and
 the apparent permeability μU/(ΔP/L); fits over the run: Darcy-Forchheimer, ASABE D272 and
-Ergun refitted (:func:`network.flow.fit_curve`). Exit 0 done, 1 a velocity did not converge
-(its point is written with ``converged: false``), 2 bad input.
+Ergun refitted (:func:`network.flow.fit_curve`). The packing is read in ``--units`` (``--sample``,
+``--margin`` too). Exit 0 done, 1 a velocity did not converge (its point is written with
+``converged: false``), 2 bad input: one ``error:`` line (docs/cli.md).
 """
 
 from __future__ import annotations
@@ -24,11 +25,13 @@ from pathlib import Path
 
 import numpy as np
 
-from ._air import MU_AIR_PA_S, RHO_AIR_KG_M3, check_positive
+from ._air import check_positive
+from ._cli import (CliError, CliParser, add_air, add_packing, add_sample, bad_input, check_common,
+                   check_outputs, check_plot, computing, load_packing, run, sample_box_m)
 from .conductance import POLICIES
 from .flow import (ASABE_SOYBEAN_A, ASABE_SOYBEAN_B, DEFAULT_DEPTH_M, GRAINS,
                    asabe_d272_gradient, ergun_gradient, fit_curve, solve_network)
-from .packing import default_packing_path, read_container, read_packing
+from .packing import read_container
 from .pores import sample_region
 
 #: Default: 12 velocities spaced logarithmically over aeration and drying, m/s.
@@ -66,33 +69,38 @@ def parse_velocities(text: str) -> list[float]:
     return [round(v, 15) for v in vals]
 
 
-def build_parser() -> argparse.ArgumentParser:
-    ap = argparse.ArgumentParser(prog="python -m network.curve",
-                                 description="Pressure gradient against airflow with inertia "
-                                             "(per-conduit contraction/expansion losses).")
-    ap.add_argument("packing", nargs="?", default=None,
-                    help=f"CSV/.npz/dump (default: the bundled {default_packing_path().name})")
-    ap.add_argument("--axis", default="z", choices=["x", "y", "z"])
-    ap.add_argument("--sample", nargs=6, type=float,
-                    metavar=("XMIN", "XMAX", "YMIN", "YMAX", "ZMIN", "ZMAX"))
-    ap.add_argument("--margin", type=float, default=None)
-    ap.add_argument("--cylinder", action="store_true")
-    ap.add_argument("--viscosity", type=float, default=MU_AIR_PA_S,
-                    help=f"Pa s (default {MU_AIR_PA_S})")
-    ap.add_argument("--density", type=float, default=RHO_AIR_KG_M3,
-                    help=f"kg/m^3 (default {RHO_AIR_KG_M3})")
+def build_parser() -> CliParser:
+    ap = CliParser(prog="python -m network.curve",
+                   description="Pressure gradient against airflow with inertia (per-conduit "
+                               "contraction/expansion losses), with Darcy-Forchheimer, ASABE "
+                               "D272 and Ergun fits. Exit status 0 done, 1 a velocity did not "
+                               "converge or the solve failed, 2 bad input (docs/cli.md).")
+    add_packing(ap)
+    ap.add_argument("--axis", default="z", type=str.lower, choices=["x", "y", "z"],
+                    help="flow direction, any case")
+    add_sample(ap)
+    add_air(ap)
     ap.add_argument("--velocities", default=DEFAULT_VELOCITIES,
-                    help="a,b,c or start:stop:n (log-spaced), m/s (default 0.005:0.3:12)")
-    ap.add_argument("--depth", type=float, default=DEFAULT_DEPTH_M)
-    ap.add_argument("--grain", default="soybeans", help="D272 line to compare with "
-                    f"(known: {', '.join(D272)})")
-    ap.add_argument("--policy", default="table-only", choices=POLICIES)
-    ap.add_argument("--rtol", type=float, default=1e-3)
-    ap.add_argument("--db", default=None)
-    ap.add_argument("--json", dest="json_out", default=None)
-    ap.add_argument("--csv", dest="csv_out", default=None)
-    ap.add_argument("--plot", default=None, help="write the D272-style log-log plot (png)")
-    ap.add_argument("--quiet", "-q", action="store_true")
+                    help="superficial velocities, m/s, > 0: a,b,c or start:stop:n "
+                         "(n log-spaced points)")
+    ap.add_argument("--depth", type=float, default=DEFAULT_DEPTH_M,
+                    help="bed depth, m, > 0 (reported; the gradient does not depend on it)")
+    ap.add_argument("--grain", default="soybeans",
+                    help=f"D272 line to compare with (known: {', '.join(D272)})")
+    ap.add_argument("--policy", default="table-only", choices=POLICIES,
+                    help="Q* source (see python -m network.solve --help)")
+    ap.add_argument("--rtol", type=float, default=1e-3,
+                    help="Q* relative tolerance of table+fe and fe-only, > 0")
+    ap.add_argument("--db", default=None,
+                    help="throat table, SQLite (default: the cache's default database)")
+    ap.add_argument("--json", dest="json_out", default=None, metavar="OUT.json",
+                    help="write points, fits and timings here (default: not written)")
+    ap.add_argument("--csv", dest="csv_out", default=None, metavar="OUT.csv",
+                    help=f"write the points, columns {','.join(KEYS)} (default: not written)")
+    ap.add_argument("--plot", default=None, metavar="OUT.png",
+                    help="write the D272-style log-log plot (needs matplotlib: "
+                         "pip install '.[plot]'; default: not drawn)")
+    ap.add_argument("--quiet", "-q", action="store_true", help="no stage progress on stderr")
     return ap
 
 
@@ -126,66 +134,17 @@ def plot_curve(path, points, *, grain, porosity, diameter_m, viscosity_pa_s, den
 
 
 def _check_options(args) -> list[float]:
-    for name in ("viscosity", "density", "depth", "rtol"):
-        check_positive(f"--{name}", getattr(args, name))
+    check_common(args)
     if args.grain not in D272:
         raise ValueError(f"--grain {args.grain!r} unknown; known grains: {', '.join(GRAINS)}")
-    if args.margin is not None and not args.margin >= 0:
-        raise ValueError(f"--margin must be >= 0, got {args.margin!r}")
+    check_outputs(json=args.json_out, csv=args.csv_out, plot=args.plot)
+    if args.plot:
+        check_plot()
     return parse_velocities(args.velocities)
 
 
-def main(argv=None) -> int:
-    args = build_parser().parse_args(argv)
-    if not args.quiet:
-        logging.basicConfig(level=logging.INFO, format="[%(relativeCreated)7.0f ms] %(message)s",
-                            stream=sys.stderr)
-    t0 = time.perf_counter()
-    path = Path(args.packing) if args.packing else default_packing_path()
-    try:
-        us = _check_options(args)
-        packing = read_packing(path)
-        container = None if args.sample else read_container(path)
-        region = sample_region(packing, box=args.sample, margin=args.margin,
-                               cylinder=args.cylinder, container=container, axis=args.axis)
-    except (OSError, ValueError) as e:
-        print(f"error: {e}", file=sys.stderr)
-        return 2
-    try:
-        res = solve_network(packing, axis=args.axis, region=region, policy=args.policy,
-                            viscosity_pa_s=args.viscosity, velocity_m_s=us[0],
-                            depth_m=args.depth, rtol=args.rtol, db=args.db, inertia=True,
-                            density_kg_m3=args.density, curve_velocities_m_s=us[1:])
-    except (ValueError, RuntimeError, NotImplementedError) as e:
-        print(f"error: {e}", file=sys.stderr)
-        return 1
-    pts = [{k: p[k] for k in KEYS} | {"newton_iterations": p["newton_iterations"],
-                                      "cg_iterations": p["cg_iterations"]}
-           for p in res.curve_points()]
-    ok = [p for p in pts if p["converged"]]
-    fits = fit_curve([p["velocity_m_s"] for p in ok],
-                     [p["pressure_gradient_pa_per_m"] for p in ok],
-                     viscosity_pa_s=args.viscosity, density_kg_m3=args.density,
-                     porosity=res.porosity, diameter_m=res.sauter_diameter_m) if ok else {}
-    print(f"packing {path} ({packing.n} spheres), axis {args.axis}: k (Stokes) = "
-          f"{res.permeability_m2:.4e} m2, porosity {res.porosity:.4f}, d32 "
-          f"{res.sauter_diameter_m:.4g} m")
-    print(f"{'U m/s':>9} {'Re_p':>8} {'dP/L Pa/m':>11} {'k_app m2':>11} {'k/k_app':>8} "
-          f"{'Newton':>6} {'CG':>5}  converged")
-    for p in pts:
-        print(f"{p['velocity_m_s']:9.4g} {p['reynolds_particle']:8.3g} "
-              f"{p['pressure_gradient_pa_per_m']:11.5g} {p['apparent_permeability_m2']:11.4e} "
-              f"{res.permeability_m2 / p['apparent_permeability_m2']:8.4f} "
-              f"{p['newton_iterations']:6d} {p['cg_iterations']:5d}  {p['converged']}")
-    for k, v in fits.items():
-        print(f"  {k} = {v:.5g}" if isinstance(v, float) else f"  {k} = {v}")
-    total = time.perf_counter() - t0
-    print(f"total {total:.2f} s")
-    out = {"packing": str(path), "n_spheres": packing.n, "axis": args.axis, "grain": args.grain,
-           "density_kg_m3": args.density, "viscosity_pa_s": args.viscosity,
-           "porosity": res.porosity, "sauter_diameter_m": res.sauter_diameter_m,
-           "permeability_stokes_m2": res.permeability_m2, "points": pts} | fits | {
-           "seconds": dict(res.timings_s, wall=total)}
+def _write_outputs(args, out, pts, ok, res) -> None:
+    """--json, --csv and --plot (paths checked before the solve)."""
     if args.json_out:
         with open(args.json_out, "w") as f:
             json.dump(out, f, indent=2)
@@ -202,11 +161,63 @@ def main(argv=None) -> int:
                    diameter_m=res.sauter_diameter_m, viscosity_pa_s=args.viscosity,
                    density_kg_m3=args.density)
         print(f"wrote {args.plot}")
+
+
+def main(argv=None) -> int:
+    """Run the command; exit status 0 done, 1 the computation failed, 2 bad input."""
+    return run(_main, build_parser(), argv)
+
+
+def _main(args) -> int:
+    if not args.quiet:
+        logging.basicConfig(level=logging.INFO, format="[%(relativeCreated)7.0f ms] %(message)s",
+                            stream=sys.stderr)
+    t0 = time.perf_counter()
+    with bad_input():
+        us = _check_options(args)
+        path, packing = load_packing(args)
+        box, margin = sample_box_m(args)
+        container = None if box else read_container(path)
+        region = sample_region(packing, box=box, margin=margin, cylinder=args.cylinder,
+                               container=container, axis=args.axis)
+    with computing():
+        res = solve_network(packing, axis=args.axis, region=region, policy=args.policy,
+                            viscosity_pa_s=args.viscosity, velocity_m_s=us[0],
+                            depth_m=args.depth, rtol=args.rtol, db=args.db, inertia=True,
+                            density_kg_m3=args.density, curve_velocities_m_s=us[1:])
+        pts = [{k: p[k] for k in KEYS} | {"newton_iterations": p["newton_iterations"],
+                                          "cg_iterations": p["cg_iterations"]}
+               for p in res.curve_points()]
+        ok = [p for p in pts if p["converged"]]
+        fits = fit_curve([p["velocity_m_s"] for p in ok],
+                         [p["pressure_gradient_pa_per_m"] for p in ok],
+                         viscosity_pa_s=args.viscosity, density_kg_m3=args.density,
+                         porosity=res.porosity, diameter_m=res.sauter_diameter_m) if ok else {}
+    print(f"packing {path} ({packing.n} spheres), axis {args.axis}: k (Stokes) = "
+          f"{res.permeability_m2:.4e} m2, porosity {res.porosity:.4f}, d32 "
+          f"{res.sauter_diameter_m:.4g} m")
+    print(f"{'U m/s':>9} {'Re_p':>8} {'dP/L Pa/m':>11} {'k_app m2':>11} {'k/k_app':>8} "
+          f"{'Newton':>6} {'CG':>5}  converged")
+    for p in pts:
+        print(f"{p['velocity_m_s']:9.4g} {p['reynolds_particle']:8.3g} "
+              f"{p['pressure_gradient_pa_per_m']:11.5g} {p['apparent_permeability_m2']:11.4e} "
+              f"{res.permeability_m2 / p['apparent_permeability_m2']:8.4f} "
+              f"{p['newton_iterations']:6d} {p['cg_iterations']:5d}  {p['converged']}")
+    for k, v in fits.items():
+        print(f"  {k} = {v:.5g}" if isinstance(v, float) else f"  {k} = {v}")
+    total = time.perf_counter() - t0
+    print(f"total {total:.2f} s")
+    out = {"packing": str(path), "units": args.units, "n_spheres": packing.n, "axis": args.axis, "grain": args.grain,
+           "density_kg_m3": args.density, "viscosity_pa_s": args.viscosity,
+           "porosity": res.porosity, "sauter_diameter_m": res.sauter_diameter_m,
+           "permeability_stokes_m2": res.permeability_m2, "points": pts} | fits | {
+           "seconds": dict(res.timings_s, wall=total)}
+    with computing():
+        _write_outputs(args, out, pts, ok, res)
     bad = [p["velocity_m_s"] for p in pts if not p["converged"]]
     if bad:
-        print(f"error: the nonlinear solve did not converge at U = {bad} m/s "
-              "(marked converged: false)", file=sys.stderr)
-        return 1
+        raise CliError(f"the nonlinear solve did not converge at U = {bad} m/s (marked "
+                       "converged: false)", 1)
     return 0
 
 

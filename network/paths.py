@@ -4,8 +4,8 @@ Usage::
 
     python -m network.paths PACKING [--entry X Y | --entries N] [--kind widest|narrowest|
         maximin|shortest|all] [--axis z] [--method build|delaunay] [--seed S]
-        [--velocity U ...] [--branches path|all] [--pressure [--policy P]]
-        [--json OUT.json] [--plot OUT.png] [--standin LX LY LZ]
+        [--velocity U ...] [--depth D] [--branches path|all] [--pressure [--policy P]]
+        [--units m|cm|mm] [--json OUT.json] [--plot OUT.png] [--standin LX LY LZ]
 
 ``widest``/``narrowest`` are the thesis's step-increment paths (``--method build``: tetrahedra
 built sphere by sphere as in Appendices D-E; ``--method delaunay``: the same rule walked on the
@@ -16,15 +16,19 @@ random (``--seed``) away from the walls. The branched-path model (Table 4.4 layo
 Table 4.5 comparison with ASABE D272 and Ergun) is evaluated on every widest/narrowest path at
 each ``--velocity``; ``--pressure`` solves the network model (``network.flow.solve_network``)
 and prints the pressure drop along every path that lies on the tessellation (thesis 4.2.3).
-Timings, load average and platform go into the JSON. ``--standin LX LY LZ`` replaces PACKING
-by a geometric stand-in from ``network.packing.random_packing`` (no gravity) at porosity 0.408.
-A bad input (no packing, an unreadable file, a bad option value) exits with status 2 and one
-line on stderr.
+Conventions (:data:`CONVENTIONS`): T is Eq. 3.27's smoothed length over L0, the bed depth for
+built paths and the path's own axial span for paths on the tessellation (they start and end
+inside the bed); pressure drops beside ASABE D272 and Ergun are over ``--depth`` (0.25 m, as
+``network.solve``), the thesis's 2.44 Pa only beside them at 0.25 m; a path traced twice
+counts once. Timings, load average and platform go into the JSON. ``--standin LX LY LZ``
+replaces PACKING by a stand-in from ``network.packing.random_packing`` at porosity 0.408.
+Exit 0 done, 1 failed, 2 bad input (an entry outside the bed, ``--entries 0``, ...): one
+``error:`` line on stderr (docs/cli.md).
 """
 
 from __future__ import annotations
 
-import argparse
+import dataclasses
 import json
 import os
 import platform
@@ -33,14 +37,17 @@ import time
 
 import numpy as np
 
+from ._cli import (CliError, CliParser, add_air, add_packing, bad_input, check_outputs,
+                   check_plot, computing, load_packing, run)
+from ._air import check_positive
 from .airpaths import (bed_depth, branched_table, face_graph, plot_paths, pore_pressure_array,
                        pressure_along_path, random_entry_points, trace_paths)
-from .flow import asabe_d272_gradient, ergun_gradient, solve_network
-from .packing import Packing, random_packing, read_packing
-from .pores import Region, tessellate, tie_groups
+from .flow import DEFAULT_DEPTH_M, asabe_d272_gradient, ergun_gradient, solve_network
+from .packing import UNITS, Packing, random_packing
+from .pores import Region, axis_index, tessellate, tie_groups
 
 _ALL = ("widest", "narrowest", "maximin", "shortest")
-#: Thesis values (Tables 4.1-4.5) printed beside ours.
+#: Thesis values (Tables 4.1-4.5) printed beside ours (pressures: over 0.25 m of soybeans).
 THESIS = {
     "tortuosity": {"widest": 1.39, "narrowest": 1.40},
     "mean_width_mm": {"widest": (2.73, 2.91), "narrowest": (1.85, 2.00)},
@@ -48,25 +55,51 @@ THESIS = {
     "branched_mfx3_average_pa": {"0.013": 2.74, "0.027": 5.65},
     "measured_pa": {"0.013": 2.44, "0.027": 6.80},
 }
+#: Bed depth of the thesis's measured and modelled pressure drops (Table 4.5), m.
+THESIS_DEPTH_M = 0.25
+CONVENTIONS = {
+    "tortuosity": "Eq. 3.27 smoothed length over L0, the straight length along the flow axis "
+                  "(thesis 3.4.2): the bed depth (centre span + mean diameter, Appendix D) for "
+                  "built paths, which run floor to top; the path's own axial span for paths on "
+                  "the tessellation, which start and end inside the bed",
+    "depth": "pressure drops in the Table 4.5 layout are over --depth (default 0.25 m, as "
+             "network.solve): ASABE D272 and Ergun as gradient x depth, the branched model as "
+             "its drop along each path / the path's L0 x depth; the thesis's values are printed "
+             "beside them only at 0.25 m and its velocities",
+    "duplicates": "a path traced again from another entry (same kind, same tetrahedra) is "
+                  "listed but counted once in the means and the branched model",
+}
 
 
 def _parser():
-    p = argparse.ArgumentParser(prog="python -m network.paths", description=__doc__.split("\n")[0])
-    p.add_argument("packing", nargs="?", help="CSV x,y,z,r (m), .npz or LAMMPS dump")
+    p = CliParser(prog="python -m network.paths",
+                  description=__doc__.split("\n")[0] + " Exit status 0 done, 1 failed, 2 bad "
+                  "input (docs/cli.md).")
+    add_packing(p, bundled=False)
     g = p.add_mutually_exclusive_group()
     g.add_argument("--entry", nargs=2, type=float, action="append", metavar=("X", "Y"),
-                   help="entry point (m); repeat for several")
+                   help="entry point in the packing's unit (--units), the two axes normal to "
+                        "--axis in x, y, z order; must lie inside the bed; repeat for several")
     g.add_argument("--entries", type=int, default=None, metavar="N",
-                   help="N random entry points (default 3)")
-    p.add_argument("--kind", default="all", choices=_ALL + ("all",))
-    p.add_argument("--axis", default="z", choices=("x", "y", "z"))
+                   help="N >= 1 random entry points away from the walls (--seed; default 3)")
+    p.add_argument("--kind", default="all", choices=_ALL + ("all",),
+                   help="widest/narrowest: step-increment paths; maximin: optimal widest; "
+                        "shortest: shortest on the tessellation; all: the four")
+    p.add_argument("--axis", default="z", type=str.lower, choices=("x", "y", "z"),
+                   help="flow direction, any case")
     p.add_argument("--method", default="build", choices=("build", "delaunay"),
-                   help="how widest/narrowest paths are made (default build, as the thesis)")
-    p.add_argument("--seed", type=int, default=0)
+                   help="how widest/narrowest paths are made: build (the thesis's "
+                        "construction) or delaunay (the same rule on the tessellation)")
+    p.add_argument("--seed", type=int, default=0,
+                   help="seed of the random entry points and of --standin")
     p.add_argument("--velocity", type=float, nargs="+", default=[0.013, 0.027],
-                   help="superficial velocities for the branched model (m/s)")
+                   help="superficial velocities for the branched model, m/s, > 0")
+    p.add_argument("--depth", type=float, default=DEFAULT_DEPTH_M,
+                   help="bed depth of the Table 4.5 comparison (branched model, ASABE D272, "
+                        "Ergun) and of --pressure, m, > 0; as network.solve")
+    add_air(p, density=False)
     p.add_argument("--branches", default="path", choices=("all", "path"),
-                   help="daughter losses counted: the path's (Eq. 3.28, default) or all three "
+                   help="daughter losses counted: the path's (Eq. 3.28) or all three "
                         "(Appendix F)")
     p.add_argument("--no-branched", action="store_true", help="skip the branched model")
     p.add_argument("--pressure", action="store_true",
@@ -74,9 +107,12 @@ def _parser():
                         "the paths on the tessellation (thesis 4.2.3) at the first --velocity")
     p.add_argument("--policy", default="shape-factor",
                    choices=("shape-factor", "table-only", "table+fe", "fe-only"),
-                   help="Q* source of the network model for --pressure (default shape-factor)")
-    p.add_argument("--json", metavar="OUT.json")
-    p.add_argument("--plot", metavar="OUT.png")
+                   help="Q* source of the network model for --pressure")
+    p.add_argument("--json", metavar="OUT.json", help="write every number here (default: not "
+                                                      "written)")
+    p.add_argument("--plot", metavar="OUT.png",
+                   help="draw the paths (needs matplotlib: pip install '.[plot]'; default: "
+                        "not drawn)")
     p.add_argument("--standin", nargs=3, type=float, metavar=("LX", "LY", "LZ"),
                    help="instead of PACKING, a geometric stand-in packing in this box (m): "
                         "diameters 5.5-7.5 mm, porosity 0.408, by network.packing.random_packing "
@@ -110,63 +146,121 @@ def standin_packing(box_m, *, rng=None):
 
 
 def main(argv=None) -> int:
-    args = _parser().parse_args(argv)
-    t0 = time.perf_counter()
-    try:
-        if args.standin:
-            x, r = standin_packing(args.standin, rng=args.seed)
-            source = f"stand-in {args.standin} seed {args.seed}"
-        elif args.packing:
-            pk = read_packing(args.packing)
-            x, r = np.asarray(pk.centers), np.asarray(pk.radii)
-            source = str(args.packing)
-        else:
-            raise ValueError("give PACKING or --standin LX LY LZ")
-        if any(u <= 0 for u in args.velocity):
-            raise ValueError(f"--velocity must be > 0 m/s, got {args.velocity}")
-        t_read = time.perf_counter() - t0
-        if args.entry:
-            xy = np.array(args.entry, dtype=float)
-        else:
-            xy = random_entry_points(x, r, 3 if args.entries is None else args.entries,
-                                     axis=args.axis, rng=args.seed)
-    except (OSError, ValueError) as e:
-        print(f"error: {e}", file=sys.stderr)
-        return 2
-    kinds = _ALL if args.kind == "all" else (args.kind,)
-    need_graph = any(k in ("maximin", "shortest") for k in kinds) or args.method == "delaunay"
-    graph = tess = None
-    t1 = time.perf_counter()
-    if need_graph or args.pressure:
-        tess = tessellate(Packing(x, r, source))
-        graph = face_graph(tess)
-    t_graph = time.perf_counter() - t1
-    paths, t_kind = [], {}
-    for kind in kinds:
-        tk = time.perf_counter()
-        paths += trace_paths(x, r, xy, kind=kind, method=args.method, graph=graph,
-                             axis=args.axis)
-        t_kind[kind] = time.perf_counter() - tk
-    depth = bed_depth(x, r, args.axis)
+    """Run the command; exit status 0 done, 1 the computation failed, 2 bad input."""
+    return run(_main, _parser(), argv)
 
-    print(f"{source}: {len(r)} spheres, depth {depth:.4f} m along {args.axis}, "
+
+def _check_options(args) -> None:
+    """Options and output paths, before the packing is read (ValueError names the option)."""
+    if args.entries is not None and args.entries < 1:
+        raise ValueError(f"--entries n must be >= 1 (number of entry points), got "
+                         f"{args.entries}")
+    if any(not u > 0 for u in args.velocity):
+        raise ValueError(f"--velocity must be > 0 m/s, got {args.velocity}")
+    check_positive("--depth", args.depth)
+    check_positive("--viscosity", args.viscosity)
+    check_outputs(json=args.json, plot=args.plot)
+    if args.plot:
+        check_plot()
+
+
+def _read(args):
+    """(centres (N, 3) m, radii (N,) m, source) of --standin or PACKING."""
+    if args.standin:
+        x, r = standin_packing(args.standin, rng=args.seed)
+        return x, r, f"stand-in {args.standin} seed {args.seed}"
+    if not args.packing:
+        raise ValueError("give PACKING or --standin LX LY LZ")
+    _, pk = load_packing(args)
+    return np.asarray(pk.centers), np.asarray(pk.radii), str(args.packing)
+
+
+def _entries(args, x, r):
+    """(n, 2) entry points, m: --entry (checked inside the bed) or --entries at random."""
+    if not args.entry:
+        return random_entry_points(x, r, 3 if args.entries is None else args.entries,
+                                   axis=args.axis, rng=args.seed)
+    scale = UNITS[args.units]
+    xy = np.array(args.entry, dtype=float) * scale
+    plane = [k for k in range(3) if k != axis_index(args.axis)]
+    lo, hi = (x - r[:, None]).min(axis=0)[plane], (x + r[:, None]).max(axis=0)[plane]
+    for e, pt in zip(args.entry, xy):
+        if not (np.all(np.isfinite(pt)) and np.all(pt >= lo) and np.all(pt <= hi)):
+            names = ["xyz"[k] for k in plane]
+            raise ValueError(f"--entry {e[0]:g} {e[1]:g} lies outside the bed, which spans "
+                             + ", ".join(f"{n} {a / scale:.6g}..{b / scale:.6g}"
+                                         for n, a, b in zip(names, lo, hi))
+                             + f" ({args.units}): give a point inside it")
+    return xy
+
+
+def _own_span(p):
+    """A path on the tessellation measured over its own axial span (it starts and ends
+    inside the bed); built paths keep the bed depth (thesis 3.4.2)."""
+    if p.method == "build" or p.points.shape[0] < 2:
+        return p
+    span = float(np.ptp(p.points[:, axis_index(p.axis)]))
+    return dataclasses.replace(p, depth_m=span) if span > 0 else p
+
+
+def _duplicates(paths):
+    """(n,) index of the first identical path (same kind and tetrahedra), -1 if none."""
+    first, out = {}, []
+    for i, p in enumerate(paths):
+        key = (p.kind, p.status, p.tetra_vertices.tobytes())
+        out.append(first.setdefault(key, i) if key in first else -1)
+        first.setdefault(key, i)
+    return np.array(out, dtype=int)
+
+
+def _main(args) -> int:
+    t0 = time.perf_counter()
+    with bad_input():
+        _check_options(args)
+        x, r, source = _read(args)
+        t_read = time.perf_counter() - t0
+        xy = _entries(args, x, r)
+        kinds = _ALL if args.kind == "all" else (args.kind,)
+        need_graph = any(k in ("maximin", "shortest") for k in kinds) or args.method == "delaunay"
+        graph = tess = None
+        t1 = time.perf_counter()
+        if need_graph or args.pressure:
+            tess = tessellate(Packing(x, r, source))
+            graph = face_graph(tess)
+        t_graph = time.perf_counter() - t1
+    paths, t_kind = [], {}
+    with computing():
+        for kind in kinds:
+            tk = time.perf_counter()
+            paths += [_own_span(p) for p in trace_paths(x, r, xy, kind=kind, method=args.method,
+                                                         graph=graph, axis=args.axis)]
+            t_kind[kind] = time.perf_counter() - tk
+    depth = bed_depth(x, r, args.axis)
+    dup = _duplicates(paths)
+    distinct = [p for p, d in zip(paths, dup) if d < 0]
+
+    print(f"{source}: {len(r)} spheres, bed depth {depth:.4f} m along {args.axis}, "
           f"{len(xy)} entries; read {t_read:.2f} s, tessellation+open areas {t_graph:.2f} s, "
           + ", ".join(f"{k} {v:.2f} s" for k, v in t_kind.items()))
+    print(f"tortuosity T: {CONVENTIONS['tortuosity']}")
     print(f"{'kind':10s} {'entry (m)':>18s} {'status':>9s} {'tetra':>6s} {'L (m)':>7s} "
-          f"{'T raw':>6s} {'T':>6s} {'T span':>6s} {'W (mm)':>7s} {'<30deg':>7s}")
-    for p in paths:
+          f"{'L0 (m)':>7s} {'T raw':>6s} {'T':>6s} {'T span':>6s} {'W (mm)':>7s} "
+          f"{'<30deg':>7s}")
+    for i, p in enumerate(paths):
         s = p.summary()
         print(f"{p.kind:10s} ({p.entry_xy[0]:7.4f},{p.entry_xy[1]:7.4f}) {p.status:>9s} "
-              f"{p.n_tetrahedra:6d} {p.length_m:7.3f} {p.tortuosity_raw:6.3f} {p.tortuosity:6.3f} "
-              f"{p.tortuosity_span:6.3f} "
-              f"{p.mean_width_m * 1e3:7.2f} {s['turning_below_30deg']:7.2f}")
+              f"{p.n_tetrahedra:6d} {p.length_m:7.3f} {p.depth_m:7.4f} {p.tortuosity_raw:6.3f} "
+              f"{p.tortuosity:6.3f} {p.tortuosity_span:6.3f} "
+              f"{p.mean_width_m * 1e3:7.2f} {s['turning_below_30deg']:7.2f}"
+              + (f"  same as path {dup[i]}" if dup[i] >= 0 else ""))
     for kind in kinds:
-        ok = [p for p in paths if p.kind == kind and p.status == "ok"]
+        ok = [p for p in distinct if p.kind == kind and p.status == "ok"]
         if not ok:
             continue
         ref = THESIS["tortuosity"].get(kind)
         refw = THESIS["mean_width_mm"].get(kind)
-        print(f"mean {kind}: tetrahedra {np.mean([p.n_tetrahedra for p in ok]):.0f}, "
+        print(f"mean {kind} ({len(ok)} distinct paths): tetrahedra "
+              f"{np.mean([p.n_tetrahedra for p in ok]):.0f}, "
               f"tortuosity {np.mean([p.tortuosity for p in ok]):.3f}"
               + (f" (thesis {ref})" if ref else "")
               + f", width {np.mean([p.mean_width_m for p in ok]) * 1e3:.2f} mm"
@@ -177,74 +271,98 @@ def main(argv=None) -> int:
 
     branched, table45 = [], {}
     if not args.no_branched:
-        t2 = time.perf_counter()
-        for i, p in enumerate(paths):
-            if p.kind in ("widest", "narrowest") and p.status == "ok":
-                tab = branched_table(x, r, p, velocities_m_s=args.velocity,
-                                     branches=args.branches)
-                branched.append({"path": i, "kind": p.kind, "entry_xy_m": p.entry_xy.tolist(),
-                                 **tab})
-        if branched:
-            print(f"branched model (Pa; branches={args.branches}, Q0 = U x mean face area; "
-                  f"{time.perf_counter() - t2:.2f} s)")
-            us = [f"{u:g}" for u in args.velocity]
-            print(f"{'kind':10s} {'LFPW':8s} " + " ".join(f"MFx3@{u:<7s}" for u in us) + " "
-                  + " ".join(f"MFx2@{u:<7s}" for u in us))
-            for b in branched:
-                for w in ("max", "min", "average"):
-                    print(f"{b['kind']:10s} {w:8s} "
-                          + " ".join(f"{b[w]['MFx3'][u]:12.3g}" for u in us) + " "
-                          + " ".join(f"{b[w]['MFx2'][u]:12.3g}" for u in us))
-            for u in us:
-                avg = np.mean([b["average"]["MFx3"][u] for b in branched])
-                ref = THESIS["branched_mfx3_average_pa"].get(u)
-                meas = THESIS["measured_pa"].get(u)
-                print(f"mean MFx3 average-width at {u} m/s: {avg:.3g} Pa"
-                      + (f" (thesis {ref} Pa, measured {meas} Pa)" if ref else ""))
-            table45 = _table_4_5(x, r, depth, args.velocity, branched)
-            print("Table 4.5 layout (Pa over the bed depth): "
-                  + "; ".join(f"{k} " + " ".join(f"{v:.3g}" for v in vals.values())
-                              for k, vals in table45.items()))
+        with computing():
+            branched, table45 = _branched(args, x, r, paths, dup)
 
     along = []
     if args.pressure:
-        along = _pressure_along(args, x, r, source, tess, graph, paths)
+        with computing():
+            along = _pressure_along(args, x, r, source, tess, graph, paths)
 
-    if args.json:
-        out = {
-            "source": source, "n_spheres": int(len(r)), "axis": args.axis, "depth_m": depth,
-            "method": args.method, "entries_xy_m": xy.tolist(),
-            "seconds": {"read": t_read, "tessellation": t_graph, **t_kind},
-            "paths": [{**p.summary(), "points_m": p.points.tolist(),
-                       "widths_m": p.widths_m.tolist(),
-                       "turning_angles_deg": p.turning_angles_deg.tolist()} for p in paths],
-            "branched": branched, "table_4_5_pa": table45, "pressure_along_paths": along, "thesis": THESIS,
-            "platform": platform.platform(), "cpu_count": os.cpu_count(),
-            "loadavg": os.getloadavg(), "timestamp": time.strftime("%Y-%m-%dT%H:%M:%SZ",
-                                                                   time.gmtime()),
-        }
-        with open(args.json, "w") as f:
-            json.dump(out, f, indent=1)
-    if args.plot:
-        plot_paths(x, paths, args.plot, axis=args.axis, title=source)
+    with computing():
+        if args.json:
+            out = {
+                "source": source, "units": args.units, "n_spheres": int(len(r)),
+                "axis": args.axis, "depth_m": depth, "comparison_depth_m": args.depth,
+                "conventions": CONVENTIONS, "method": args.method, "entries_xy_m": xy.tolist(),
+                "seconds": {"read": t_read, "tessellation": t_graph, **t_kind},
+                "paths": [{**p.summary(), "duplicate_of": int(d) if d >= 0 else None,
+                           "points_m": p.points.tolist(), "widths_m": p.widths_m.tolist(),
+                           "turning_angles_deg": p.turning_angles_deg.tolist()}
+                          for p, d in zip(paths, dup)],
+                "branched": branched, "table_4_5_pa": table45,
+                "pressure_along_paths": along, "thesis": THESIS,
+                "platform": platform.platform(), "cpu_count": os.cpu_count(),
+                "loadavg": os.getloadavg(), "timestamp": time.strftime("%Y-%m-%dT%H:%M:%SZ",
+                                                                       time.gmtime()),
+            }
+            with open(args.json, "w") as f:
+                json.dump(out, f, indent=1)
+        if args.plot:
+            plot_paths(x, paths, args.plot, axis=args.axis, title=source)
     return 0
 
 
-def _table_4_5(x, r, depth, velocities, branched):
-    """Pressure drops over the bed depth (Pa): measured (thesis), branched model (ours, mean of
-    the MFx3 average-width paths), ASABE D272 and Ergun at the bed's porosity (thesis 4.2.2)."""
+def _thesis_point(args, u: str) -> bool:
+    """Whether the thesis's 0.25 m pressures apply at velocity ``u`` and --depth."""
+    return np.isclose(args.depth, THESIS_DEPTH_M) and u in THESIS["measured_pa"]
+
+
+def _branched(args, x, r, paths, dup):
+    """The branched model on every distinct ok widest/narrowest path: Table 4.4 (Pa along the
+    path) and the Table 4.5 layout (Pa over --depth)."""
+    t2 = time.perf_counter()
+    branched = []
+    for i, p in enumerate(paths):
+        if p.kind in ("widest", "narrowest") and p.status == "ok" and dup[i] < 0:
+            tab = branched_table(x, r, p, velocities_m_s=args.velocity, branches=args.branches,
+                                 mu_pa_s=args.viscosity)
+            branched.append({"path": i, "kind": p.kind, "entry_xy_m": p.entry_xy.tolist(),
+                             "path_depth_m": p.depth_m, **tab})
+    if not branched:
+        return [], {}
+    print(f"branched model (Pa along each path; branches={args.branches}, Q0 = U x mean face "
+          f"area; {time.perf_counter() - t2:.2f} s)")
+    us = [f"{u:g}" for u in args.velocity]
+    print(f"{'kind':10s} {'LFPW':8s} " + " ".join(f"MFx3@{u:<7s}" for u in us) + " "
+          + " ".join(f"MFx2@{u:<7s}" for u in us))
+    for b in branched:
+        for w in ("max", "min", "average"):
+            print(f"{b['kind']:10s} {w:8s} "
+                  + " ".join(f"{b[w]['MFx3'][u]:12.3g}" for u in us) + " "
+                  + " ".join(f"{b[w]['MFx2'][u]:12.3g}" for u in us))
+    table45 = _table_4_5(args, x, r, branched)
+    for u in us:
+        along = np.mean([b["average"]["MFx3"][u] for b in branched])
+        print(f"mean MFx3 average-width at {u} m/s: {along:.3g} Pa along the paths, "
+              f"{table45['branched model'][u]:.3g} Pa over {args.depth:g} m"
+              + (f" (thesis {THESIS['branched_mfx3_average_pa'][u]} Pa, measured "
+                 f"{THESIS['measured_pa'][u]} Pa)" if _thesis_point(args, u) else ""))
+    print(f"Table 4.5 layout (Pa over {args.depth:g} m): "
+          + "; ".join(f"{k} " + " ".join(f"{v:.3g}" for v in vals.values())
+                      for k, vals in table45.items()))
+    return branched, table45
+
+
+def _table_4_5(args, x, r, branched):
+    """Pressure drops over --depth (Pa): measured (thesis, only at its 0.25 m), branched model
+    (ours, mean of the MFx3 average-width paths, each drop / its L0 x depth), ASABE D272 and
+    Ergun at the bed's porosity (thesis 4.2.2)."""
+    depth, velocities = args.depth, args.velocity
     lo, hi = (x - r[:, None]).min(axis=0), (x + r[:, None]).max(axis=0)
     porosity = 1.0 - float(np.sum(4.0 / 3.0 * np.pi * r**3) / np.prod(hi - lo))
     us = [f"{u:g}" for u in velocities]
-    return {
-        "measured (thesis)": {u: THESIS["measured_pa"].get(u, float("nan")) for u in us},
-        "branched model": {u: float(np.mean([b["average"]["MFx3"][u] for b in branched]))
-                           for u in us},
-        "ASABE D272": {f"{u:g}": float(asabe_d272_gradient(u) * depth) for u in velocities},
-        f"Ergun (porosity {porosity:.3f})": {
-            f"{u:g}": float(ergun_gradient(u, porosity=porosity, diameter_m=2 * r.mean()) * depth)
-            for u in velocities},
-    }
+    out = {}
+    if any(_thesis_point(args, u) for u in us):
+        out["measured (thesis)"] = {u: THESIS["measured_pa"].get(u, float("nan")) for u in us}
+    out["branched model"] = {u: float(np.mean([b["average"]["MFx3"][u] / b["path_depth_m"]
+                                               for b in branched]) * depth) for u in us}
+    out["ASABE D272"] = {f"{u:g}": float(asabe_d272_gradient(u) * depth) for u in velocities}
+    out[f"Ergun (porosity {porosity:.3f})"] = {
+        f"{u:g}": float(ergun_gradient(u, porosity=porosity, diameter_m=2 * r.mean(),
+                                       viscosity_pa_s=args.viscosity) * depth)
+        for u in velocities}
+    return out
 
 
 def _pressure_along(args, x, r, source, tess, graph, paths):
@@ -260,6 +378,7 @@ def _pressure_along(args, x, r, source, tess, graph, paths):
     m[ax] = 4.0 * d
     res = solve_network(Packing(x, r, source), axis=args.axis, tessellation=tess,
                         policy=args.policy, velocity_m_s=args.velocity[0], porosity_points=0,
+                        depth_m=args.depth, viscosity_pa_s=args.viscosity,
                         region=Region(lo + m, hi - m))
     labels, n_groups = tie_groups(tess)
     p_all = pore_pressure_array(tess.n_pores, res.pore_ids, res.pressure_pa,

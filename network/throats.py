@@ -9,68 +9,74 @@ Examples
 --------
     python -m network.throats bed.csv --out throats.csv
     python -m network.throats --out default_throats.csv          # the bundled scene
+    python -m network.throats bed_mm.csv --units mm --out throats.csv
+
+The packing is read in ``--units`` (``--sample``, ``--margin`` too); the CSV is in metres. Exit 0
+done, 1 failed, 2 bad input: one ``error:`` line (docs/cli.md).
 """
 
 from __future__ import annotations
 
-import argparse
 import logging
 import sys
 import time
-from pathlib import Path
 
 import numpy as np
 
-from .packing import default_packing_path, read_packing
+from ._cli import (CliParser, add_packing, add_sample, bad_input, check_common, check_outputs,
+                   computing, load_packing, run, sample_box_m)
 from .pores import sample_region, select_sample, tessellate, tie_groups
 
+HEADER = "r1,r2,r3,l12,l13,l23,throat,pore1,pore2"
 
-def build_parser() -> argparse.ArgumentParser:
-    ap = argparse.ArgumentParser(
+
+def build_parser() -> CliParser:
+    ap = CliParser(
         prog="python -m network.throats",
-        description="Export the distinct throats (r1,r2,r3,l12,l13,l23 + ids) of a packing's "
-                    "flow sample: the input of cache.precompute.")
-    ap.add_argument("packing", nargs="?", default=None,
-                    help="CSV x,y,z,r / .npz / LIGGGHTS dump (default: the bundled scene)")
-    ap.add_argument("--out", required=True, help="output CSV")
-    ap.add_argument("--sample", nargs=6, type=float,
-                    metavar=("XMIN", "XMAX", "YMIN", "YMAX", "ZMIN", "ZMAX"),
-                    help="sample box (packing units); default: the interior box")
-    ap.add_argument("--margin", type=float, default=None,
-                    help="wall margin of the default box (default 1.5 mean diameters)")
+        description="Export the distinct throats (r1,r2,r3,l12,l13,l23 in m + ids) of a "
+                    "packing's flow sample: the input of cache.precompute. Exit status 0 done, "
+                    "1 failed, 2 bad input (docs/cli.md).")
+    add_packing(ap)
+    ap.add_argument("--out", required=True, metavar="OUT.csv",
+                    help=f"output CSV, columns {HEADER} (lengths in m; required)")
+    add_sample(ap, cylinder=False)
     ap.add_argument("--all", dest="everything", action="store_true",
                     help="every interior face of the whole tessellation, not only the sample")
-    ap.add_argument("--quiet", "-q", action="store_true")
+    ap.add_argument("--quiet", "-q", action="store_true", help="no progress on stderr")
     return ap
 
 
 def main(argv=None) -> int:
-    args = build_parser().parse_args(argv)
+    """Run the command; exit status 0 done, 1 the computation failed, 2 bad input."""
+    return run(_main, build_parser(), argv)
+
+
+def _main(args) -> int:
     if not args.quiet:
         logging.basicConfig(level=logging.INFO, format="%(message)s", stream=sys.stderr)
     t0 = time.perf_counter()
-    path = Path(args.packing) if args.packing else default_packing_path()
-    try:
-        packing = read_packing(path)
+    with bad_input():
+        check_common(args)
+        check_outputs(out=args.out)
+        path, packing = load_packing(args)
+        box, margin = sample_box_m(args)
+        region = None if args.everything else sample_region(packing, box=box, margin=margin)
+    with computing():
         tess = tessellate(packing)
         if args.everything:
             idx = tess.interior_throats
         else:
-            region = sample_region(packing, box=args.sample, margin=args.margin)
             labels, n_groups = tie_groups(tess)
             sample = select_sample(tess, region, axis="z",
                                    groups=None if n_groups == tess.n_pores else labels)
             idx = sample.throats
-    except (OSError, ValueError) as e:
-        print(f"error: {e}", file=sys.stderr)
-        return 2
-    data = np.column_stack([tess.throat_radii[idx], tess.throat_sides[idx], idx,
-                            tess.throat_pores[idx]])
-    fmt = ["%.9g"] * 6 + ["%d"] * 3
-    np.savetxt(args.out, data, delimiter=",", fmt=fmt, comments="",
-               header="r1,r2,r3,l12,l13,l23,throat,pore1,pore2")
+        data = np.column_stack([tess.throat_radii[idx], tess.throat_sides[idx], idx,
+                                tess.throat_pores[idx]])
+        np.savetxt(args.out, data, delimiter=",", fmt=["%.9g"] * 6 + ["%d"] * 3, comments="",
+                   header=HEADER)
     print(f"wrote {args.out}: {idx.size} throats of {tess.n_throats} "
-          f"({packing.n} spheres, {path}) in {time.perf_counter() - t0:.2f} s")
+          f"({packing.n} spheres, {path}, read in {args.units}) in "
+          f"{time.perf_counter() - t0:.2f} s")
     return 0
 
 
