@@ -97,6 +97,9 @@ class AMGSolver:
             self._ml = pyamg.smoothed_aggregation_solver(
                 self._As, B=self._B, symmetry="symmetric", strength=strength, max_coarse=500,
                 coarse_solver="splu")
+        for level in self._ml.levels:       # pyamg's 1x1 BSR smoothers are slower than CSR's
+            if sp.issparse(level.A) and level.A.format == "bsr" and level.A.blocksize == (1, 1):
+                level.A = sp.csr_matrix(level.A)
         dt = time.perf_counter() - t0
         self.strength = strength
         self.builds += 1

@@ -10,9 +10,11 @@ signed flow is the monotone function
 The unknowns are the free pore pressures and the common inlet pressure P (outlet pores at 0);
 the equations are mass balance in every free pore and a total inlet flow :math:`Q = UA`. The
 Jacobian is the graph Laplacian of the weights w, condensed like the Stokes system, with one
-extra row for P; Newton steps are solved by Schur complement (two CG solves on
-:math:`J_{ff}`, preconditioned by the held AMG hierarchy of the Stokes matrix, rebuilt on
-:math:`J_{ff}` only when CG needs more than 40 iterations) with backtracking on the residual.
+extra row for P: the Laplacian with all inlet pores merged into one node, SPD, its CSR pattern
+built once. A Newton step is one CG solve of that bordered system, preconditioned by the held
+AMG hierarchy of the Stokes matrix on the free block and :math:`1/J_{PP}` on the inlet node
+(the hierarchy rebuilt on the Jacobian's free block only when CG needs more than 40
+iterations), with backtracking on the residual.
 At K = 0 the first step from zero is the Stokes solution. Velocities are solved in ascending
 order from the previous solution, scaled by the local power law of the last two points.
 """
@@ -30,7 +32,6 @@ import scipy.sparse.linalg as spla
 from threadpoolctl import threadpool_limits
 
 from ._amg import AMGSolver
-from ._linear import assemble_laplacian
 
 __all__ = ["InertialPoint", "conduit_flow", "solve_inertial"]
 
@@ -145,26 +146,34 @@ def solve_inertial(n_pores, conns, g, K, inlet, outlet, flows_m3_s, *, tol: floa
     fixed = is_in.copy()
     fixed[outlet] = True
     free = np.flatnonzero(~fixed)
-    A = assemble_laplacian(n_pores, c, g)
+    nf = free.size
+    # reduced index of every pore: free pores 0..nf-1, all inlet pores one node nf, outlet -1
+    red = np.full(n_pores, -1, dtype=np.int64)
+    red[free] = np.arange(nf)
+    red[inlet] = nf
+    J = _BorderedLaplacian(red[c[:, 0]], red[c[:, 1]], nf + 1)
     if amg is None:
-        amg = AMGSolver(A[free][:, free])
-    prec = amg.preconditioner()
-    state = {"amg": amg, "prec": prec}
+        amg = AMGSolver(J.matrix(g)[:nf, :nf])
+    state = {"amg": amg, "prec": amg.preconditioner()}
     i, j = c[:, 0], c[:, 1]
 
     def residual(p, Q):
         q, w = conduit_flow(p[i] - p[j], g, K, crossover=crossover)
         net = np.bincount(i, q, n_pores) - np.bincount(j, q, n_pores)
-        return net[free], net[inlet].sum() - Q, q, w
+        return np.append(net[free], net[inlet].sum() - Q), q, w
 
-    def cg(J, b, eta):
-        x, info = _cg(J, b, state["prec"], eta)
+    def solve(Jw, b, eta):
+        """Bordered system: CG with AMG on the free block and 1/J_PP on the inlet node."""
+        def apply(r):
+            return np.append(state["prec"].matvec(r[:nf]), r[nf] / Jw[nf, nf])
+        M = spla.LinearOperator(Jw.shape, matvec=apply, dtype=float)
+        x, info = _cg(Jw, b, M, eta)
         if info[1] > _REBUILD_ITERATIONS:
             log.info("CG needed %d iterations on the Jacobian: building its own hierarchy",
                      info[1])
-            state["amg"] = AMGSolver(J)
+            state["amg"] = AMGSolver(Jw[:nf, :nf])
             state["prec"] = state["amg"].preconditioner()
-            x, info2 = _cg(J, b, state["prec"], eta)
+            x, info2 = _cg(Jw, b, M, eta)
             info = (info2[0], info[1] + info2[1])
         return x, info
 
@@ -181,34 +190,28 @@ def solve_inertial(n_pores, conns, g, K, inlet, outlet, flows_m3_s, *, tol: floa
             p = p * (Q / q2) ** np.clip(expo, 1.0, 2.0)
         elif hist:
             p = p * (Q / hist[-1][0])
-        rf, rP, q, w = residual(p, Q)
-        rel = max(np.abs(rf).max(initial=0.0), abs(rP)) / Q
+        r, q, w = residual(p, Q)
+        rel = np.abs(r).max() / Q
         it = cg_it = 0
         while rel > tol and it < maxiter:
             it += 1
-            L = assemble_laplacian(n_pores, c, w)
-            Jff = L[free][:, free]
-            jfP = np.asarray(L[free][:, inlet].sum(axis=1)).ravel()
-            JPP = float(L[inlet][:, inlet].sum())
             # inexact Newton: the linear solve need only beat the target by 10x
             eta = float(np.clip(0.1 * tol / rel, 1e-13, 1e-2))
             with threadpool_limits(limits=1, user_api="blas"):
-                x1, i1 = cg(Jff, -rf, eta)
-                x2, i2 = cg(Jff, jfP, eta)
-            cg_it += i1[1] + i2[1]
-            dP = (-rP - jfP @ x1) / (JPP - jfP @ x2)
+                x, info = solve(J.matrix(w), -r, eta)
+            cg_it += info[1]
             dp = np.zeros(n_pores)
-            dp[free] = x1 - x2 * dP
-            dp[inlet] = dP
+            dp[free] = x[:nf]
+            dp[inlet] = x[nf]
             step = 1.0
             for _ in range(30):
-                rf2, rP2, q2_, w2 = residual(p + step * dp, Q)
-                rel2 = max(np.abs(rf2).max(initial=0.0), abs(rP2)) / Q
+                r2, q2_, w2 = residual(p + step * dp, Q)
+                rel2 = np.abs(r2).max() / Q
                 if rel2 < rel or rel2 <= tol:
                     break
                 step *= 0.5
             p = p + step * dp
-            rf, rP, q, w, rel = rf2, rP2, q2_, w2, rel2
+            r, q, w, rel = r2, q2_, w2, rel2
         P = float(p[inlet[0]])
         hist.append((Q, P))
         out[k] = InertialPoint(float(Q), P, bool(rel <= tol), it, cg_it, float(rel),
@@ -231,3 +234,28 @@ def _cg(J, b, M, eta):
     x, flag = spla.cg(sp.csr_array(J), b, rtol=eta, atol=0.0, maxiter=300, M=M,
                       callback=count)
     return x, (flag, n_it[0])
+
+
+class _BorderedLaplacian:
+    """Weighted graph Laplacian on reduced nodes (index -1: a fixed node, dropped), its CSR
+    pattern built once; :meth:`matrix` refills the data for new weights by one bincount."""
+
+    def __init__(self, ri, rj, n):
+        rows = np.concatenate([ri, rj, ri, rj])
+        cols = np.concatenate([ri, rj, rj, ri])
+        sign = np.concatenate([np.ones(2 * ri.size), -np.ones(2 * ri.size)])
+        keep = (rows >= 0) & (cols >= 0)
+        self._m = ri.size
+        key = rows[keep] * n + cols[keep]
+        uniq, self._pos = np.unique(key, return_inverse=True)
+        self._src = np.flatnonzero(keep) % ri.size        # throat of each entry
+        self._sign = sign[keep]
+        r_u = uniq // n
+        self._indices = (uniq % n).astype(np.int32)
+        self._indptr = np.searchsorted(r_u, np.arange(n + 1)).astype(np.int32)
+        self.n = n
+
+    def matrix(self, w):
+        data = np.bincount(self._pos, weights=self._sign * w[self._src],
+                           minlength=self._indices.size)
+        return sp.csr_array((data, self._indices, self._indptr), shape=(self.n, self.n))
