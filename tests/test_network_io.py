@@ -134,3 +134,40 @@ def test_binary_file_is_refused(tmp_path):
     p.write_bytes(b"\x00\x01\x02abc")
     with pytest.raises(ValueError, match="binary file, not a packing"):
         read_packing(p)
+
+
+def _dimers():
+    """Five two-sphere grains (radius 0.5, centres 0.6 apart), grains 3 apart."""
+    base = np.array([[0, 0, 0], [3, 0, 0], [0, 3, 0], [0, 0, 3], [3, 3, 3.0]])
+    c = np.concatenate([base, base + [0.6, 0, 0]])
+    return c, np.full(10, 0.5), np.tile(np.arange(5), 2)
+
+
+def test_grain_id_roundtrip_csv_and_npz(tmp_path):
+    c, r, g = _dimers()
+    pk = Packing(c, r, grain_id=g)
+    write_packing_csv(pk, tmp_path / "g.csv", digits=17)
+    assert (tmp_path / "g.csv").read_text().splitlines()[0] == "x,y,z,r,grain_id"
+    back = read_packing(tmp_path / "g.csv")
+    np.testing.assert_array_equal(back.grain_id, g)
+    assert back.n_grains == 5 and back.n == 10
+    np.savez(tmp_path / "g.npz", centers=c, radii=r, grain_id=g)
+    np.testing.assert_array_equal(read_packing(tmp_path / "g.npz").grain_id, g)
+    # the old four-column file still reads, as one grain per sphere
+    write_packing_csv(Packing(c, r), tmp_path / "s.csv")
+    assert read_packing(tmp_path / "s.csv").grain_id is None
+
+
+def test_grain_id_on_spheres_apart_is_refused_naming_it(tmp_path):
+    c, r, g = _dimers()
+    g = g.copy()
+    g[7] = 4                                  # grain 4 now also owns a sphere of grain 2
+    p = tmp_path / "bad.csv"
+    p.write_text("x,y,z,r,grain_id\n" + "\n".join(
+        f"{c[i, 0]},{c[i, 1]},{c[i, 2]},{r[i]},{g[i]}" for i in range(10)) + "\n")
+    with pytest.raises(ValueError, match=r"grain_id 4 is on spheres that do not overlap into one "
+                                         r"body \(line 6 and line 9 are apart\)"):
+        read_packing(p)
+    p.write_text(p.read_text().replace(",4\n", ",4.5\n", 1))
+    with pytest.raises(ValueError, match="grain_id must be a whole number"):
+        read_packing(p)

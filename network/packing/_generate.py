@@ -24,7 +24,7 @@ import math
 import numpy as np
 from scipy.spatial import cKDTree
 
-from ._io import Packing
+from ._packing import Packing
 
 __all__ = ["random_packing", "periodic_copies", "soybean_default_scene", "SOYBEAN_DEFAULT"]
 

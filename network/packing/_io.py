@@ -7,7 +7,6 @@ offending line (1-based, as an editor shows it) in its ``ValueError``.
 
 from __future__ import annotations
 
-import dataclasses
 import logging
 import os
 import zipfile
@@ -15,94 +14,16 @@ from pathlib import Path
 
 import numpy as np
 
-__all__ = ["Packing", "read_packing", "write_packing_csv", "MIN_SPHERES", "default_packing_path",
-           "read_container", "scale_warning", "UNITS", "FORMATS", "PLAUSIBLE_DIAMETER_M"]
+from ._packing import Packing, check_grains, validate_spheres
+
+__all__ = ["read_packing", "write_packing_csv", "default_packing_path", "read_container",
+           "UNITS", "FORMATS"]
 
 log = logging.getLogger(__name__)
 
 def default_packing_path() -> Path:
     """The bundled soybean-like scene, ``network/data/soybean_default.csv`` (see its README)."""
     return Path(__file__).resolve().parents[1] / "data" / "soybean_default.csv"
-
-
-#: Fewest spheres that make a three-dimensional Delaunay tessellation with an interior.
-MIN_SPHERES = 5
-
-
-@dataclasses.dataclass(frozen=True)
-class Packing:
-    """A sphere packing.
-
-    Attributes
-    ----------
-    centers : (N, 3) ndarray of float, m
-        Sphere centres.
-    radii : (N,) ndarray of float, m
-        Sphere radii, all > 0.
-    source : str
-        Where the packing came from (a path, or a short description); informative only.
-    """
-
-    centers: np.ndarray
-    radii: np.ndarray
-    source: str = ""
-
-    def __post_init__(self):
-        try:
-            c = np.asarray(self.centers, dtype=float)
-            r = np.asarray(self.radii, dtype=float)
-        except (TypeError, ValueError) as e:
-            raise TypeError(f"centers and radii must be numeric arrays: {e}") from e
-        if c.ndim != 2 or c.shape[1] != 3:
-            raise ValueError(f"centers must have shape (N, 3), got {c.shape}")
-        if r.shape != (c.shape[0],):
-            raise ValueError(f"radii must have shape ({c.shape[0]},), got {r.shape}")
-        c.setflags(write=False)
-        r.setflags(write=False)
-        object.__setattr__(self, "centers", c)
-        object.__setattr__(self, "radii", r)
-
-    @property
-    def n(self) -> int:
-        """Number of spheres."""
-        return int(self.radii.shape[0])
-
-    @property
-    def mean_diameter(self) -> float:
-        """Arithmetic mean sphere diameter, m."""
-        return float(2.0 * self.radii.mean())
-
-    def bounds(self) -> np.ndarray:
-        """(2, 3) array: lowest and highest centre coordinate along x, y, z (m)."""
-        return np.stack([self.centers.min(axis=0), self.centers.max(axis=0)])
-
-
-def _validate(centers, radii, lines, source, *, check_duplicates=True):
-    """Check finite values, positive radii, distinct centres and enough spheres.
-
-    ``lines[i]`` is the 1-based file line (or array row) that sphere i came from.
-    """
-    n = len(radii)
-    if n < MIN_SPHERES:
-        raise ValueError(f"{source}: too few spheres ({n}); a packing needs at least {MIN_SPHERES}")
-    bad = ~np.isfinite(centers).all(axis=1) | ~np.isfinite(radii)
-    if bad.any():
-        i = int(np.flatnonzero(bad)[0])
-        raise ValueError(f"{source}: line {lines[i]}: non-finite value (NaN or inf) "
-                         f"in x,y,z,r = {centers[i].tolist() + [float(radii[i])]}")
-    bad = radii <= 0
-    if bad.any():
-        i = int(np.flatnonzero(bad)[0])
-        raise ValueError(f"{source}: line {lines[i]}: radius must be > 0, got {radii[i]!r}")
-    if check_duplicates:
-        order = np.lexsort(centers.T[::-1])
-        s = centers[order]
-        dup = np.all(s[1:] == s[:-1], axis=1)
-        if dup.any():
-            k = int(np.flatnonzero(dup)[0])
-            a, b = sorted((int(order[k]), int(order[k + 1])))
-            raise ValueError(f"{source}: line {lines[b]}: duplicate centre {centers[b].tolist()} "
-                             f"(same as line {lines[a]})")
 
 
 def _parse_rows(rows, ncols, first_line, source):
@@ -157,6 +78,8 @@ def _read_csv(path: Path) -> Packing:
             raise ValueError(f"{src}: line {head_no}: header {head!r} lacks column(s) "
                              f"{missing}; expected x, y, z and r (or radius, or diameter)")
         cols = [names.index(c) for c in ("x", "y", "z")] + [names.index(rname[0])]
+        if "grain_id" in names:
+            cols.append(names.index("grain_id"))
         scale = 0.5 if rname[0] in _DIAMETER_NAMES else 1.0
         body = lines[1:]
         if not body:
@@ -178,8 +101,16 @@ def _read_csv(path: Path) -> Packing:
                            [i for i, _ in body], src)
     data = fast[:, cols]
     lineno = np.array([i for i, _ in body])
-    _validate(data[:, :3], data[:, 3] * scale, lineno, src)
-    return Packing(data[:, :3], data[:, 3] * scale, source=src)
+    validate_spheres(data[:, :3], data[:, 3] * scale, lineno, src)
+    grain = None
+    if data.shape[1] == 5:
+        grain = data[:, 4]
+        bad = np.flatnonzero(~np.isfinite(grain) | (np.mod(grain, 1) != 0))
+        if bad.size:
+            raise ValueError(f"{src}: line {lineno[bad[0]]}: grain_id must be a whole number, "
+                             f"got {grain[bad[0]]!r}")
+        check_grains(data[:, :3], data[:, 3] * scale, grain, lineno, src)
+    return Packing(data[:, :3], data[:, 3] * scale, source=src, grain_id=grain)
 
 
 def _isfloat(s: str) -> bool:
@@ -198,10 +129,16 @@ def _read_npz(path: Path) -> Packing:
             raise ValueError(f"{src}: missing array(s) {missing}; found {z.files}")
         c = np.asarray(z["centers"], dtype=float)
         r = np.asarray(z["radii"], dtype=float).ravel()
+        grain = np.asarray(z["grain_id"]).ravel() if "grain_id" in z.files else None
     if c.ndim != 2 or c.shape[1] != 3 or c.shape[0] != r.shape[0]:
         raise ValueError(f"{src}: centers {c.shape} and radii {r.shape} must be (N, 3) and (N,)")
-    _validate(c, r, np.arange(1, len(r) + 1), f"{src} (row)")
-    return Packing(c, r, source=src)
+    rows = np.arange(1, len(r) + 1)
+    validate_spheres(c, r, rows, f"{src} (row)")
+    if grain is not None:
+        if grain.shape != r.shape:
+            raise ValueError(f"{src}: grain_id {grain.shape} must be ({r.size},)")
+        check_grains(c, r, grain, rows, f"{src} (row)")
+    return Packing(c, r, source=src, grain_id=grain)
 
 
 def _read_dump(path: Path) -> Packing:
@@ -247,7 +184,7 @@ def _read_dump(path: Path) -> Packing:
         raise ValueError(f"{src}: line {s + 1}: scaled coordinates (xs ys zs) are not supported; "
                          "dump x y z or xu yu zu")
     lineno = np.array([i for i, _ in body])
-    _validate(c, r, lineno, src)
+    validate_spheres(c, r, lineno, src)
     return Packing(c, r, source=src)
 
 
@@ -315,23 +252,6 @@ UNITS = {"m": 1.0, "cm": 1e-2, "mm": 1e-3}
 #: Formats :func:`read_packing` reads, for error messages.
 FORMATS = ("delimited text x,y,z,r (comma, semicolon, spaces or tabs; YADE export.text)",
            ".npz with centers and radii", "LAMMPS/LIGGGHTS dump custom")
-#: Mean grain diameters (m) outside which a packing is probably not in metres.
-PLAUSIBLE_DIAMETER_M = (0.5e-3, 50e-3)
-
-
-def scale_warning(packing: Packing) -> str | None:
-    """A one-line warning when the mean diameter is outside 0.5-50 mm (not metres?), else None.
-
-    >>> scale_warning(Packing(np.eye(3) * 10, np.full(3, 3.3)))[:40]
-    'mean grain diameter 6.6 m is outside 0.5'
-    """
-    d = packing.mean_diameter
-    lo, hi = PLAUSIBLE_DIAMETER_M
-    if lo <= d <= hi:
-        return None
-    return (f"mean grain diameter {d:.3g} m is outside 0.5-50 mm, the range of grains: if the "
-            f"file is not in metres, give --units mm or --units cm (a dimensionless packing "
-            f"is fine with --viscosity 1)")
 
 
 def read_container(path: str | os.PathLike) -> dict | None:
@@ -367,6 +287,11 @@ def read_container(path: str | os.PathLike) -> dict | None:
 
 
 def write_packing_csv(packing: Packing, path: str | os.PathLike, *, digits: int = 7) -> None:
-    """Write a packing as CSV ``x,y,z,r`` with ``digits`` significant digits."""
+    """Write a packing as CSV ``x,y,z,r`` (``x,y,z,r,grain_id`` for grains of several spheres)
+    with ``digits`` significant digits."""
     data = np.column_stack([packing.centers, packing.radii])
-    np.savetxt(path, data, delimiter=",", header="x,y,z,r", comments="", fmt=f"%.{digits}g")
+    fmt, head = [f"%.{digits}g"] * 4, "x,y,z,r"
+    if packing.grain_id is not None:
+        data = np.column_stack([data, packing.grain_id])
+        fmt, head = fmt + ["%d"], head + ",grain_id"
+    np.savetxt(path, data, delimiter=",", header=head, comments="", fmt=fmt)
