@@ -21,9 +21,14 @@ import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 from threadpoolctl import threadpool_limits
 
-__all__ = ["AMGSolver", "SolveInfo"]
+__all__ = ["AMGSolver", "SMOOTHERS", "SolveInfo"]
 
 log = logging.getLogger(__name__)
+
+#: Gauss-Seidel smoothing: pyamg's default symmetric sweeps before and after the coarse
+#: correction, or one forward sweep before and one backward after (still a symmetric
+#: V-cycle, half the smoothing work; the Newton Jacobians of network.flow._inertial use it).
+SMOOTHERS = ("symmetric", "forward-backward")
 
 #: CG iterations with the classical strength measure before the evolution measure is tried.
 _SWITCH_ITERATIONS = 150
@@ -56,6 +61,8 @@ class AMGSolver:
     ----------
     A : (n, n) sparse array
         SPD with a positive diagonal (a condensed pore-network Laplacian).
+    smoother : {'symmetric', 'forward-backward'}, keyword-only
+        Gauss-Seidel sweeps of the V-cycle (:data:`SMOOTHERS`; default pyamg's symmetric).
 
     Attributes
     ----------
@@ -67,7 +74,10 @@ class AMGSolver:
         Seconds spent building them.
     """
 
-    def __init__(self, A):
+    def __init__(self, A, *, smoother: str = "symmetric"):
+        if smoother not in SMOOTHERS:
+            raise ValueError(f"smoother must be one of {SMOOTHERS}, got {smoother!r}")
+        self.smoother = smoother
         A = sp.csr_array(A)
         n = A.shape[0]
         if A.shape != (n, n):
@@ -97,9 +107,15 @@ class AMGSolver:
             self._ml = pyamg.smoothed_aggregation_solver(
                 self._As, B=self._B, symmetry="symmetric", strength=strength, max_coarse=500,
                 coarse_solver="splu")
-        for level in self._ml.levels:       # pyamg's 1x1 BSR smoothers are slower than CSR's
-            if sp.issparse(level.A) and level.A.format == "bsr" and level.A.blocksize == (1, 1):
-                level.A = sp.csr_matrix(level.A)
+        for level in self._ml.levels:       # pyamg's 1x1 BSR kernels are slower than CSR's
+            for name in ("A", "P", "R"):
+                M = getattr(level, name, None)
+                if sp.issparse(M) and M.format == "bsr" and M.blocksize == (1, 1):
+                    setattr(level, name, sp.csr_matrix(M))
+        if self.smoother == "forward-backward":
+            from pyamg.relaxation.smoothing import change_smoothers
+            change_smoothers(self._ml, ("gauss_seidel", {"sweep": "forward"}),
+                             ("gauss_seidel", {"sweep": "backward"}))
         dt = time.perf_counter() - t0
         self.strength = strength
         self.builds += 1
