@@ -13,6 +13,11 @@ Three parts (issue 4, item 10; issue 7, item 4), each a module of ``network.benc
    (``--ref-lattices``) and random monodisperse packings (``--ref-random``), every cell from a
    fresh (by default empty) table; FE policies on random packings only at ``--fe-random``.
 
+4. **Inertial** (``--inertial``, run alone) — a 12-point resistance curve on the
+   ``--inertial-spheres`` benchmark packing, timed per stage against the Stokes pipeline with
+   Newton iterations per velocity, and k/k_app against the Beetstra and Hill-Koch-Ladd drag
+   laws on Finney's packing and periodic random packings (``docs/inertial-flow.md``).
+
 Prints a table and writes JSON with the load average, platform, CPU count and a timestamp.
 ``--skip-references`` leaves part 3 out; ``--references-only`` runs part 3 alone. What each
 part measures, its timing rules and the measured FE costs: ``docs/network-bench.md``.
@@ -24,6 +29,7 @@ Examples
         --json bench.json
     python -m network.bench --references-only --json references.json
     python -m network.bench --references-only --fe-random 0.36 0.40 0.45   # ~30 min
+    python -m network.bench --inertial --json inertial.json                 # ~4 min
 """
 
 from __future__ import annotations
@@ -33,8 +39,9 @@ import json
 import sys
 from pathlib import Path
 
-from .benchmarks import (REF_LATTICE_CASES, REF_RANDOM_POROSITIES, has_grid, lattice_case, machine,
-                         policies, policy_lines, references, references_table, run_one, scaling,
+from .benchmarks import (REF_LATTICE_CASES, REF_RANDOM_POROSITIES, has_grid, inertial_lines,
+                         inertial_speed, inertial_validation, lattice_case, machine, policies,
+                         policy_lines, references, references_table, run_one, scaling,
                          scaling_exponent)
 from .conductance import MODELS, POLICIES
 
@@ -85,6 +92,10 @@ def main(argv=None) -> int:
     ap.add_argument("--repeats", type=int, default=2, help="repeats per size (minimum reported)")
     ap.add_argument("--timeout", type=float, default=1800.0, help="per-size limit, s")
     ap.add_argument("--json", dest="json_out", default="network_bench.json")
+    ap.add_argument("--inertial", action="store_true",
+                    help="run part 4 alone: inertial curve speed and drag-law errors")
+    ap.add_argument("--inertial-spheres", type=int, default=20000,
+                    help="spheres of the inertial speed packing (default 20000)")
     ap.add_argument("--one", default=None, help=argparse.SUPPRESS)
     ap.add_argument("--no-trace", action="store_true", help=argparse.SUPPRESS)
     args = ap.parse_args(argv)
@@ -103,6 +114,21 @@ def main(argv=None) -> int:
         row = run_one(Path(args.one), args.policy, args.db, args.repeats, trace=not args.no_trace,
                       model=args.model)
         print(json.dumps(row))
+        return 0
+
+    if args.inertial:
+        report = {"machine_start": machine()}
+        print(f"inertial curve on {args.inertial_spheres} spheres and drag laws:", flush=True)
+        report["inertial_speed"] = inertial_speed(args.inertial_spheres, seed=args.seed,
+                                                  db=args.db)
+        report["inertial_validation"] = inertial_validation(n_spheres=args.ref_spheres,
+                                                            seed=args.ref_seed, db=args.db)
+        print("\n".join(inertial_lines(report["inertial_speed"],
+                                       report["inertial_validation"])), flush=True)
+        report["machine_end"] = machine()
+        with open(args.json_out, "w") as f:
+            json.dump(report, f, indent=2, default=str)
+        print(f"load average {report['machine_end']['loadavg']}; wrote {args.json_out}")
         return 0
 
     workdir = Path(args.workdir or Path.home() / ".cache" / "grainflow" / "bench")

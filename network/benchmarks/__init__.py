@@ -3,18 +3,22 @@
 :func:`policies` (part 1) solves one packing with every conductance model × Q* policy;
 :func:`scaling` (part 2) times each stage against packing size, one subprocess per size
 (:func:`run_one` is what the subprocess runs); :func:`references` (part 3) compares k with
-published and computed Stokes permeabilities, printed by :func:`references_table`. The throat
+published and computed Stokes permeabilities, printed by :func:`references_table`;
+:func:`inertial_speed` and :func:`inertial_validation` (part 4, ``--inertial``) time the
+inertial curve and compare it with the drag laws, printed by :func:`inertial_lines`. The throat
 table is read only through ``_table`` (a stand-in until ``network.conductance`` exposes it).
 Method and measurement history: ``docs/network-bench.md``.
 """
 
 from ._common import machine, qstar_sources
+from ._inertial import INERTIAL_REYNOLDS, inertial_lines, inertial_speed, inertial_validation
 from ._policies import policies, policy_lines
 from ._references import (FE_POLICIES, REF_LATTICE_CASES, REF_RANDOM_POROSITIES, lattice_case,
                           references, references_table)
 from ._scaling import DIRECT_MAX, packing_file, run_one, scaling, scaling_exponent
 from ._table import has_grid
 
-__all__ = ["DIRECT_MAX", "FE_POLICIES", "REF_LATTICE_CASES", "REF_RANDOM_POROSITIES", "has_grid",
+__all__ = ["DIRECT_MAX", "FE_POLICIES", "INERTIAL_REYNOLDS", "inertial_lines", "inertial_speed",
+           "inertial_validation", "REF_LATTICE_CASES", "REF_RANDOM_POROSITIES", "has_grid",
            "lattice_case", "machine", "packing_file", "policies", "policy_lines", "qstar_sources",
            "references", "references_table", "run_one", "scaling", "scaling_exponent"]

@@ -1,0 +1,83 @@
+"""Part 4 of ``python -m network.bench`` (``--inertial``): the inertial curve, speed and error.
+
+:func:`inertial_speed` times a 12-point curve (Re_p of soybean air at 0.005-0.3 m/s) on the
+periodic random benchmark packing (``random_packing(n, rng=seed, periodic=True,
+solid_fraction=0.60)``, as the scaling part makes it; the sample is the default region):
+tessellation, conductances, the Stokes solve and the Newton curve each timed, with Newton
+iterations per velocity and the 1-minute load average. :func:`inertial_validation` runs the
+drag-law cases of :mod:`network.validation` (Finney's packing and periodic random packings)
+and :func:`inertial_lines` prints both. Measurements: ``docs/inertial-flow.md``.
+"""
+
+from __future__ import annotations
+
+import os
+import time
+
+import numpy as np
+
+from ..packing import random_packing
+from ..pores import default_region
+from ..validation import finney_inertial_case, random_inertial_case, solve_sample_curve
+
+__all__ = ["INERTIAL_REYNOLDS", "inertial_lines", "inertial_speed", "inertial_validation"]
+
+#: Reynolds numbers of the validation table.
+INERTIAL_REYNOLDS = (1.0, 2.0, 5.0, 10.0, 20.0, 50.0, 100.0, 200.0)
+
+
+def _load() -> float:
+    return float(os.getloadavg()[0])
+
+
+def inertial_speed(n_spheres: int = 20_000, *, seed: int = 1, n_points: int = 12,
+                   policy: str = "table-only", db=None) -> dict:
+    """Stage times (s) of a ``n_points`` curve 0.005-0.3 m/s on the benchmark packing."""
+    t0 = time.perf_counter()
+    pk = random_packing(int(n_spheres), rng=seed, periodic=True, solid_fraction=0.60)
+    gen = time.perf_counter() - t0
+    region = default_region(pk, axis="z")
+    us = np.geomspace(0.005, 0.3, int(n_points))
+    load0 = _load()
+    k, _, pts, t = solve_sample_curve(pk, region, us, axis=2, policy=policy, db=db,
+                                      viscosity_pa_s=1.932e-5, density_kg_m3=1.2)
+    stokes = t["tessellate"] + t["conductance"] + t["stokes"]
+    return {"n_spheres": int(n_spheres), "generate_s": gen, **{f"{k2}_s": v for k2, v in t.items()},
+            "stokes_pipeline_s": stokes, "curve_total_s": stokes + t["inertial"],
+            "curve_over_stokes": (stokes + t["inertial"]) / stokes,
+            "newton_iterations": [p.iterations for p in pts],
+            "cg_iterations": [p.cg_iterations for p in pts],
+            "converged": all(p.converged for p in pts), "permeability_m2": k,
+            "load_before": load0, "load_after": _load()}
+
+
+def inertial_validation(*, reynolds=INERTIAL_REYNOLDS, solid_fractions=(0.55, 0.60, 0.64),
+                        n_spheres: int = 800, seed: int = 1, policy: str = "table-only",
+                        db=None, crossover=None) -> list[dict]:
+    """Rows (case, Re, network k/k_app, each law's ratio and error) for Finney + random."""
+    rows = finney_inertial_case(reynolds, policy=policy, db=db, crossover=crossover).rows()
+    for phi in solid_fractions:
+        rows += random_inertial_case(phi, reynolds, n_spheres=n_spheres, rng=seed,
+                                     policy=policy, db=db, crossover=crossover).rows()
+    return rows
+
+
+def inertial_lines(speed: dict | None, rows: list[dict]) -> list[str]:
+    """The printed table of part 4."""
+    out = []
+    if speed:
+        out.append(f"inertial curve, {speed['n_spheres']} spheres: tessellate "
+                   f"{speed['tessellate_s']:.2f} s, conductance {speed['conductance_s']:.2f} s, "
+                   f"Stokes solve {speed['stokes_s']:.2f} s, Newton {speed['inertial_s']:.2f} s: "
+                   f"curve {speed['curve_over_stokes']:.2f}x the Stokes pipeline; Newton "
+                   f"iterations {speed['newton_iterations']}, load {speed['load_before']:.1f}"
+                   f"-{speed['load_after']:.1f}")
+    if rows:
+        out.append(f"{'case':<34} {'Re_p':>6} {'k/k_app':>8} {'Beetstra':>9} {'err %':>7} "
+                   f"{'HKL':>7} {'err %':>7}")
+        for r in rows:
+            out.append(f"{r['case']:<34} {r['reynolds_particle']:6g} {r['k_over_k_app']:8.4f} "
+                       f"{r['beetstra_ratio']:9.4f} {100 * r['beetstra_error']:+7.2f} "
+                       f"{r.get('hill_koch_ladd_ratio', float('nan')):7.4f} "
+                       f"{100 * r.get('hill_koch_ladd_error', float('nan')):+7.2f}")
+    return out

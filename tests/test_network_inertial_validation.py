@@ -1,0 +1,85 @@
+"""Inertial validation (issue 14 item 5): the drag laws and the network against them.
+
+Drag laws: Beetstra, van der Hoef & Kuipers (2007) as in OpenFOAM's ``dragModels::Beetstra``;
+Hill, Koch & Ladd (2001) dense random-array fit as in MFiX's ``KOCH_HILL`` (Benyahia et al.
+2006 coefficients). Network numbers recorded on Finney's packing (cube of 16 radii at its
+centre, solid fraction 0.638) at the commit that added this file; tables in
+``docs/inertial-flow.md``.
+"""
+
+import numpy as np
+import pytest
+
+from network.flow import conduit_flow
+from network.validation import (FINNEY_PATH, beetstra_drag, beetstra_stokes_drag, drag_ratio,
+                                finney_inertial_case, hill_koch_ladd_drag)
+
+
+def test_beetstra_stokes_limit_is_the_stokes_law_of_references():
+    phi = np.array([0.3, 0.5, 0.6, 0.64])
+    np.testing.assert_allclose(beetstra_drag(phi, 0.0), beetstra_stokes_drag(phi), rtol=1e-12)
+    np.testing.assert_allclose(beetstra_drag(phi, 1e-9), beetstra_stokes_drag(phi), rtol=1e-6)
+
+
+def test_beetstra_value_by_hand():
+    # phi 0.6, Re 10: F0 = 37.5 + 0.16 (1 + 1.5 sqrt 0.6); F1 by the formula, term by term
+    phi, re = 0.6, 10.0
+    f0 = 10 * phi / 0.16 + 0.16 * (1 + 1.5 * np.sqrt(phi))
+    f1 = (0.413 * re / (24 * 0.16) * (1 / 0.4 + 3 * 0.6 * 0.4 + 8.4 * re**-0.343)
+          / (1 + 10**1.8 * re**(-(1 + 2.4) / 2)))
+    assert float(beetstra_drag(phi, re)) == pytest.approx(f0 + f1, rel=1e-12)
+
+
+def test_hill_koch_ladd_is_continuous_at_its_switch_and_quadratic_below():
+    phi = 0.6
+    f1 = 0.11 + 5.1e-4 * np.exp(11.6 * phi)
+    f3 = 0.0673 + 0.212 * phi + 0.0232 / 0.4**5
+    re_switch = 2 * f3 / f1                       # Re_a = Re / 2
+    lo, hi = hill_koch_ladd_drag(phi, [re_switch * (1 - 1e-9), re_switch * (1 + 1e-9)])
+    assert lo == pytest.approx(hi, rel=1e-8)
+    f0 = float(hill_koch_ladd_drag(phi, 0.0))
+    assert f0 == pytest.approx(10 * phi / 0.4**3)
+    excess = hill_koch_ladd_drag(phi, [1.0, 2.0]) - f0
+    assert excess[1] / excess[0] == pytest.approx(4.0)      # F1 Re^2: Mei-Auriault onset
+
+
+def test_drag_ratio_and_bad_input():
+    assert float(drag_ratio("beetstra", 0.6, 0.0)) == 1.0
+    assert float(drag_ratio("hill_koch_ladd", 0.6, 0.0)) == 1.0
+    with pytest.raises(ValueError, match="law must be one of"):
+        drag_ratio("ergun", 0.6, 1.0)
+    with pytest.raises(ValueError, match="solid_fraction"):
+        beetstra_drag(1.2, 1.0)
+    with pytest.raises(ValueError, match="reynolds"):
+        beetstra_drag(0.6, -1.0)
+    with pytest.raises(ValueError, match=">= 0.4"):
+        hill_koch_ladd_drag(0.3, 1.0)
+
+
+def test_onset_law_conduit_flow():
+    # dp = q/g + K q|q| X/(Xc + X), X = K g |q|: exact inverse, slope, Re^2 onset
+    g, K, xc = np.ones(4), np.full(4, 0.5), 1.0
+    dp = np.array([1e-4, 0.1, -1.5, 100.0])
+    q, w = conduit_flow(dp, g, K, crossover=xc)
+    x = K * g * np.abs(q)
+    np.testing.assert_allclose(q / g + K * q * np.abs(q) * x / (xc + x), dp, rtol=1e-12)
+    q2, _ = conduit_flow(dp + 1e-7, g, K, crossover=xc)
+    np.testing.assert_allclose((q2 - q) / 1e-7, w, rtol=1e-5)
+    # low flow: the excess over the viscous drop is (K g q)^2 / Xc of it (Re^2 per conduit)
+    excess = (dp[0] - q[0] / g[0]) / (q[0] / g[0])
+    assert excess == pytest.approx((K[0] * g[0] * q[0]) ** 2 / xc, rel=1e-3)
+
+
+@pytest.mark.skipif(not FINNEY_PATH.exists(), reason="Finney data not available")
+def test_finney_against_the_drag_laws_at_three_reynolds_numbers():
+    case = finney_inertial_case([2.0, 10.0, 50.0])
+    assert case.converged and np.all(case.iterations <= 30)
+    assert case.solid_fraction == pytest.approx(0.638, abs=0.005)
+    # network k/k_app recorded at this file's commit (quadratic per-conduit law)
+    np.testing.assert_allclose(case.k_ratio, [1.0165, 1.0807, 1.3808], rtol=2e-3)
+    err = case.error["beetstra"]
+    assert abs(err[0]) < 0.02 and abs(err[1]) < 0.02           # issue target, Re_p <= 10
+    # known miss (docs/inertial-flow.md): at Re_p 50 the network is ~19 % below Beetstra
+    assert err[2] == pytest.approx(-0.189, abs=0.01)
+    np.testing.assert_allclose(case.error["hill_koch_ladd"], [0.0094, -0.0571, -0.2021],
+                               atol=0.003)
