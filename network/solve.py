@@ -240,7 +240,7 @@ def _main(args) -> int:
           f"{args.conductance_model}, policy {args.policy}")
     for res in results:
         _print_result(res, sys.stdout)
-    out = combined_summary(results, seconds={"read": t_read, "wall": total})
+    out = combined_summary(results, seconds={"read": t_read, "wall": total}, packing=packing)
     out["packing"] = str(path)
     out["units"] = args.units
     out["n_spheres"] = packing.n
@@ -250,6 +250,14 @@ def _main(args) -> int:
         print("anisotropy: k_x : k_y : k_z = " + " : ".join(
             f"{k[a]['permeability_m2'] / out['permeability_m2']:.3f}" for a in axes)
             + " (relative to the mean)")
+    if "permeability_tensor_m2" in out:
+        kt = out["permeability_tensor_m2"]
+        print(f"permeability tensor (diagonal): k_xx {kt['xx']:.4e}, k_yy {kt['yy']:.4e}, "
+              f"k_zz {kt['zz']:.4e} m²; horizontal/vertical resistance "
+              f"{out['horizontal_to_vertical_resistance']:.3f}")
+    if out.get("orientation_order") is not None:
+        print(f"grains: {packing.n_grains}, long-axis order S against the vertical "
+              f"{out['orientation_order']:.3f} (1 vertical, -0.5 horizontal, 0 random)")
     if np.isclose(args.velocity, 0.013) and np.isclose(args.depth, 0.25):
         t = THESIS_LSV
         print(f"thesis (soybeans, 0.25 m at 0.013 m/s; section 4.2.3, Table 4.5): measured "

@@ -205,8 +205,7 @@ def solve_network(packing: Packing, *, axis="z", region: Region | None = None,
                            viscosity_pa_s=viscosity_pa_s)
     # pressures and flows of the flow-imposed problem (thesis BC): Q = v A
     scale = velocity_m_s * sample.area_m2 / q1
-    r = packing.radii
-    d32 = float(2 * np.sum(r**3) / np.sum(r**2))
+    d32 = packing.sauter_diameter
     times["total"] = float(sum(v for kk, v in times.items()))
     if trace_memory:
         times["peak_memory_mb"] = peaks
@@ -216,7 +215,7 @@ def solve_network(packing: Packing, *, axis="z", region: Region | None = None,
                    "setup_s": info.setup_s, "solve_s": info.solve_s}
     chk = {k2: v for k2, v in check.items() if k2 != "throat_flow"}
     if core_margin_m is None:
-        k_core, core_margin = _core_estimate(sample, g, p, reg, packing.mean_diameter,
+        k_core, core_margin = _core_estimate(sample, g, p, reg, packing.grain_diameter,
                                              viscosity_pa_s)
     else:
         core_margin = core_margin_m

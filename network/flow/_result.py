@@ -182,13 +182,18 @@ class FlowResult:
                                     "seconds": pt.seconds}}
 
 
-def combined_summary(results, *, seconds: dict | None = None) -> dict:
+def combined_summary(results, *, seconds: dict | None = None, packing=None) -> dict:
     r"""JSON-ready summary of one or several :class:`FlowResult` (one per axis).
 
     One axis: its :meth:`FlowResult.summary`. Several: the arithmetic mean of the directional
     permeabilities, :math:`\bar k = \tfrac13 \sum_a k_a`, the gradient :math:`\mu v/\bar k`
     (Pa/m) and drop over the depth (Pa) it gives, the anisotropy :math:`k_a/\bar k`, and every
     axis's own summary under ``by_axis``. ``seconds`` is merged into the ``seconds`` entry.
+    With the three axes, the diagonal of the permeability tensor ``permeability_tensor_m2``
+    (k_xx, k_yy, k_zz, m²) and ``horizontal_to_vertical_resistance`` =
+    :math:`k_{zz} / \tfrac12(k_{xx} + k_{yy})` (resistance is 1/k; z is vertical); with a
+    ``packing`` of multi-sphere grains, ``orientation_order``: :math:`S` of the grains' long
+    axes against the vertical (:meth:`network.packing.Packing.orientation_order`).
     """
     results = list(results)
     if not results:
@@ -201,7 +206,7 @@ def combined_summary(results, *, seconds: dict | None = None) -> dict:
     first = results[0]
     k = float(np.mean([r.permeability_m2 for r in results]))
     grad = first.viscosity_pa_s * first.velocity_m_s / k
-    return {
+    out = {
         "axis": "all",
         "conductance_model": first.conductance_model,
         "policy": first.policy,
@@ -219,3 +224,13 @@ def combined_summary(results, *, seconds: dict | None = None) -> dict:
         "by_axis": by,
         "seconds": dict(seconds or {}),
     }
+    ks = {r.axis: float(r.permeability_m2) for r in results}
+    if set(ks) == {"x", "y", "z"}:
+        out["permeability_tensor_m2"] = {"xx": ks["x"], "yy": ks["y"], "zz": ks["z"]}
+        out["horizontal_to_vertical_resistance"] = ks["z"] / (0.5 * (ks["x"] + ks["y"]))
+    if packing is not None and packing.grain_id is not None and packing.n_grains < packing.n:
+        out["orientation_order"] = packing.orientation_order(axis=2)
+        out["orientation_order_note"] = ("S = <3 cos^2(theta) - 1>/2 of the grains' long axes "
+                                         "against z: 1 all vertical, -0.5 all horizontal, 0 "
+                                         "random")
+    return out

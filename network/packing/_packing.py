@@ -8,14 +8,15 @@ that is probably not in metres.
 from __future__ import annotations
 
 import dataclasses
+import functools
 
 import numpy as np
 import scipy.sparse as sp
 from scipy.sparse.csgraph import connected_components
 from scipy.spatial import cKDTree
 
-__all__ = ["MIN_SPHERES", "PLAUSIBLE_DIAMETER_M", "Packing", "check_grains", "scale_warning",
-           "validate_spheres"]
+__all__ = ["MIN_SPHERES", "PLAUSIBLE_DIAMETER_M", "Packing", "check_grains", "grain_volumes",
+           "scale_warning", "validate_spheres"]
 
 #: Fewest spheres that make a three-dimensional Delaunay tessellation with an interior.
 MIN_SPHERES = 5
@@ -84,6 +85,69 @@ class Packing:
     def bounds(self) -> np.ndarray:
         """(2, 3) array: lowest and highest centre coordinate along x, y, z (m)."""
         return np.stack([self.centers.min(axis=0), self.centers.max(axis=0)])
+
+    @functools.cached_property
+    def grain_diameters(self) -> np.ndarray:
+        r"""(n_grains,) volume-equivalent diameter of each grain, :math:`(6V/\pi)^{1/3}`, m.
+
+        A sphere's is its diameter; a multi-sphere grain's volume is that of the union of its
+        spheres, by quasi-Monte Carlo (1024 scrambled Sobol points in the grain's bounding box,
+        randomly shifted per grain, seed 0): about 1 % of V per grain (0.3 % of d) measured on
+        dimers and 7-sphere rods, independent between grains, so a mean over n grains is good to
+        about 0.3/sqrt(n) %. Grains in ``np.unique(grain_id)`` order.
+        """
+        if self.grain_id is None:
+            return 2.0 * self.radii
+        return (6.0 / np.pi * grain_volumes(self.centers, self.radii, self.grain_id)) ** (1 / 3)
+
+    @property
+    def grain_diameter(self) -> float:
+        """Mean volume-equivalent grain diameter, m (the mean sphere diameter for spheres)."""
+        if self.grain_id is None or self.n_grains == self.n:
+            return self.mean_diameter
+        return float(self.grain_diameters.mean())
+
+    def orientation_order(self, axis: int = 2) -> float | None:
+        r"""Orientation order of the grains' long axes against ``axis`` (z: vertical).
+
+        .. math:: S = \langle \tfrac32 \cos^2\theta - \tfrac12 \rangle
+
+        over the grains of two or more spheres, :math:`\theta` the angle between ``axis`` and
+        the grain's long axis: the principal axis of largest extent of its sphere centres,
+        weighted by :math:`r^3`. S = 1: all along the axis, -1/2: all normal to it, 0: random.
+        None without multi-sphere grains.
+
+        >>> rod = Packing([[0, 0, 0], [0, 0, 1], [5, 0, 0], [6, 0, 0]], [1, 1, 1, 1],
+        ...               grain_id=[0, 0, 1, 1])
+        >>> rod.orientation_order(axis=2)    # one vertical, one horizontal: (1 - 0.5)/2
+        0.25
+        """
+        if self.grain_id is None:
+            return None
+        ids, g = np.unique(self.grain_id, return_inverse=True)
+        count = np.bincount(g)
+        w = self.radii**3
+        wsum = np.bincount(g, w)
+        mean = np.column_stack([np.bincount(g, w * self.centers[:, k]) for k in range(3)])
+        mean /= wsum[:, None]
+        d = self.centers - mean[g]
+        gyr = np.zeros((ids.size, 3, 3))
+        np.add.at(gyr, g, w[:, None, None] * d[:, :, None] * d[:, None, :])
+        multi = count > 1
+        if not multi.any():
+            return None
+        _, vec = np.linalg.eigh(gyr[multi])                     # ascending eigenvalues
+        cos = vec[:, int(axis), -1]                             # long axis, component on axis
+        return float(np.mean(1.5 * cos**2 - 0.5))
+
+    @property
+    def sauter_diameter(self) -> float:
+        r"""Sauter mean diameter :math:`d_{32} = \sum d^3 / \sum d^2` of the grains, m."""
+        if self.grain_id is None or self.n_grains == self.n:
+            r = self.radii
+            return float(2 * np.sum(r**3) / np.sum(r**2))
+        d = self.grain_diameters
+        return float(np.sum(d**3) / np.sum(d**2))
 
 
 def validate_spheres(centers, radii, lines, source, *, check_duplicates=True):
@@ -156,10 +220,53 @@ def scale_warning(packing: Packing) -> str | None:
     >>> scale_warning(Packing(np.eye(3) * 10, np.full(3, 3.3)))[:40]
     'mean grain diameter 6.6 m is outside 0.5'
     """
-    d = packing.mean_diameter
+    d = packing.grain_diameter
     lo, hi = PLAUSIBLE_DIAMETER_M
     if lo <= d <= hi:
         return None
     return (f"mean grain diameter {d:.3g} m is outside 0.5-50 mm, the range of grains: if the "
             f"file is not in metres, give --units mm or --units cm (a dimensionless packing "
             f"is fine with --viscosity 1)")
+
+
+def grain_volumes(centers, radii, grain_id, *, points: int = 1024, rng=0) -> np.ndarray:
+    """(n_grains,) volume of the union of each grain's spheres, m³ (Monte Carlo, see
+    :attr:`Packing.grain_diameters`); grains in ``np.unique(grain_id)`` order.
+
+    >>> v = grain_volumes([[0, 0, 0], [1, 0, 0]], [1.0, 1.0], [7, 7])   # two unit spheres
+    >>> bool(abs(v[0] / (8 * np.pi / 3 - 5 * np.pi / 12) - 1) < 0.03)   # 2 V - lens
+    True
+    """
+    c = np.asarray(centers, float)
+    r = np.asarray(radii, float)
+    ids, g = np.unique(np.asarray(grain_id), return_inverse=True)
+    order = np.argsort(g, kind="stable")
+    start = np.searchsorted(g[order], np.arange(ids.size))
+    count = np.bincount(g, minlength=ids.size)
+    lo = np.full((ids.size, 3), np.inf)
+    hi = np.full((ids.size, 3), -np.inf)
+    np.minimum.at(lo, g, c - r[:, None])
+    np.maximum.at(hi, g, c + r[:, None])
+    from scipy.stats import qmc                          # scrambled Sobol: error ~ 1/points
+
+    u = qmc.Sobol(3, scramble=True, seed=rng).random(int(points))
+    # a random shift of the point set per grain (Cranley-Patterson rotation): the grains' errors
+    # are independent, so a mean over n grains is good to 1/sqrt(n) of one grain's error
+    shift = np.random.default_rng(rng).random((ids.size, 3))
+    vol = np.empty(ids.size)
+    kmax = int(count.max())
+    step = max(1, 2_000_000 // (int(points) * kmax))
+    for a in range(0, ids.size, step):                 # chunks of grains, vectorised inside
+        b = min(a + step, ids.size)
+        frac = np.mod(u[None] + shift[a:b, None], 1.0)
+        pts = lo[a:b, None] + (hi[a:b] - lo[a:b])[:, None] * frac       # (m, P, 3)
+        inside = np.zeros(pts.shape[:2], dtype=bool)
+        for k in range(kmax):                          # k-th sphere of each grain
+            has = count[a:b] > k
+            sph = order[np.minimum(start[a:b] + k, c.shape[0] - 1)]
+            d2 = np.sum((pts - c[sph][:, None]) ** 2, axis=2)
+            inside |= has[:, None] & (d2 < r[sph][:, None] ** 2)
+        vol[a:b] = inside.mean(axis=1) * np.prod(hi[a:b] - lo[a:b], axis=1)
+    one = count == 1                                   # one-sphere grains: exact
+    vol[one] = 4.0 / 3.0 * np.pi * r[order[start[one]]] ** 3
+    return vol

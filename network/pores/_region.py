@@ -104,12 +104,12 @@ def default_region(packing, *, margin: float | None = None, cylinder: bool = Fal
     """
     lo = (packing.centers - packing.radii[:, None]).min(axis=0)
     hi = (packing.centers + packing.radii[:, None]).max(axis=0)
-    m = 1.5 * packing.mean_diameter if margin is None else float(margin)
+    m = 1.5 * packing.grain_diameter if margin is None else float(margin)
     if m < 0:
         raise ValueError(f"margin must be >= 0, got {m}")
     if np.any(hi - lo <= 2 * m):
         raise ValueError(f"margin {m:g} leaves no interior in a packing of extent {hi - lo}")
-    d = packing.mean_diameter
+    d = packing.grain_diameter
     thin = np.flatnonzero(hi - lo - 2 * m < MIN_INTERIOR_DIAMETERS * d)
     if thin.size:
         k = int(thin[0])
@@ -192,4 +192,4 @@ def check_inside_bed(packing, region: Region, *, tolerance: float = 1e-9) -> Non
         raise ValueError(
             f"the sample {'xyz'[k]} {region.lo[k]:.6g}..{region.hi[k]:.6g} reaches outside the "
             f"packed bed, which spans x {lo[0]:.6g}..{hi[0]:.6g}, y {lo[1]:.6g}..{hi[1]:.6g}, "
-            f"z {lo[2]:.6g}..{hi[2]:.6g} (same unit as the packing): give a sample inside it")
+            f"z {lo[2]:.6g}..{hi[2]:.6g} (m): give a sample inside it")

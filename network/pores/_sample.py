@@ -145,6 +145,14 @@ def select_sample(tessellation, region: Region, *, axis="z", groups=None) -> Sam
                     "that is many, the region reaches past the bed (give --sample, --margin, "
                     "or a companion JSON with the container)", n_big)
         inside &= ~outside_bed
+    # pore bodies made only of tetrahedra inside one grain are solid (multi-sphere grains)
+    solid_t = t.solid_pores()
+    if solid_t.any():
+        n_t = np.bincount(lab, None, xyz_all.shape[0])
+        solid = np.bincount(lab, solid_t, xyz_all.shape[0]) >= np.maximum(n_t, 1)
+        log.info("%d pore bodies of the sample region lie inside one grain: solid, left out",
+                 int(np.sum(inside & solid)))
+        inside &= ~solid
     pores = np.flatnonzero(inside)
     if pores.size == 0:
         raise ValueError(f"the sample region {region.lo}–{region.hi} contains no pore")

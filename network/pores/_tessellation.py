@@ -139,7 +139,27 @@ class Tessellation:
         """
         circ_r = np.linalg.norm(self.pore_circumcenter
                                 - self.packing.centers[self.pore_vertices[:, 0]], axis=1)
-        return circ_r > float(diameters) * self.packing.mean_diameter
+        return circ_r > float(diameters) * self.packing.grain_diameter
+
+    def solid_pores(self) -> np.ndarray:
+        """(Np,) bool: tetrahedra inside one grain, solid rather than pore space.
+
+        With multi-sphere grains (``packing.grain_id``) a tetrahedron whose four spheres all
+        belong to one grain and whose centroid lies inside one of those spheres is inside the
+        grain: the spheres of a grain overlap heavily, so its tetrahedra are (nearly) all solid.
+        A tetrahedron spanning two grains, or one grain's spheres around a void (a concave
+        grain), stays a pore. Without grains: none.
+        """
+        if self.packing.grain_id is None:
+            return np.zeros(self.n_pores, dtype=bool)
+        g = self.packing.grain_id[self.pore_vertices]                     # (Np, 4)
+        one = np.all(g == g[:, :1], axis=1)
+        c = self.packing.centers[self.pore_vertices[one]]                   # (m, 4, 3)
+        r = self.packing.radii[self.pore_vertices[one]]
+        d2 = np.sum((self.pore_centroid[one][:, None] - c) ** 2, axis=2)
+        solid = np.zeros(self.n_pores, dtype=bool)
+        solid[one] = np.any(d2 < r**2, axis=1)
+        return solid
 
     @property
     def interior_throats(self) -> np.ndarray:
