@@ -10,6 +10,7 @@ centre, solid fraction 0.638) at the commit that added this file; tables in
 import numpy as np
 import pytest
 
+from network.conductance import expansion_coefficient
 from network.flow import conduit_flow
 from network.validation import (FINNEY_PATH, beetstra_drag, beetstra_stokes_drag, drag_ratio,
                                 finney_inertial_case, hill_koch_ladd_drag)
@@ -68,6 +69,17 @@ def test_onset_law_conduit_flow():
     # low flow: the excess over the viscous drop is (K g q)^2 / Xc of it (Re^2 per conduit)
     excess = (dp[0] - q[0] / g[0]) / (q[0] / g[0])
     assert excess == pytest.approx((K[0] * g[0] * q[0]) ** 2 / xc, rel=1e-3)
+
+
+def test_expansion_loss_with_the_laminar_profile():
+    # momentum + energy balance: K = alpha - 2 beta s + (2 beta - alpha) s^2; Poiseuille tube
+    # alpha = 2, beta = 4/3: K(0) = 2 (twice Borda-Carnot), K(1) = 0, K(0.5) = 5/6
+    s = np.array([0.0, 0.5, 1.0])
+    np.testing.assert_allclose(expansion_coefficient(s, profile="laminar"), [2, 5 / 6, 0],
+                               atol=1e-12)
+    np.testing.assert_allclose(expansion_coefficient(s), (1 - s) ** 2, atol=1e-12)
+    with pytest.raises(ValueError, match="profile must be one of"):
+        expansion_coefficient(s, profile="turbulent")
 
 
 @pytest.mark.skipif(not FINNEY_PATH.exists(), reason="Finney data not available")

@@ -28,7 +28,8 @@ import throats
 
 from .._air import RHO_AIR_KG_M3, check_density
 
-__all__ = ["contraction_coefficient", "expansion_coefficient", "inertial_coefficients"]
+__all__ = ["PROFILES", "contraction_coefficient", "expansion_coefficient",
+           "inertial_coefficients"]
 
 
 def contraction_coefficient(sigma):
@@ -42,18 +43,31 @@ def contraction_coefficient(sigma):
     return (1.0 / cc - 1.0) ** 2
 
 
-def expansion_coefficient(sigma):
-    r"""Borda-Carnot loss coefficient of a sudden expansion, :math:`K_e = (1-\sigma)^2`.
+#: Kinetic-energy and momentum-flux coefficients (alpha, beta) of the velocity profile in the
+#: window and downstream: a flat profile, or the laminar (Poiseuille) one of a circular tube.
+PROFILES = {"uniform": (1.0, 1.0), "laminar": (2.0, 4.0 / 3.0)}
 
-    >>> float(expansion_coefficient(0.25))
-    0.5625
+
+def expansion_coefficient(sigma, *, profile: str = "uniform"):
+    r"""Loss coefficient of a sudden expansion from area ratio :math:`\sigma = A_1/A_2`.
+
+    Momentum and energy balances between the expansion plane and the reattached flow, with
+    profile coefficients :math:`(\alpha, \beta)` on both sides (:data:`PROFILES`):
+    :math:`K_e = \alpha - 2\beta\sigma + (2\beta - \alpha)\sigma^2` (per
+    :math:`\rho V_1^2/2`); Borda-Carnot :math:`(1-\sigma)^2` for a flat profile.
+
+    >>> float(expansion_coefficient(0.25)), float(expansion_coefficient(0.0, profile="laminar"))
+    (0.5625, 2.0)
     """
+    if profile not in PROFILES:
+        raise ValueError(f"profile must be one of {sorted(PROFILES)}, got {profile!r}")
+    a, b = PROFILES[profile]
     s = np.clip(np.asarray(sigma, dtype=float), 0.0, 1.0)
-    return (1.0 - s) ** 2
+    return a - 2.0 * b * s + (2.0 * b - a) * s**2
 
 
 def inertial_coefficients(tessellation, throats_idx, h_m, *, internal=None,
-                          density_kg_m3: float = RHO_AIR_KG_M3):
+                          density_kg_m3: float = RHO_AIR_KG_M3, profile: str = "uniform"):
     r"""Inertial coefficients K of M conduits for both flow directions, Pa s² m⁻⁶.
 
     Parameters
@@ -67,6 +81,8 @@ def inertial_coefficients(tessellation, throats_idx, h_m, *, internal=None,
         Throats inside one merged pore body: K = 0 (one pressure node).
     density_kg_m3 : float, keyword-only
         ρ (default 1.20 kg/m³).
+    profile : {'uniform', 'laminar'}, keyword-only
+        Velocity profile of the expansion loss (:func:`expansion_coefficient`).
 
     Returns
     -------
@@ -89,7 +105,7 @@ def inertial_coefficients(tessellation, throats_idx, h_m, *, internal=None,
         a_b = np.asarray(throats.open_area(np.maximum(rk, point), sides), dtype=float)
         with np.errstate(divide="ignore", invalid="ignore"):
             sigma[:, side] = np.where(a_b > 0, a_w / a_b, 1.0)
-    kc, ke = contraction_coefficient(sigma), expansion_coefficient(sigma)
+    kc, ke = contraction_coefficient(sigma), expansion_coefficient(sigma, profile=profile)
     with np.errstate(divide="ignore"):
         scale = np.where(a_w > 0, rho / (2.0 * a_w**2), 0.0)
     K = np.column_stack([kc[:, 0] + ke[:, 1], kc[:, 1] + ke[:, 0]]) * scale[:, None]

@@ -76,9 +76,11 @@ class InertialCase:
 
 
 def solve_sample_curve(packing, region, velocities_m_s, *, axis=0, policy="table-only",
-                       db=None, viscosity_pa_s=1.0, density_kg_m3=1.0, crossover=None):
+                       db=None, viscosity_pa_s=1.0, density_kg_m3=1.0, crossover=None,
+                       profile="uniform"):
     """The inertial pipeline of :func:`network.solve_network` (conduit model, bodies merged),
-    with the onset ``crossover`` of :func:`network.flow.solve_inertial` selectable:
+    with the onset ``crossover`` of :func:`network.flow.solve_inertial` and the expansion
+    ``profile`` of :func:`network.conductance.inertial_coefficients` selectable:
     ``(permeability_m2, length_m, points, seconds)``, ``seconds`` a dict by stage."""
     t = {}
     t0 = time.perf_counter()
@@ -92,7 +94,8 @@ def solve_sample_curve(packing, region, velocities_m_s, *, axis=0, policy="table
     before = sample.throats
     sample, g = prune_disconnected(sample, tess, cres.g)
     K = inertial_coefficients(tess, before, cres.h_m, internal=cres.internal,
-                              density_kg_m3=density_kg_m3)[np.searchsorted(before,
+                              density_kg_m3=density_kg_m3,
+                              profile=profile)[np.searchsorted(before,
                                                                            sample.throats)]
     t["conductance"] = time.perf_counter() - t0
     t0 = time.perf_counter()
@@ -110,14 +113,14 @@ def solve_sample_curve(packing, region, velocities_m_s, *, axis=0, policy="table
 
 
 def _run(name, packing, region, diameter, solid_fraction, reynolds, *, axis, policy, db,
-         laws, crossover):
+         laws, crossover, profile):
     re = np.asarray(reynolds, dtype=float)
     if re.ndim != 1 or not re.size or np.any(~np.isfinite(re)) or np.any(re <= 0):
         raise ValueError(f"reynolds must be a non-empty list of values > 0, got {reynolds!r}")
     t0 = time.perf_counter()
     us = re / diameter                      # mu = rho = 1: Re = U d
     k, length, pts, _ = solve_sample_curve(packing, region, us, axis=axis, policy=policy,
-                                           db=db, crossover=crossover)
+                                           db=db, crossover=crossover, profile=profile)
     grad = np.array([p.dp_pa for p in pts]) / length
     k_ratio = grad * k / us                 # (dP/L) / (mu U / k)
     law_ratio = {}
@@ -134,7 +137,8 @@ def _run(name, packing, region, diameter, solid_fraction, reynolds, *, axis, pol
 
 def random_inertial_case(solid_fraction: float, reynolds, *, n_spheres: int = 800, rng=1,
                          copies: int = 3, axis: int = 0, policy: str = "table-only",
-                         db=None, laws=tuple(DRAG_LAWS), crossover=None) -> InertialCase:
+                         db=None, laws=tuple(DRAG_LAWS), crossover=None,
+                         profile="uniform") -> InertialCase:
     """Periodic random packing of unit spheres at ``solid_fraction`` (<= 0.64), copied
     ``copies``³ times; sample = all but half a period at every face (module notes)."""
     phi = float(solid_fraction)
@@ -147,12 +151,13 @@ def random_inertial_case(solid_fraction: float, reynolds, *, n_spheres: int = 80
     region = Region(np.full(3, 0.5 * side), np.full(3, (copies - 0.5) * side))
     return _run(f"random phi={phi:.3f} n={n_spheres} seed={rng}", packing, region, 1.0, phi,
                 reynolds, axis=axis, policy=policy, db=db, laws=laws,
-                crossover=crossover)
+                crossover=crossover, profile=profile)
 
 
 def finney_inertial_case(reynolds, *, half_side: float = 8.0, axis: int = 0,
                          policy: str = "table-only", db=None, path=FINNEY_PATH,
-                         laws=tuple(DRAG_LAWS), crossover=None) -> InertialCase:
+                         laws=tuple(DRAG_LAWS), crossover=None,
+                         profile="uniform") -> InertialCase:
     """A cube of half-side ``half_side`` (sphere radii) at the centroid of Finney's packing;
     the law is evaluated at the cube's solid fraction (sphere volume counted by quadrature
     of 200 000 seeded points)."""
@@ -163,7 +168,7 @@ def finney_inertial_case(reynolds, *, half_side: float = 8.0, axis: int = 0,
     phi = _box_solid_fraction(packing, region)
     return _run(f"finney cube {2 * h:g} r, phi={phi:.3f}", packing, region,
                 float(2 * packing.radii.mean()), phi, reynolds, axis=axis, policy=policy,
-                db=db, laws=laws, crossover=crossover)
+                db=db, laws=laws, crossover=crossover, profile=profile)
 
 
 def _box_solid_fraction(packing: Packing, region: Region, n_points: int = 200_000) -> float:
@@ -176,7 +181,8 @@ def _box_solid_fraction(packing: Packing, region: Region, n_points: int = 200_00
 
 def lattice_inertial_case(kind: str, solid_fraction: float, reynolds, *, n_cells: int = 7,
                           axis: int = 0, policy: str = "table-only", db=None,
-                          offset: float = 0.137, crossover=None) -> InertialCase:
+                          offset: float = 0.137, crossover=None,
+                         profile="uniform") -> InertialCase:
     """Simple-cubic / BCC / FCC array, lattice constant 1, sample box as
     :func:`lattice_sample_permeability`; ``law_ratio`` holds the random-packing laws for
     information only (an ordered array is not a random bed)."""
@@ -184,4 +190,4 @@ def lattice_inertial_case(kind: str, solid_fraction: float, reynolds, *, n_cells
     region = Region(np.full(3, 1.0 + offset), np.full(3, n_cells - 2 + offset))
     return _run(f"{kind} phi={float(solid_fraction):.3f}", Packing(c, r), region,
                 float(2 * r[0]), float(solid_fraction), reynolds, axis=axis, policy=policy,
-                db=db, laws=("beetstra",), crossover=crossover)
+                db=db, laws=("beetstra",), crossover=crossover, profile=profile)
