@@ -11,7 +11,10 @@ Examples
     python -m network.throats --out default_throats.csv          # the bundled scene
     python -m network.throats bed_mm.csv --units mm --out throats.csv
 
-The packing is read in ``--units`` (``--sample``, ``--margin`` too); the CSV is in metres. Exit 0
+The packing is read in ``--units`` (``--sample``, ``--margin`` too); the CSV is in metres, with
+17 significant digits so that the values read back are the tessellation's bit for bit and the
+cache's shape keys (``cache.shape_keys``, quantum 1e-9 r̄) match those ``network.solve`` looks
+up (9 digits moved keys and sent every throat to FE again, issue 13). Exit 0
 done, 1 failed, 2 bad input: one ``error:`` line (docs/cli.md).
 """
 
@@ -72,7 +75,7 @@ def _main(args) -> int:
             idx = sample.throats
         data = np.column_stack([tess.throat_radii[idx], tess.throat_sides[idx], idx,
                                 tess.throat_pores[idx]])
-        np.savetxt(args.out, data, delimiter=",", fmt=["%.9g"] * 6 + ["%d"] * 3, comments="",
+        np.savetxt(args.out, data, delimiter=",", fmt=["%.17g"] * 6 + ["%d"] * 3, comments="",
                    header=HEADER)
     print(f"wrote {args.out}: {idx.size} throats of {tess.n_throats} "
           f"({packing.n} spheres, {path}, read in {args.units}) in "
