@@ -1,0 +1,256 @@
+"""The grain library: measured kernel and bed properties of the crops grainflow packs, with sources.
+
+Every number is a :class:`Sourced` value: the value (a float, a ``(low, high)`` range or a
+``(length, width, thickness)`` triple), the source it was read from (paper or standard, the
+table/abstract, and the page address where it was found), and a note. A value no source gave is
+``None`` with a note saying so; nothing here is estimated, interpolated or filled from memory.
+
+Method. Sources were found with full-text search of stored public pages (journal abstracts and
+landing pages); the address recorded is the one the search returned. Where a paper reports a
+moisture series, the value kept is the low-moisture end (storage-dry grain, the condition of the
+ASABE D272 airflow data) and the note gives the series. Where sources disagree the choice and the
+reason are in the note and in ``docs/grain-library.md``. Kernel axes are length x width x
+thickness in mm; densities kg/m^3; porosity a fraction; friction and restitution dimensionless.
+``friction_pp``/``restitution_pp`` are grain-grain contacts, ``*_pw`` grain-wall (the wall
+material is named in the note). The D272 airflow constants live in ``network/_grains.py``
+(DESIGN: network owns the empirical equations), under the same grain names.
+
+>>> grain("soybean").particle_density_kg_m3.value
+1285.0
+>>> grain("oats")
+Traceback (most recent call last):
+...
+ValueError: unknown grain 'oats'; known grains: barley, canola, rough_rice, shelled_corn, sorghum, soybean, wheat
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+__all__ = ["Sourced", "Grain", "GRAINS", "grain", "GRAIN_FIELDS"]
+
+
+@dataclass(frozen=True)
+class Sourced:
+    """One library value with the source it was read from (``value=None``: not found)."""
+
+    value: float | tuple[float, ...] | None
+    source: str
+    note: str = ""
+
+    def __post_init__(self):
+        if self.value is None and not self.note:
+            raise ValueError(f"a missing value needs a note saying so (source {self.source!r})")
+
+
+def _missing(what: str, searched: str) -> Sourced:
+    return Sourced(None, "not found", f"no source found for {what}; searched: {searched}")
+
+
+@dataclass(frozen=True)
+class Grain:
+    """Kernel, bed and contact properties of one crop; every field a :class:`Sourced`."""
+
+    name: str
+    axes_mm: Sourced                #: (length, width, thickness), mm
+    axes_sd_mm: Sourced             #: standard deviations of the three axes, mm
+    particle_density_kg_m3: Sourced  #: true (kernel) density
+    bulk_porosity: Sourced          #: measured loose-fill bulk porosity (low, high)
+    friction_pp: Sourced            #: grain-grain sliding friction coefficient
+    friction_pw: Sourced            #: grain-wall sliding friction coefficient
+    restitution_pp: Sourced         #: grain-grain coefficient of restitution
+    restitution_pw: Sourced         #: grain-wall coefficient of restitution
+
+
+#: the Sourced fields of :class:`Grain`, in order
+GRAIN_FIELDS = ("axes_mm", "axes_sd_mm", "particle_density_kg_m3", "bulk_porosity",
+                "friction_pp", "friction_pw", "restitution_pp", "restitution_pw")
+
+_SD_SEARCH = "the abstracts found report means/ranges only, no standard deviations"
+_THESIS = ("thesis Table 3.1 (seed/thesis.txt; PFC parameters reported by Liu et al. 2008a; "
+           "density and porosity from Milani et al. 2000)")
+_KIBAR = ("Kibar & Ozturk 2008, Physical and mechanical properties of soybean, Int. Agrophys. "
+          "22(3):239-244, abstract; http://www.international-agrophysics.org/"
+          "Physical-and-mechanical-properties-of-soybean,106500,0,2.html")
+_WANDKAR = ("Wandkar, Ukey & Pawar 2012, Determination of physical properties of soybean at "
+            "different moisture levels, Agric Eng Int: CIGR Journal 14(2):138-142, abstract; "
+            "https://pt.scribd.com/document/241390185/1616-pdf")
+_BOAC = ("Boac, Casada, Maghirang & Harner 2010, Material and interaction properties of selected "
+         "grains and oilseeds for modeling discrete particles, Trans. ASABE 53(4), abstract "
+         "(best single-sphere soybean DEM model); https://krex.k-state.edu/signposting/describedby/"
+         "84675692-7dc8-46c6-80c9-f3136172661f")
+_WHEAT_PROPS = ("Moisture-dependent physical properties of wheat, Int. Agrophys. 2003, 17(4):"
+                "207-211 (Univ. of Tehran), abstract; http://www.international-agrophysics.org/"
+                "Moisture-dependent-physical-properties-of-wheat,106749,0,2.html")
+_WHEAT_DEM = ("Calibration of contact parameters between wheat and key components of grain "
+              "leveling robots based on discrete element method, INMATEH 78(1) 2026, "
+              "doi:10.35633/inmateh-78-73, abstract (Wan Ken Mai 22 wheat); https://inmateh.eu/"
+              "volumes/volume-78--no-1--2026/calibration-of-contact-parameters-between-wheat-and-"
+              "key-components-of-grain-leveling-robots-base/")
+_CORN_QPM = ("physical properties of HQPM 5 quality protein maize vs moisture (9-25 % w.b.), "
+             "abstract; https://katalog.lib.cas.cz/KNAV/EdsRecord/edsair,edsair.doi.dedup....."
+             "2effc5a48cff87dba17832cb4c893982")
+_CORN_DARFOUR = ("Darfour, Ayeh, Odoi, Mills & Odoi 2022, Physical characteristics of maize grain "
+                 "as influenced by varietal and moisture differences, Int. J. Food Properties, "
+                 "doi:10.1080/10942912.2022.2077756, abstract; "
+                 "https://bohrium.dp.tech/paper/arxiv/817363054650982401")
+_CORN_DEM = ("Study on the contact parameter calibration of the maize kernel polyhedral discrete "
+             "element model, Agriculture (MDPI), Sep 2024, abstract; https://doaj.org/"
+             "cookie_consent?continue=%2Farticle%2F60ec5dd5f18a46b5848b620b933fdfde")
+_BARLEY_TAV = ("Tavakoli, Tavakoli, Rajabipour, Ahmadi & Gharib-Zahedi 2009, Moisture-dependent "
+               "physical properties of barley grains, Int J Agric & Biol Eng 2(4):84-91, abstract; "
+               "https://ijabe.org/index.php/ijabe/article/view/161")
+_BARLEY_JAST = ("barley varieties Sahra and Valfajr vs moisture 10.12-42.17 % w.b., J. Agric. Sci. "
+                "Technol. (Gorgan Univ.), abstract; http://jast.modares.ac.ir/article-23-10966-en.html")
+_BARLEY_OE = ("Ozturk & Esen 2008, Physical and mechanical properties of barley, Agricultura "
+              "Tropica et Subtropica 41(3), abstract; https://it.scribd.com/document/253876858/Barley")
+_RICE = ("Zareiforoush, Komarizadeh & Alizadeh 2009, Effect of moisture content on some physical "
+         "properties of paddy grains, Res. J. Appl. Sci. Eng. Technol. 1(3):132-139, abstract "
+         "(cultivar Alikazemi); https://studylib.net/doc/13289394/")
+_CANOLA = ("Razavi, Yeganehzad & Sadeghi 2009, Moisture dependent physical properties of canola "
+           "seeds, J. Agric. Sci. Technol. 11(3):309-322, abstract; "
+           "https://profdoc.um.ac.ir/paper-abstract-1011501.html")
+_SORGHUM = ("Effect of moisture content on physical and aerodynamic properties of sorghum, Journal "
+            "of Medical and Bioengineering 2014, abstract (9.06-29.15 % w.b.); https://mdsite.deno."
+            "dev/https://www.academia.edu/106744912/Effect%5Fof%5FMoisture%5FContent%5Fon%5F"
+            "Physical%5Fand%5FAerodynamic%5FProperties%5Fof%5FSorghum")
+_DEM_SEARCH = "DEM calibration abstracts (pages corpus) for this crop gave no value"
+
+GRAINS: dict[str, Grain] = {
+    "soybean": Grain(
+        "soybean",
+        axes_mm=Sourced((7.24, 6.79, 5.78), _KIBAR,
+                        "at 8 % moisture; 7.24-8.19 x 6.79-7.12 x 5.78-6.23 mm over 8-16 %; its "
+                        "geometric mean 6.57 mm matches the thesis bed (5.5-7.5 mm, mean 6.5). "
+                        "Wandkar 2012 gives 6.55 x 5.56 x 4.53 mm at 7.37 % d.b. (smaller beans)"),
+        axes_sd_mm=_missing("the axis standard deviations", _SD_SEARCH),
+        particle_density_kg_m3=Sourced(1285.0, _THESIS,
+                                       "Wandkar 2012: 1250-1111 kg/m^3 (7.37-15.80 % d.b.); "
+                                       "Kibar 2008: 983-906 kg/m^3 (rejected: below water, and "
+                                       "its 21-23 % porosity is no loose fill)"),
+        bulk_porosity=Sourced((0.4007, 0.419), _WANDKAR,
+                              "40.07-41.9 % over 7.37-15.80 % d.b.; thesis Table 3.1: 0.408"),
+        friction_pp=Sourced(0.47, _THESIS, "direct shear (Liu et al. 2008a); Boac 2010 DEM "
+                            "calibration: 0.45"),
+        friction_pw=Sourced(0.3, _THESIS, "against Plexiglass; Boac 2010: 0.30 against steel; "
+                            "Kibar 2008: galvanized steel 0.164-0.286, wood 0.304-0.441"),
+        restitution_pp=Sourced(0.6, _BOAC, "calibrated particle restitution of the best model"),
+        restitution_pw=_missing("a soybean-wall restitution",
+                                "Boac 2010 abstract gives one particle restitution only"),
+    ),
+    "wheat": Grain(
+        "wheat",
+        axes_mm=Sourced((7.08, 3.27, 2.98), _WHEAT_PROPS,
+                        "mean of five varieties at 7.4 % d.b."),
+        axes_sd_mm=_missing("the axis standard deviations", _SD_SEARCH),
+        particle_density_kg_m3=Sourced(1240.0, _WHEAT_PROPS,
+                                       "dry end of 1240-847.2 kg/m^3 over 0-22 % d.b. (rewetted "
+                                       "wheat; the wet end is below water and not used)"),
+        bulk_porosity=_missing("a measured wheat bulk porosity",
+                               "the wheat abstract says only that porosity increased; the bulk/true "
+                               "density pairs it gives do not reproduce that trend, so none is derived"),
+        friction_pp=Sourced(0.53, _WHEAT_DEM, "wheat-wheat static friction; rolling 0.04"),
+        friction_pw=Sourced(0.5023, _WHEAT_DEM, "wheat-steel static friction; rolling 0.111; "
+                            "the 2003 wheat abstract: 0.279-0.450 over several surfaces"),
+        restitution_pp=Sourced(0.52, _WHEAT_DEM, "wheat-wheat"),
+        restitution_pw=Sourced(0.47, _WHEAT_DEM, "wheat-steel"),
+    ),
+    "shelled_corn": Grain(
+        "shelled_corn",
+        axes_mm=Sourced((9.2476, 7.8684, 3.8572), _CORN_QPM,
+                        "at 9 % w.b. (one quality-protein variety); 9.25-10.20 x 7.87-8.26 x "
+                        "3.86-4.71 mm over 9-25 % w.b.; issue 15 quotes about 12 x 8 x 4.5 mm "
+                        "(no source found for that triple)"),
+        axes_sd_mm=_missing("the axis standard deviations", _SD_SEARCH),
+        particle_density_kg_m3=Sourced(1250.0, _CORN_DARFOUR,
+                                       "five Ghanaian varieties; constant with moisture"),
+        bulk_porosity=Sourced((0.4032, 0.4324), _CORN_DARFOUR, "40.32-43.24 %"),
+        friction_pp=Sourced(0.182, _CORN_DEM, "maize-maize static friction calibrated for a "
+                            "polyhedral kernel model (a sphere or clump model needs its own)"),
+        friction_pw=Sourced(0.545, _CORN_DEM, "maize-steel, measured on an inclined plane"),
+        restitution_pp=Sourced(0.318, _CORN_DEM, "maize-maize, calibrated"),
+        restitution_pw=Sourced(0.5, _CORN_DEM, "maize-steel, measured"),
+    ),
+    "barley": Grain(
+        "barley",
+        axes_mm=Sourced((8.91, 3.30, 2.58), _BARLEY_TAV,
+                        "at 7.34 % d.b.; 8.91-9.64 x 3.30-3.74 x 2.58-2.98 mm to 21.58 % d.b."),
+        axes_sd_mm=_missing("the axis standard deviations", _SD_SEARCH),
+        particle_density_kg_m3=Sourced(1099.65, _BARLEY_JAST,
+                                       "variety Sahra at 10.12 % w.b. (1099.65-1245.72 kg/m^3); "
+                                       "Valfajr 1410.82-1230.61; Ozturk & Esen 2008: 984-1014 "
+                                       "(rejected: about water, porosity inconsistent)"),
+        bulk_porosity=Sourced((0.385, 0.4834), "low: " + _BARLEY_OE + "; high: " + _BARLEY_JAST,
+                              "0.385 at 14 % d.b. (Ozturk & Esen); 0.4834 Sahra at 10.12 % w.b. "
+                              "(to 0.5074 at 42 % w.b.; Valfajr 0.51-0.59)"),
+        friction_pp=_missing("a barley grain-grain DEM friction", _DEM_SEARCH),
+        friction_pw=Sourced(0.773, _BARLEY_OE, "galvanized steel, 0.773-0.920 over 10-14 % d.b. "
+                            "(concrete 0.877-0.993, wood 0.560-0.713)"),
+        restitution_pp=_missing("a barley restitution", _DEM_SEARCH),
+        restitution_pw=_missing("a barley-wall restitution", _DEM_SEARCH),
+    ),
+    "rough_rice": Grain(
+        "rough_rice",
+        axes_mm=Sourced((9.83, 2.65, 1.92), _RICE,
+                        "cultivar Alikazemi at 8 % d.b. (to 10.05 x 2.76 x 2.01 at 21 %); "
+                        "Hashemi 10.20 x 2.31 x 1.85"),
+        axes_sd_mm=_missing("the axis standard deviations", _SD_SEARCH),
+        particle_density_kg_m3=_missing("a rough-rice true density",
+                                        "Ashtiani et al. 2010 and Zareiforoush 2009 abstracts "
+                                        "give trends, not values"),
+        bulk_porosity=_missing("a rough-rice loose-fill porosity",
+                               "abstracts found give trends or one-variety values without the "
+                               "fill method"),
+        friction_pp=_missing("a rough-rice grain-grain DEM friction", _DEM_SEARCH),
+        friction_pw=Sourced(0.4179, _RICE, "galvanized iron sheet, Alikazemi, 0.4179-0.4965 "
+                            "over 8-21 % d.b. (glass 0.3168-0.4369, plywood 0.4394-0.5264)"),
+        restitution_pp=_missing("a rough-rice restitution", _DEM_SEARCH),
+        restitution_pw=_missing("a rough-rice-wall restitution", _DEM_SEARCH),
+    ),
+    "canola": Grain(
+        "canola",
+        axes_mm=Sourced((1.925, 1.475, 1.475), _CANOLA,
+                        "length 1.925-2.262 mm and diameter 1.475-1.911 mm over 5.27-23.69 % "
+                        "w.b. (four varieties); width = thickness = the reported diameter"),
+        axes_sd_mm=_missing("the axis standard deviations", _SD_SEARCH),
+        particle_density_kg_m3=_missing("a canola true density",
+                                        "Razavi 2009 abstract gives bulk density 666-739 kg/m^3 "
+                                        "only"),
+        bulk_porosity=_missing("a canola loose-fill porosity",
+                               "Razavi 2009 abstract gives no porosity"),
+        friction_pp=_missing("a canola grain-grain DEM friction",
+                             "Cao et al. 2021 Processes 9:605 (rapeseed DEM) abstract gives no "
+                             "values"),
+        friction_pw=Sourced(0.301, _CANOLA, "galvanized iron sheet, 0.301-0.419 (rubber "
+                            "0.372-0.460, glass 0.253-0.392)"),
+        restitution_pp=_missing("a canola restitution", "Cao et al. 2021 abstract gives no values"),
+        restitution_pw=_missing("a canola-wall restitution",
+                                "Cao et al. 2021 abstract gives no values"),
+    ),
+    "sorghum": Grain(
+        "sorghum",
+        axes_mm=Sourced((4.45, 3.86, 2.49), _SORGHUM,
+                        "at 9.06 % w.b.; 4.45-4.65 x 3.86-4.16 x 2.49-2.72 mm to 29.15 %"),
+        axes_sd_mm=_missing("the axis standard deviations", _SD_SEARCH),
+        particle_density_kg_m3=Sourced(1257.33, _SORGHUM, "1257.33-1126.72 kg/m^3 over the series"),
+        bulk_porosity=Sourced((0.3515, 0.3675), _SORGHUM, "35.15-36.75 %"),
+        friction_pp=_missing("a sorghum grain-grain DEM friction", _DEM_SEARCH),
+        friction_pw=Sourced(0.32, _SORGHUM, "iron, 0.32-0.43 (acrylic 0.25-0.48, zinc 0.21-0.42)"),
+        restitution_pp=_missing("a sorghum restitution", _DEM_SEARCH),
+        restitution_pw=_missing("a sorghum-wall restitution", _DEM_SEARCH),
+    ),
+}
+
+
+def grain(name: str) -> Grain:
+    """The library entry of ``name`` (case and ``-``/space insensitive); ValueError lists the known.
+
+    >>> grain("Shelled corn").name
+    'shelled_corn'
+    """
+    key = str(name).strip().lower().replace("-", "_").replace(" ", "_")
+    try:
+        return GRAINS[key]
+    except KeyError:
+        raise ValueError(f"unknown grain {name!r}; known grains: "
+                         f"{', '.join(sorted(GRAINS))}") from None

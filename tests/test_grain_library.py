@@ -1,0 +1,116 @@
+"""The grain library (issue 16 item 1): every value sourced or marked not found, every number
+physically sensible, the D272 soybean check of the thesis, and one set of grain names."""
+
+import math
+
+import pytest
+
+from dem.grains import GRAIN_FIELDS, GRAINS, Grain, Sourced, grain
+from network._grains import D272, D272Constants
+
+#: physically sensible bounds for these crops (kernel densities above water, loose-fill
+#: porosities, friction and restitution coefficients, kernel axes from canola to corn)
+BOUNDS = {
+    "particle_density_kg_m3": (1000.0, 1500.0),
+    "bulk_porosity": (0.3, 0.5),
+    "friction_pp": (0.1, 1.0),
+    "friction_pw": (0.1, 1.0),
+    "restitution_pp": (0.1, 0.95),
+    "restitution_pw": (0.1, 0.95),
+    "axes_mm": (1.0, 15.0),
+    "axes_sd_mm": (0.0, 3.0),
+}
+
+
+@pytest.mark.parametrize("name", sorted(GRAINS))
+def test_every_field_sourced_or_marked_not_found(name):
+    g = GRAINS[name]
+    assert isinstance(g, Grain) and g.name == name
+    for field in GRAIN_FIELDS:
+        v = getattr(g, field)
+        assert isinstance(v, Sourced), field
+        if v.value is None:
+            assert "not found" in v.source or "no source" in v.note, (name, field)
+            assert v.note
+        else:
+            assert len(v.source) > 20 and v.source != "not found", (name, field)
+
+
+@pytest.mark.parametrize("name", sorted(GRAINS))
+def test_numbers_positive_and_sensible(name):
+    g = GRAINS[name]
+    for field in GRAIN_FIELDS:
+        v = getattr(g, field).value
+        if v is None:
+            continue
+        lo, hi = BOUNDS[field]
+        for x in (v if isinstance(v, tuple) else (v,)):
+            assert math.isfinite(x) and x > 0 and lo <= x <= hi, (name, field, x)
+    if g.axes_mm.value is not None:
+        length, width, thickness = g.axes_mm.value
+        assert length >= width >= thickness
+    if g.bulk_porosity.value is not None:
+        lo, hi = g.bulk_porosity.value
+        assert lo <= hi
+
+
+def test_frozen():
+    with pytest.raises(Exception):
+        GRAINS["soybean"].name = "x"
+
+
+def test_missing_value_needs_a_note():
+    with pytest.raises(ValueError, match="note"):
+        Sourced(None, "somewhere")
+
+
+def test_unknown_grain_lists_the_known_ones():
+    with pytest.raises(ValueError) as e:
+        grain("oats")
+    for name in GRAINS:
+        assert name in str(e.value)
+    assert grain(" Shelled-Corn ") is GRAINS["shelled_corn"]
+
+
+def test_soybean_is_the_thesis_bed():
+    s = grain("soybean")
+    assert s.particle_density_kg_m3.value == 1285.0
+    lo, hi = s.bulk_porosity.value
+    assert lo <= 0.408 <= hi
+    assert s.friction_pp.value == 0.47 and s.friction_pw.value == 0.3
+
+
+def test_same_grain_names():
+    assert set(D272) == set(GRAINS)
+
+
+@pytest.mark.parametrize("name", sorted(D272))
+def test_d272_entries(name):
+    c = D272[name]
+    assert isinstance(c, D272Constants) and c.edition.startswith("ASABE D272")
+    if c.a_pa_s2_m3 is None or c.b_s_m is None:
+        assert c.a_pa_s2_m3 is None and c.b_s_m is None and "not found" in c.note
+    else:
+        assert c.a_pa_s2_m3 > 0 and c.b_s_m > 0 and "D272" in c.source
+    for rng in (c.velocity_range_m_s, c.airflow_range_m3_min_m2):
+        if rng is not None:
+            assert 0 < rng[0] < rng[1]
+
+
+def test_d272_soybean_gives_the_thesis_check():
+    """Thesis 4.2.3 / Table 4.5: 2.28 Pa over 0.25 m at 0.013 m/s (and 5.18 Pa at 0.027 m/s)."""
+    c = D272["soybean"]
+    assert (c.a_pa_s2_m3, c.b_s_m) == (1.02e4, 16.0)
+
+    def dp(u, depth):
+        return depth * c.a_pa_s2_m3 * u**2 / math.log1p(c.b_s_m * u)
+
+    assert dp(0.013, 0.25) == pytest.approx(2.28, abs=0.005)
+    assert dp(0.027, 0.25) == pytest.approx(5.18, abs=0.005)
+
+
+def test_d272_soybean_agrees_with_the_empirical_module():
+    from network.flow import ASABE_SOYBEAN_A, ASABE_SOYBEAN_B
+
+    assert (ASABE_SOYBEAN_A, ASABE_SOYBEAN_B) == (D272["soybean"].a_pa_s2_m3,
+                                                  D272["soybean"].b_s_m)
