@@ -16,8 +16,11 @@ contraction to a vena contracta :math:`C_c = 1 - (1-\sigma)/(2.08(1-\sigma)+0.53
 reversible Bernoulli parts, :math:`\pm(1-\sigma^2)`, change the static pressure of a body by
 its own kinetic energy and cancel along every path between inlet and outlet bodies; they are
 left out so that every conduit's law is monotone (Newton's Jacobian stays a weighted graph
-Laplacian). No coefficient is fitted to bed-scale data. Derivation, measured onset and the
-validation: ``docs/inertial-flow.md``.
+Laplacian). ``profile='laminar'`` takes the expansion's momentum and energy balances with the
+Poiseuille-tube profile coefficients (alpha 2, beta 4/3) instead of flat ones; the weak-inertia
+onset is the solver's (:func:`network.flow.conduit_flow`, ``crossover``). No coefficient is
+fitted to bed-scale data. Derivation, measured onset and the validation against the LBM drag
+laws: ``docs/inertial-flow.md``.
 """
 
 from __future__ import annotations

@@ -7,14 +7,19 @@ signed flow is the monotone function
 .. math:: q(\Delta p) = \frac{2\,\Delta p}{1/g + \sqrt{1/g^2 + 4K|\Delta p|}},\qquad
           \frac{dq}{d\Delta p} = w = \frac{1}{1/g + 2K|q|} \in (0, g].
 
+With ``crossover`` :math:`X_c` the inertial term has a weak-inertia onset,
+:math:`K q|q|\,X/(X_c+X)`, :math:`X = Kg|q|`: its excess over the viscous drop starts as
+:math:`X^2/X_c` (Re² per conduit, the minimum-dissipation argument of
+``docs/inertial-flow.md``) and tends to :math:`Kq|q|` at high Re.
+
 The unknowns are the free pore pressures and the common inlet pressure P (outlet pores at 0);
 the equations are mass balance in every free pore and a total inlet flow :math:`Q = UA`. The
 Jacobian is the graph Laplacian of the weights w, condensed like the Stokes system, with one
 extra row for P: the Laplacian with all inlet pores merged into one node, SPD, its CSR pattern
 built once. A Newton step is one CG solve of that bordered system, preconditioned by the held
-AMG hierarchy of the Stokes matrix on the free block and :math:`1/J_{PP}` on the inlet node
-(the hierarchy rebuilt on the Jacobian's free block only when CG needs more than 40
-iterations), with backtracking on the residual.
+AMG hierarchy of the Stokes matrix as the free block's inverse inside an exact block inverse
+(one V-cycle per application; the hierarchy rebuilt on the Jacobian's free block only when
+CG needs more than 40 iterations), with backtracking on the residual.
 At K = 0 the first step from zero is the Stokes solution. Velocities are solved in ascending
 order from the previous solution, every pore pressure extrapolated by its own power law of the
 last two points.
@@ -164,17 +169,28 @@ def solve_inertial(n_pores, conns, g, K, inlet, outlet, flows_m3_s, *, tol: floa
         return np.append(net[free], net[inlet].sum() - Q), q, w
 
     def solve(Jw, b, eta):
-        """Bordered system: CG with AMG on the free block and 1/J_PP on the inlet node."""
-        def apply(r):
-            return np.append(state["prec"].matvec(r[:nf]), r[nf] / Jw[nf, nf])
-        M = spla.LinearOperator(Jw.shape, matvec=apply, dtype=float)
-        x, info = _cg(Jw, b, M, eta)
+        """Bordered system by CG; preconditioner: the exact block inverse of
+        [[M^-1, j], [j^T, J_PP]] with M the AMG V-cycle of the free block (one V-cycle)."""
+        def prec():
+            Mf = state["prec"].matvec
+            jf = Jw[[nf], :nf].toarray().ravel()
+            z = Mf(jf)
+            schur = Jw[nf, nf] - jf @ z
+            if not schur > 0:                   # V-cycle too far off: block diagonal
+                z, schur = np.zeros(nf), Jw[nf, nf]
+
+            def apply(r):
+                yP = (r[nf] - z @ r[:nf]) / schur
+                return np.append(Mf(r[:nf]) - z * yP, yP)
+            return spla.LinearOperator(Jw.shape, matvec=apply, dtype=float)
+
+        x, info = _cg(Jw, b, prec(), eta)
         if info[1] > _REBUILD_ITERATIONS:
             log.info("CG needed %d iterations on the Jacobian: building its own hierarchy",
                      info[1])
             state["amg"] = AMGSolver(Jw[:nf, :nf], smoother="forward-backward")
             state["prec"] = state["amg"].preconditioner()
-            x, info2 = _cg(Jw, b, M, eta)
+            x, info2 = _cg(Jw, b, prec(), eta)
             info = (info2[0], info[1] + info2[1])
         return x, info
 
@@ -205,6 +221,7 @@ def solve_inertial(n_pores, conns, g, K, inlet, outlet, flows_m3_s, *, tol: floa
             with threadpool_limits(limits=1, user_api="blas"):
                 x, info = solve(J.matrix(w), -r, eta)
             cg_it += info[1]
+            log.debug("Newton %d: residual %.2e, eta %.1e, %d CG", it, rel, eta, info[1])
             dp = np.zeros(n_pores)
             dp[free] = x[:nf]
             dp[inlet] = x[nf]
