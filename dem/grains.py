@@ -87,6 +87,9 @@ _WHEAT_DEM = ("Calibration of contact parameters between wheat and key component
               "doi:10.35633/inmateh-78-73, abstract (Wan Ken Mai 22 wheat); https://inmateh.eu/"
               "volumes/volume-78--no-1--2026/calibration-of-contact-parameters-between-wheat-and-"
               "key-components-of-grain-leveling-robots-base/")
+_WHEAT_RAMAJ = ("Ramaj, Schock, Karaj & Mueller 2022, Influence of self-compaction on the airflow "
+                "resistance of aerated wheat bulks, Appl. Sci. 12(17):8909, abstract; "
+                "https://ouci.dntb.gov.ua/works/7BABw8B9 (doi:10.3390/app12178909)")
 _CORN_QPM = ("physical properties of HQPM 5 quality protein maize vs moisture (9-25 % w.b.), "
              "abstract; https://katalog.lib.cas.cz/KNAV/EdsRecord/edsair,edsair.doi.dedup....."
              "2effc5a48cff87dba17832cb4c893982")
@@ -146,9 +149,10 @@ GRAINS: dict[str, Grain] = {
         particle_density_kg_m3=Sourced(1240.0, _WHEAT_PROPS,
                                        "dry end of 1240-847.2 kg/m^3 over 0-22 % d.b. (rewetted "
                                        "wheat; the wet end is below water and not used)"),
-        bulk_porosity=_missing("a measured wheat bulk porosity",
-                               "the wheat abstract says only that porosity increased; the bulk/true "
-                               "density pairs it gives do not reproduce that trend, so none is derived"),
+        bulk_porosity=Sourced((0.391, 0.413), _WHEAT_RAMAJ,
+                              "in-bin pore volume after 1 h at bulk depths 3.4 m and 1.0 m (cv. "
+                              "Pionier, 0.123 kg/kg d.b.; 0.370 after 236 h of self-compaction); "
+                              "the 2003 abstract gives no porosity value"),
         friction_pp=Sourced(0.53, _WHEAT_DEM, "wheat-wheat static friction; rolling 0.04"),
         friction_pw=Sourced(0.5023, _WHEAT_DEM, "wheat-steel static friction; rolling 0.111; "
                             "the 2003 wheat abstract: 0.279-0.450 over several surfaces"),
