@@ -76,7 +76,7 @@ _WANDKAR = ("Wandkar, Ukey & Pawar 2012, Determination of physical properties of
             "different moisture levels, Agric Eng Int: CIGR Journal 14(2):138-142, abstract; "
             "https://pt.scribd.com/document/241390185/1616-pdf")
 _BOAC = ("Boac, Casada, Maghirang & Harner 2010, Material and interaction properties of selected "
-         "grains and oilseeds for modeling discrete particles, Trans. ASABE 53(4), abstract "
+         "grains and oilseeds for modeling discrete particles, Trans. ASABE (2010), abstract "
          "(best single-sphere soybean DEM model); https://krex.k-state.edu/signposting/describedby/"
          "84675692-7dc8-46c6-80c9-f3136172661f")
 _WHEAT_PROPS = ("Moisture-dependent physical properties of wheat, Int. Agrophys. 2003, 17(4):"
@@ -110,7 +110,7 @@ _BARLEY_OE = ("Ozturk & Esen 2008, Physical and mechanical properties of barley,
 _RICE = ("Zareiforoush, Komarizadeh & Alizadeh 2009, Effect of moisture content on some physical "
          "properties of paddy grains, Res. J. Appl. Sci. Eng. Technol. 1(3):132-139, abstract "
          "(cultivar Alikazemi); https://studylib.net/doc/13289394/")
-_CANOLA = ("Razavi, Yeganehzad & Sadeghi 2009, Moisture dependent physical properties of canola "
+_CANOLA = ("Razavi, Yeganehzad et al. 2009, Moisture dependent physical properties of canola "
            "seeds, J. Agric. Sci. Technol. 11(3):309-322, abstract; "
            "https://profdoc.um.ac.ir/paper-abstract-1011501.html")
 _SORGHUM = ("Effect of moisture content on physical and aerodynamic properties of sorghum, Journal "
