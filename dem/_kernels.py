@@ -159,9 +159,8 @@ def particle_update(x, v, w, r, ms, gforce, first_start, second_start, by_second
             vz = v[p, 2] - vwz + (ax * ny - ay * nx)
             cn = 2.0 * beta * np.sqrt(ms[p] * kn_w)
             ct = 2.0 * beta * np.sqrt(ms[p] * ks_w)
-            # the history is read as zero: what the numpy engine did (it cleared the previous step's
-            # wall springs before reading them); kept here to verify the port bit for bit
-            out = contact_law(ov, nx, ny, nz, vx, vy, vz, 0.0, 0.0, 0.0, kn_w, ks_w, cn, ct, mu_w, dt)
+            out = contact_law(ov, nx, ny, nz, vx, vy, vz, wall_shear[m, p, 0], wall_shear[m, p, 1],
+                              wall_shear[m, p, 2], kn_w, ks_w, cn, ct, mu_w, dt)
             wfx += out[0]
             wfy += out[1]
             wfz += out[2]

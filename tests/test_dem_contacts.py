@@ -96,6 +96,24 @@ def test_friction_threshold_on_incline(mu, slides):
         assert speed < 1e-4
 
 
+def test_wall_spring_holds_a_block_on_an_incline():
+    # Static friction needs the shear spring's history: a block (spin held at 0) on a 25 deg
+    # wall with mu = 0.6 > tan 25 comes to rest with k_s |xi| = m g sin 25, i.e.
+    # |xi| = 1.848e-4 kg * 9.81 * 0.4226 / 1.636e6 N/m = 4.68e-10 m. (The numpy engine, and the
+    # numba port 4b675fe that copied it, dropped the wall spring every step: the block crept
+    # at 1.2e-4 m/s.)
+    angle = np.deg2rad(25.0)
+    n = np.array([-np.sin(angle), 0.0, np.cos(angle)])
+    mat = Material(wall_friction=0.6)  # damping ratio 0.1
+    sim = Simulation([n * (R - 1e-7)], [R], [PlaneWall((0, 0, 0), tuple(n), "incline")], mat)
+    for _ in range(10000):
+        sim.spins[:] = 0.0
+        sim.step()
+    assert np.linalg.norm(sim.velocities[0]) < 1e-9
+    xi = np.linalg.norm(sim.wall_shear[0, 0])
+    assert xi == pytest.approx(sim.mass[0] * 9.81 * np.sin(angle) / mat.ks_pw, rel=1e-6)
+
+
 def test_energy_is_conserved_without_damping():
     # 27 spheres in a closed box with gravity, no damping, no friction: E = KE + PE stays
     # constant to O(dt) (symplectic Euler); we allow 1 % of the initial kinetic energy.
