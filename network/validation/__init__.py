@@ -5,6 +5,7 @@ from ._inertial_cases import (FINNEY_PATH, InertialCase, finney_inertial_case,
                               lattice_inertial_case, random_inertial_case,
                               solve_sample_curve)
 from ._cases import ESTIMATORS, lattice_sample_permeability, random_sample_permeability
+from ._periodic import periodic_permeability
 from ._references import (STOKES_CELL_BCC, STOKES_CELL_FCC, ZICK_HOMSY_SC, beetstra_permeability,
                           beetstra_stokes_drag, computed_lattice_permeability,
                           drag_to_permeability, ergun_viscous_permeability,
@@ -16,5 +17,5 @@ __all__ = ["DRAG_LAWS", "ESTIMATORS", "FINNEY_PATH", "InertialCase", "beetstra_d
            "lattice_inertial_case", "random_inertial_case", "STOKES_CELL_BCC", "STOKES_CELL_FCC", "ZICK_HOMSY_SC",
            "beetstra_permeability", "beetstra_stokes_drag", "computed_lattice_permeability",
            "drag_to_permeability", "ergun_viscous_permeability", "kozeny_carman_permeability",
-           "lattice_permeability", "lattice_sample_permeability", "random_sample_permeability",
+           "lattice_permeability", "lattice_sample_permeability", "periodic_permeability", "random_sample_permeability",
            "sangani_acrivos_sc_drag", "solve_sample_curve", "zick_homsy_sc_drag"]
