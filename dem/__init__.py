@@ -12,7 +12,8 @@ pack_bed(container, *, porosity=0.408, rng=None, procedure='lid'|'sediment', ...
     rect-bin default (``SCENE_DEFAULTS``), the only way found to its 0.408 ± 0.01 target with
     overlaps below 1 % of a radius (0.415 interior; numbers in ``docs/dem-packing.md``).
 vibrate_bed(centers, radii, container, *, freq_hz, amplitude_m, duration_s, ...) -> VibrationResult
-    Sinusoidal vertical motion of the bin (Eq. 3.11) with porosity histories.
+    Sinusoidal vertical motion of the bin (Eq. 3.11) with porosity histories, steady stop and
+    checkpoints to resume from; rest_motion tells whether a packing is at rest.
 Simulation, DemInstabilityError, PlaneWall, CylinderWall
     The time integrator (Verlet list, linear spring–dashpot–Coulomb contacts, walls).
 linear_contact_forces, series_stiffness, damping_coefficient, restitution_coefficient
@@ -24,7 +25,8 @@ generate_spheres, thesis_particle_count, intensity_g
 write_packing, read_packing
     CSV ``x,y,z,r`` (m) + JSON summary.
 
-CLIs: ``python -m dem.pack``, ``python -m dem.vibrate``, ``python -m dem.bench``.
+CLIs: ``python -m dem.pack``, ``python -m dem.vibrate`` (``--study thesis``: the thesis's vibration study,
+:mod:`dem.study`), ``python -m dem.bench``.
 
 Model and approximations (each measured by ``dem.bench`` or stated in the JSON summaries)
 -------------------------------------------------------------------------------------------
@@ -36,11 +38,12 @@ Model and approximations (each measured by ``dem.bench`` or stated in the JSON s
   radius in the 0.25 m beds); its effect on porosity and coordination is measured with
   ``python -m dem.bench --mass-scale-study``.
 * Equilibrium: mean unbalanced-force ratio below ``tol`` (default 2e-3).
-* Vibration runs shorter than the thesis's 16 s; the histories show how far the bed got.
+* Vibration runs shorter than the thesis's 16 s where stated; the histories show how far the bed got.
 """
 
 from ._contacts import damping_coefficient, linear_contact_forces, restitution_coefficient, series_stiffness
-from ._integrate import SOYBEAN, DemInstabilityError, Material, Simulation
+from ._integrate import DemInstabilityError, Simulation
+from ._material import SOYBEAN, Material
 from ._io import read_packing, write_packing
 from ._measure import Region, coordination_numbers, porosity_in_region, porosity_in_spheres
 from ._container import SCENE_DEFAULTS, SCENES, Container, default_measure_spheres, scene_container
@@ -48,7 +51,7 @@ from ._fill import generate_spheres, thesis_particle_count
 from ._measure import lens_volume, sphere_volume
 from ._procedures import PROCEDURES, PackResult, pack_bed
 from ._summary import summarize, surface_height
-from ._vibrate import VibrationResult, intensity_g, vibrate_bed
+from ._vibrate import VibrationResult, intensity_g, rest_motion, vibrate_bed
 from ._walls import CylinderWall, PlaneWall
 
 __all__ = [
@@ -60,5 +63,5 @@ __all__ = [
     "read_packing", "write_packing",
     # added by issue 12 (public names the tests and CLIs use instead of private modules)
     "PlaneWall", "CylinderWall", "generate_spheres", "default_measure_spheres", "surface_height",
-    "lens_volume", "sphere_volume", "intensity_g",
+    "lens_volume", "sphere_volume", "intensity_g", "rest_motion",
 ]

@@ -14,7 +14,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ._integrate import SOYBEAN, Simulation
+from ._integrate import Simulation
+from ._material import SOYBEAN
 from ._measure import Region
 from ._walls import CylinderWall, PlaneWall
 

@@ -10,7 +10,7 @@ from __future__ import annotations
 import numpy as np
 from scipy.spatial import cKDTree
 
-from ._integrate import SOYBEAN
+from ._material import SOYBEAN
 
 __all__ = ["KEPLER_POROSITY", "thesis_particle_count", "check_fill", "generate_spheres"]
 

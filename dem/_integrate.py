@@ -28,17 +28,16 @@ from __future__ import annotations
 
 import logging
 import time
-from dataclasses import dataclass
 
 import numpy as np
 
-from ._contacts import series_stiffness
 from ._kernels import pair_damping, pair_forces, particle_update
+from ._material import SOYBEAN, Material
 from ._neighbors import VerletList, remap_history
 from ._threads import ThreadChooser
 from ._walls import CylinderWall, PlaneWall
 
-__all__ = ["Material", "Simulation", "DemInstabilityError", "SOYBEAN"]
+__all__ = ["Simulation", "DemInstabilityError"]
 
 log = logging.getLogger(__name__)
 
@@ -47,61 +46,6 @@ class DemInstabilityError(RuntimeError):
     """The simulation blew up (energy growth, NaN, particles through walls)."""
 
 
-@dataclass(frozen=True)
-class Material:
-    """Grain and wall properties (defaults: soybean in Plexiglas, thesis Table 3.1).
-
-    Stiffnesses are per-entity values as in PFC3D; a contact uses the series
-    combination (:func:`dem._contacts.series_stiffness`).
-    """
-
-    density_kg_m3: float = 1285.0
-    kn_n_m: float = 4.0e6
-    ks_n_m: float = 2.0e6
-    friction: float = 0.47
-    wall_kn_n_m: float = 1.8e7
-    wall_ks_n_m: float = 0.9e7
-    wall_friction: float = 0.3
-    damping_ratio: float = 0.1
-    radius_min_m: float = 0.00275
-    radius_max_m: float = 0.00375
-
-    def __post_init__(self):
-        for name in ("density_kg_m3", "kn_n_m", "ks_n_m", "wall_kn_n_m", "wall_ks_n_m"):
-            v = getattr(self, name)
-            if not (np.isfinite(v) and v > 0):
-                raise ValueError(f"{name} must be positive and finite, got {v}")
-        for name in ("friction", "wall_friction"):
-            v = getattr(self, name)
-            if not (np.isfinite(v) and v >= 0):
-                raise ValueError(f"{name} must be >= 0, got {v}")
-        if not 0 <= self.damping_ratio < 1:
-            raise ValueError(f"damping_ratio must be in [0, 1), got {self.damping_ratio}")
-        if not 0 < self.radius_min_m <= self.radius_max_m:
-            raise ValueError(
-                f"need 0 < radius_min_m <= radius_max_m, got {self.radius_min_m}, {self.radius_max_m}"
-            )
-
-    @property
-    def kn_pp(self):
-        """Particle–particle contact normal stiffness, N/m."""
-        return float(series_stiffness(self.kn_n_m, self.kn_n_m))
-
-    @property
-    def ks_pp(self):
-        return float(series_stiffness(self.ks_n_m, self.ks_n_m))
-
-    @property
-    def kn_pw(self):
-        """Particle–wall contact normal stiffness, N/m."""
-        return float(series_stiffness(self.kn_n_m, self.wall_kn_n_m))
-
-    @property
-    def ks_pw(self):
-        return float(series_stiffness(self.ks_n_m, self.wall_ks_n_m))
-
-
-SOYBEAN = Material()
 
 
 def _dot(a, b):
@@ -311,6 +255,33 @@ class Simulation:
         """(Nc, 2) pairs in contact at the last force evaluation."""
         return self.verlet.pairs[self._touch.view(bool)]
 
+    def get_state(self):
+        """Everything a continued run needs, as arrays: positions, velocities, spins, radii, time,
+        step count, container motion and the contact springs (pair keys i*N+j with their
+        history, the wall springs). :meth:`set_state` on a Simulation with the same walls and
+        material continues bit for bit as if never stopped (the Verlet list is rebuilt, which
+        does not change any number)."""
+        return {"centers": self._x.copy(), "velocities": self._v.copy(), "spins": self._w.copy(),
+                "radii": self.radii.copy(), "time_s": np.float64(self.time_s), "steps": np.int64(self.steps),
+                "z_offset_m": np.float64(self.z_offset_m), "wall_vz_m_s": np.float64(self.wall_vz_m_s),
+                "pair_keys": self.verlet.keys.copy(), "pair_history": np.column_stack([self.shear, self._touch]),
+                "wall_shear": self.wall_shear.copy(), "wall_touch": self._wall_touch.copy()}
+
+    def set_state(self, state):
+        """Continue from :meth:`get_state` (same particles, walls and material)."""
+        if state["centers"].shape != self._x.shape or state["wall_shear"].shape != self.wall_shear.shape:
+            raise ValueError(f"state of {state['centers'].shape[0]} particles and {state['wall_shear'].shape[0]} "
+                             f"walls does not fit {self.n} particles and {len(self.walls)} walls")
+        self._x[:], self._v[:], self._w[:] = state["centers"], state["velocities"], state["spins"]
+        self._set_radii(np.array(state["radii"], dtype=float))
+        self.time_s, self.steps = float(state["time_s"]), int(state["steps"])
+        self.z_offset_m, self.wall_vz_m_s = float(state["z_offset_m"]), float(state["wall_vz_m_s"])
+        self.verlet.build(self._x, self.radii)
+        self._set_pairs(remap_history(np.asarray(state["pair_keys"]), np.asarray(state["pair_history"], dtype=float),
+                                      self.verlet.keys))
+        self.wall_shear[:] = state["wall_shear"]
+        self._wall_touch[:] = state["wall_touch"]
+
     # ------------------------------------------------------------------ stepping
     def step(self):
         """Advance one time step; returns the net force, (3, N) component-first, N."""
@@ -332,26 +303,32 @@ class Simulation:
 
     def check_stability(self, *, max_speed_m_s=20.0, max_overlap_fraction=0.5):
         """Raise DemInstabilityError on NaN, runaway speeds, deep overlaps or escapes."""
-        if not np.all(np.isfinite(self.centers)) or not np.all(np.isfinite(self.velocities)):
+        bad = ~(np.all(np.isfinite(self._x), axis=1) & np.all(np.isfinite(self._v), axis=1))
+        if np.any(bad):
             raise DemInstabilityError(
-                f"non-finite positions/velocities at t = {self.time_s:.4g} s (step {self.steps}); "
-                "reduce dt_safety or mass_scale"
+                f"non-finite position/velocity of particle #{int(np.flatnonzero(bad)[0])} at t = "
+                f"{self.time_s:.4g} s (step {self.steps}); reduce dt_safety or mass_scale"
             )
-        vmax = float(np.sqrt(np.max(_dot(self._v.T, self._v.T))))
+        speed2 = _dot(self._v.T, self._v.T)
+        k = int(np.argmax(speed2))
+        vmax = float(np.sqrt(speed2[k]))
         if vmax > max_speed_m_s:
             raise DemInstabilityError(
-                f"particle speed {vmax:.3g} m/s exceeds {max_speed_m_s} m/s at t = {self.time_s:.4g} s "
-                f"(step {self.steps}): energy blow-up; reduce dt_safety or mass_scale"
+                f"particle #{k} at {self._x[k].round(4).tolist()} m moves at {vmax:.3g} m/s > "
+                f"{max_speed_m_s} m/s at t = {self.time_s:.4g} s (step {self.steps}): energy blow-up; "
+                "reduce dt_safety or mass_scale"
             )
         pairs = self.touching_pairs
         if len(pairs):
             i, j = pairs[:, 0], pairs[:, 1]
             d = np.linalg.norm(self.centers[j] - self.centers[i], axis=1)
             frac = (self.radii[i] + self.radii[j] - d) / np.minimum(self.radii[i], self.radii[j])
-            if frac.max() > max_overlap_fraction:
+            m = int(np.argmax(frac))
+            if frac[m] > max_overlap_fraction:
                 raise DemInstabilityError(
-                    f"overlap {frac.max():.2f} of a radius at t = {self.time_s:.4g} s: particles "
-                    "pass through each other (stiffness too low for the load or dt too large)"
+                    f"overlap {frac[m]:.2f} of a radius between particles #{int(i[m])} and #{int(j[m])} at "
+                    f"t = {self.time_s:.4g} s: particles pass through each other (stiffness too low for "
+                    "the load or dt too large)"
                 )
         if len(self.last_wall_fn):
             wmax = float(self.last_wall_fn.max()) / self.material.kn_pw / float(self.radii.min())

@@ -8,7 +8,7 @@ from pathlib import Path
 
 import numpy as np
 
-__all__ = ["write_packing", "read_packing", "summary_path"]
+__all__ = ["write_packing", "write_summary", "read_packing", "summary_path"]
 
 
 def summary_path(csv_path):
@@ -34,10 +34,15 @@ def write_packing(path, centers, radii, summary=None):
     np.savetxt(tmp, np.column_stack([centers, radii]), delimiter=",", header="x,y,z,r", comments="", fmt="%.9e")
     os.replace(tmp, path)
     if summary is not None:
-        jp = summary_path(path)
-        tmpj = jp.with_name(jp.name + ".tmp")
-        tmpj.write_text(json.dumps(summary, indent=1, default=_json_default))
-        os.replace(tmpj, jp)
+        write_summary(path, summary)
+
+
+def write_summary(csv_path, summary):
+    """Write (replace) the JSON summary beside a packing CSV, atomically."""
+    jp = summary_path(csv_path)
+    tmpj = jp.with_name(jp.name + ".tmp")
+    tmpj.write_text(json.dumps(summary, indent=1, default=_json_default))
+    os.replace(tmpj, jp)
 
 
 def read_packing(path):

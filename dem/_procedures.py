@@ -27,7 +27,7 @@ import numpy as np
 
 from ._container import Container, make_simulation
 from ._fill import check_fill, generate_spheres, thesis_particle_count
-from ._integrate import SOYBEAN
+from ._material import SOYBEAN
 from ._measure import sphere_volume
 from ._summary import interior_porosity, overlap_fractions, summarize
 

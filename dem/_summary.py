@@ -12,7 +12,7 @@ from __future__ import annotations
 import numpy as np
 
 from ._container import default_measure_spheres
-from ._integrate import SOYBEAN
+from ._material import SOYBEAN
 from ._measure import coordination_numbers, porosity_in_region, porosity_in_spheres, sphere_volume
 
 __all__ = ["summarize", "surface_height", "interior_porosity", "overlap_fractions"]

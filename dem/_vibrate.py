@@ -19,12 +19,12 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ._integrate import SOYBEAN
-from ._measure import Region, porosity_in_region, porosity_in_spheres, sphere_volume
+from ._material import SOYBEAN
+from ._measure import porosity_in_region, porosity_in_spheres, sphere_volume
 from ._container import default_measure_spheres, make_simulation
 from ._summary import summarize, surface_height
 
-__all__ = ["vibrate_bed", "VibrationResult", "intensity_g"]
+__all__ = ["vibrate_bed", "VibrationResult", "intensity_g", "rest_motion", "REST_PROBE_S"]
 
 log = logging.getLogger(__name__)
 G = 9.81
@@ -51,17 +51,31 @@ class VibrationResult:
     radii: np.ndarray
     snapshots: dict = field(default_factory=dict)
     summary: dict = field(default_factory=dict)
+    motion: dict = field(default_factory=dict)  # floor_z_m, bed_z_m (mean centre height) at the records
 
 
-def _shifted(region, dz):
-    lo = (region.lo[0], region.lo[1], region.lo[2] + dz)
-    hi = (region.hi[0], region.hi[1], region.hi[2] + dz)
-    return Region(region.kind, lo, hi, region.radius, region.center_xy)
+#: Simulated time of the rest probe, s (:func:`rest_motion`).
+REST_PROBE_S = 0.02
+
+
+def rest_motion(centers, radii, container, *, material=SOYBEAN, mass_scale=100.0, probe_s=REST_PROBE_S):
+    """Mean displacement of the spheres, in mean radii, over ``probe_s`` with the walls still.
+
+    A packing read from a file has lost its contact springs and velocities, so its force
+    balance alone cannot say whether it is at rest; its motion can. Measured over 0.02 s: rect-bin
+    packed by ``dem.pack`` 0.0004, a 200-sphere box settled to a force ratio 0.08: 0.003; a bed
+    stopped at ratio 0.4: 0.023; spheres in the air: 0.56.
+    """
+    sim = make_simulation(container, centers, radii, material=material, lid=False, mass_scale=mass_scale)
+    sim.run(duration_s=probe_s)
+    return float(np.mean(np.linalg.norm(sim.centers - np.asarray(centers), axis=1)) / np.mean(radii))
 
 
 def vibrate_bed(centers, radii, container, *, freq_hz=15.0, amplitude_m=0.002, duration_s=1.0, material=SOYBEAN,
-            mass_scale=100.0, dt_safety=0.25, record_every_s=None, snapshot_times_s=(), measure_spheres=None,
-            tol=1e-3, max_settle_steps=100000, progress=None, check_every=200):
+                mass_scale=100.0, dt_safety=0.25, record_every_s=None, snapshot_times_s=(), measure_spheres=None,
+                tol=1e-3, max_settle_steps=100000, progress=None, check_every=200, steady_window_s=None,
+                steady_tol=1e-3, rest_tol=None, checkpoint=None, checkpoint_every_s=None, resume=None,
+                threads=None):
     """Vibrate a packing vertically and record its porosity.
 
     Parameters
@@ -72,7 +86,7 @@ def vibrate_bed(centers, radii, container, *, freq_hz=15.0, amplitude_m=0.002, d
     freq_hz : float
         f (thesis: 15 Hz).
     amplitude_m : float
-        A (thesis: 0.5–4 mm).
+        A (thesis: 0.5–4 mm); 0 is a control run (the bed at rest for the same time).
     duration_s : float
         Vibration time (thesis: 16 s).
     mass_scale : float
@@ -83,6 +97,18 @@ def vibrate_bed(centers, radii, container, *, freq_hz=15.0, amplitude_m=0.002, d
         Times at which a copy of the centres is kept.
     tol : float
         Equilibrium criterion of the final settling (after the walls stop).
+    steady_window_s : float, optional
+        Stop the vibration early once the global porosity has been steady this long: over the
+        last window its least-squares slope times the window is below ``steady_tol``.
+    rest_tol : float, optional
+        Refuse (ValueError) a packing that is not at rest: one whose spheres move on average
+        more than ``rest_tol`` mean radii in :data:`REST_PROBE_S` with the walls still
+        (:func:`rest_motion`; settled beds: below 0.003, unsettled ones 0.02–0.6).
+    checkpoint : callable(dict) -> None, optional
+        Called every ``checkpoint_every_s`` of simulated vibration with what ``resume`` takes.
+    resume : dict, optional
+        A checkpoint of an interrupted run of the same arguments: the run goes on from it and
+        ends with the numbers of an uninterrupted run.
 
     Returns
     -------
@@ -103,28 +129,42 @@ def vibrate_bed(centers, radii, container, *, freq_hz=15.0, amplitude_m=0.002, d
     region0 = container.interior(2 * dmean, surface0)
     vp = float(sphere_volume(radii).sum())
     sim = make_simulation(container, centers, radii, material=material, lid=False, mass_scale=mass_scale,
-                          dt_safety=dt_safety)
+                          dt_safety=dt_safety, threads=threads)
     sim.bounds_m[1, 2] += 2 * amplitude_m + 0.1  # bed may dilate upwards
     sim.bounds_m[0, 2] -= amplitude_m
+    if resume is None and rest_tol is not None:
+        moved = rest_motion(centers, radii, container, material=material, mass_scale=mass_scale)
+        if not moved <= rest_tol:
+            raise ValueError(f"the packing is not at rest: with the walls still its spheres moved {moved:.3g} mean "
+                             f"radii on average in {REST_PROBE_S} s (at rest: below {rest_tol:g}); settle it first")
     t0 = time.perf_counter()
-    times, ps, pi, pg = [], [], [], []
+    hist = {"times_s": [], "porosity_spheres": [], "porosity_interior": [], "porosity_global": [],
+            "floor_z_m": [], "bed_z_m": []}
     snaps = {}
     pending = sorted(float(t) for t in snapshot_times_s)
+    next_rec, next_ckpt, stop = record_every_s, checkpoint_every_s, "duration"
+    if resume is not None:
+        sim.set_state(resume["state"])
+        hist = {k: list(v) for k, v in resume["history"].items()}
+        snaps = {float(t): np.asarray(x) for t, x in resume["snapshots"].items()}
+        pending = [t for t in pending if t not in snaps and t > sim.time_s - 1e-12]
+        next_rec, next_ckpt = resume["next_record_s"], resume["next_checkpoint_s"]
 
     def record():
         dz = sim.z_offset_m
         shifted = sim.centers - [0, 0, dz]
-        times.append(sim.time_s)
-        ps.append(porosity_in_spheres(shifted, radii, mc, mr))
-        pi.append(porosity_in_region(shifted, radii, region0))
-        pg.append(1.0 - vp / (container.area_m2 * surface_height(shifted, radii, container)))
+        hist["times_s"].append(sim.time_s)
+        hist["porosity_spheres"].append(porosity_in_spheres(shifted, radii, mc, mr))
+        hist["porosity_interior"].append(porosity_in_region(shifted, radii, region0))
+        hist["porosity_global"].append(1.0 - vp / (container.area_m2 * surface_height(shifted, radii, container)))
+        hist["floor_z_m"].append(dz)
+        hist["bed_z_m"].append(float(np.mean(sim.centers[:, 2])))
 
-    record()
-    next_rec = record_every_s
+    if resume is None:
+        record()
     dt = sim.dt
     n_steps = int(np.ceil(duration_s / dt))
-    for k in range(n_steps):
-        t = sim.time_s + dt  # wall state at the end of this step
+    for k in range(sim.steps, n_steps):
         sim.z_offset_m = amplitude_m * np.sin(omega * sim.time_s)
         sim.wall_vz_m_s = amplitude_m * omega * np.cos(omega * sim.time_s)
         sim.step()
@@ -135,27 +175,49 @@ def vibrate_bed(centers, radii, container, *, freq_hz=15.0, amplitude_m=0.002, d
         if sim.time_s >= next_rec - 1e-12:
             record()
             next_rec += record_every_s
+            if steady_window_s and _steady(hist, steady_window_s, steady_tol):
+                stop = "steady"
+                break
         while pending and sim.time_s >= pending[0] - 1e-12:
             snaps[pending.pop(0)] = (sim.centers - [0, 0, sim.z_offset_m]).copy()
-        del t
+        if checkpoint is not None and next_ckpt and sim.time_s >= next_ckpt - 1e-12:
+            next_ckpt += checkpoint_every_s
+            checkpoint({"state": sim.get_state(), "history": {k: list(v) for k, v in hist.items()},
+                        "snapshots": dict(snaps), "next_record_s": next_rec, "next_checkpoint_s": next_ckpt})
     vib_wall = time.perf_counter() - t0
-    vib_steps = sim.steps
+    vib_steps, vib_time = sim.steps, sim.time_s
     sim.z_offset_m = 0.0
     sim.wall_vz_m_s = 0.0
     settle = sim.run(max_steps=max_settle_steps, tol=tol, check_every=check_every,
                      callback=None if progress is None else (lambda s, f: progress("settle", s, f)))
     record()
     summary = summarize(sim.centers, radii, container, material=material, measure_spheres=measure_spheres)
-    ps_a = np.array(ps)
+    ps_a = np.array(hist["porosity_spheres"])
+    pi, pg = hist["porosity_interior"], hist["porosity_global"]
     summary.update({
         "freq_hz": freq_hz, "amplitude_m": amplitude_m, "intensity_g": intensity_g(freq_hz, amplitude_m),
-        "duration_s": duration_s, "mass_scale": mass_scale, "dt_s": dt, "vibration_steps": int(vib_steps),
-        "vibration_wall_s": vib_wall, "settle": settle,
+        "duration_s": duration_s, "vibrated_s": vib_time, "stopped_by": stop, "mass_scale": mass_scale, "dt_s": dt,
+        "vibration_steps": int(vib_steps), "vibration_wall_s": vib_wall, "settle": settle,
         "particle_steps_per_s": (vib_steps + settle["steps"]) * len(radii) / (time.perf_counter() - t0),
         "initial": {"porosity_interior": pi[0], "porosity_global": pg[0], "porosity_spheres_mean": float(ps_a[0].mean())},
         "final": {"porosity_interior": pi[-1], "porosity_global": pg[-1], "porosity_spheres_mean": float(ps_a[-1].mean())},
-        "minimum_during": {"porosity_interior": float(np.min(pi)), "porosity_spheres_mean": float(ps_a.mean(axis=1).min())},
+        "minimum_during": {"porosity_interior": float(np.min(pi)), "porosity_spheres_mean": float(ps_a.mean(axis=1).min()),
+                           "porosity_spheres_min": float(ps_a.min())},
         "interior_region_fixed": region0.to_dict(),
+        "steady_window_s": steady_window_s, "steady_tol": steady_tol,
+        "threads": {str(k): v for k, v in sim.threads.steps_by_threads.items()},
     })
-    return VibrationResult(np.array(times), ps_a, np.array(pi), np.array(pg), sim.centers.copy(), radii,
-                           snaps, summary)
+    return VibrationResult(np.array(hist["times_s"]), ps_a, np.array(pi), np.array(pg), sim.centers.copy(), radii,
+                           snaps, summary, {"floor_z_m": np.array(hist["floor_z_m"]), "bed_z_m": np.array(hist["bed_z_m"])})
+
+
+def _steady(hist, window_s, tol):
+    """True when the global porosity's least-squares change over the last ``window_s`` is below tol."""
+    t = np.asarray(hist["times_s"])
+    if t[-1] - t[0] < window_s:
+        return False
+    sel = t >= t[-1] - window_s
+    if sel.sum() < 3:
+        return False
+    slope = np.polyfit(t[sel], np.asarray(hist["porosity_global"])[sel], 1)[0]
+    return abs(slope) * window_s < tol

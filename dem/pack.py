@@ -18,7 +18,7 @@ import numpy as np
 
 from ._cli import progress_printer, resolve_container, run_main
 from ._container import SCENE_DEFAULTS, SCENES, default_measure_spheres
-from ._integrate import Material
+from ._material import Material
 from ._io import summary_path, write_packing
 from ._procedures import PROCEDURES, pack_bed
 

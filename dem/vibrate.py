@@ -2,9 +2,12 @@
 
     python -m dem.vibrate rect.csv --freq 15 --amplitude 0.002 --duration 1.0
     python -m dem.vibrate rect.csv --freq 15 --series --duration 1.0      # 0.5, 1, 2, 3, 4 mm
+    python -m dem.vibrate --study thesis --out study/                   # cyl-bin, 16 s x 5 (dem.study)
+    python -m dem.vibrate --study thesis --scene cylinder --size 0.075 --height 0.1 --duration 4
 
 The container comes from the packing's JSON summary (written by ``dem.pack``) or from
-``--scene``. Writes ``<out>/vib_<A>mm.json`` (histories and summary), the final packing
+``--scene``. A frequency or amplitude <= 0, an intensity above 10 g, a packing without a
+container and no ``--scene``, or a packing not at rest (``--rest-tol``) is refused. Writes ``<out>/vib_<A>mm.json`` (histories and summary), the final packing
 ``<out>/vib_<A>mm.csv`` and snapshots ``<out>/vib_<A>mm_t<T>.csv``; with several
 amplitudes also ``<out>/series.json`` (porosity change against intensity).
 Exit status 0 on success, 2 on bad arguments, 3 when the run went unstable.
@@ -21,57 +24,101 @@ import numpy as np
 
 from ._cli import progress_printer, resolve_container, run_main
 from ._container import SCENES
-from ._integrate import DemInstabilityError, Material
+from ._integrate import DemInstabilityError
+from ._material import Material
 from ._io import read_packing, write_packing
 from ._vibrate import intensity_g, vibrate_bed
+from .study import run_study
 
 THESIS_AMPLITUDES_M = (0.0005, 0.001, 0.002, 0.003, 0.004)
+#: the largest intensity accepted, g
+MAX_INTENSITY_G = 10.0
 
 
 def _parser():
     p = argparse.ArgumentParser(prog="python -m dem.vibrate", description=__doc__.split("\n")[0])
-    p.add_argument("packing", help="packing CSV (x,y,z,r) with its JSON summary beside it")
+    p.add_argument("packing", nargs="?", help="packing CSV (x,y,z,r) with its JSON summary beside it (not with "
+                   "--study, which packs or reuses its own bed)")
+    p.add_argument("--study", choices=["thesis"], help="the thesis's vibration study, resumable (dem.study): "
+                   "five intensities, network resistance before/after, study.json and plots in --out")
     p.add_argument("--freq", type=float, default=15.0, help="Hz (thesis: 15)")
     p.add_argument("--amplitude", type=float, nargs="+", help="m, one or more")
     p.add_argument("--intensity", type=float, nargs="+", help="in g, alternative to --amplitude")
     p.add_argument("--series", action="store_true", help="the thesis's 0.5, 1, 2, 3, 4 mm")
-    p.add_argument("--duration", type=float, default=1.0, help="s of vibration (thesis: 16)")
+    p.add_argument("--duration", type=float, default=None, help="s of vibration (default 1; --study: 16 as the "
+                   "thesis)")
     p.add_argument("--mass-scale", type=float, default=100.0)
     p.add_argument("--record-every", type=float, default=None, help="s (default a quarter period)")
     p.add_argument("--snapshots", type=float, nargs="*", default=(), help="times (s) to save packings")
     p.add_argument("--settle-steps", type=int, default=100000, help="step limit of the settling after vibration")
-    p.add_argument("--scene", choices=sorted(SCENES), help="container if the packing has no JSON")
-    p.add_argument("--out", default="vibration_out", help="output folder")
+    p.add_argument("--scene", choices=sorted(SCENES) + ["box", "cylinder"],
+                   help="container if the packing has no JSON; with --study the bed's scene (default cyl-bin)")
+    p.add_argument("--size", type=float, nargs="+", help="--scene box: length_x width_y; cylinder: diameter (m)")
+    p.add_argument("--height", type=float, help="--scene box/cylinder: fill height (m)")
+    p.add_argument("--rest-tol", type=float, default=0.01,
+                   help="refuse a packing whose spheres move more than this many mean radii on average in 0.02 s "
+                        "with the walls still (not at rest); 0 or less: no check")
+    p.add_argument("--steady-window", type=float, default=None,
+                   help="stop once the global porosity changed less than 0.001 over this many s (default: off; "
+                        "--study: 2 s; 0: off)")
+    p.add_argument("--seed", type=int, default=1, help="--study: seed of the bed's packing")
+    p.add_argument("--checkpoint-every", type=float, default=0.25, help="--study: s of simulated time between "
+                   "checkpoints")
+    p.add_argument("--no-network", action="store_true", help="--study: skip network.solve/paths on the beds")
+    p.add_argument("--threads", type=int, default=None, help="threads of the step (default: chosen by timing)")
+    p.add_argument("--out", default=None, help="output folder (default vibration_out; --study: vibration_study)")
     p.add_argument("--quiet", action="store_true")
     return p
 
 
 def _amplitudes(args):
-    """Amplitudes (m) asked for: the thesis series, --amplitude, or --intensity in g at --freq."""
-    if args.series:
-        return list(THESIS_AMPLITUDES_M)
-    if args.amplitude:
-        return list(args.amplitude)
-    if args.intensity:
-        return [g * 9.81 / (2 * np.pi * args.freq) ** 2 for g in args.intensity]
-    raise ValueError("give --amplitude, --intensity or --series")
+    """Amplitudes (m) asked for: the thesis series, --amplitude, or --intensity in g at --freq;
+    refused (ValueError) when the frequency or an amplitude is <= 0 or an intensity above 10 g."""
+    if not args.freq > 0:
+        raise ValueError(f"--freq must be > 0, got {args.freq}")
+    if args.series or (args.study and not (args.amplitude or args.intensity)):
+        amps = list(THESIS_AMPLITUDES_M)
+    elif args.amplitude:
+        amps = list(args.amplitude)
+    elif args.intensity:
+        amps = [g * 9.81 / (2 * np.pi * args.freq) ** 2 for g in args.intensity]
+    else:
+        raise ValueError("give --amplitude, --intensity or --series")
+    for a in amps:
+        if not a > 0:
+            raise ValueError(f"amplitudes must be > 0, got {a} m")
+        if intensity_g(args.freq, a) > MAX_INTENSITY_G:
+            raise ValueError(f"intensity {intensity_g(args.freq, a):.2f} g (A = {a} m at {args.freq} Hz) is above "
+                             f"{MAX_INTENSITY_G:g} g")
+    return amps
 
 
 def _vibrate(args) -> int:
-    centers, radii, summary = read_packing(args.packing)
-    container = resolve_container(args.scene, summary=summary)
-    material = Material(**summary["material"]) if summary and "material" in summary else Material()
     amps = _amplitudes(args)
-    out = Path(args.out)
+    if args.study:
+        if args.packing:
+            raise ValueError("--study packs or reuses its own bed (in --out); give no packing")
+        args.scene = args.scene or "cyl-bin"
+        args.out = args.out or "vibration_study"
+        return run_study(args, resolve_container(args.scene, size_m=args.size, height_m=args.height), amps)
+    if not args.packing:
+        raise ValueError("give a packing CSV (or --study thesis)")
+    centers, radii, summary = read_packing(args.packing)
+    container = resolve_container(args.scene, size_m=args.size, height_m=args.height, summary=summary)
+    material = Material(**summary["material"]) if summary and "material" in summary else Material()
+    duration = 1.0 if args.duration is None else args.duration
+    out = Path(args.out or "vibration_out")
     out.mkdir(parents=True, exist_ok=True)
     rows = []
     for amp in amps:
         t0 = time.perf_counter()
         try:
-            res = vibrate_bed(centers, radii, container, freq_hz=args.freq, amplitude_m=amp, duration_s=args.duration,
+            res = vibrate_bed(centers, radii, container, freq_hz=args.freq, amplitude_m=amp, duration_s=duration,
                               material=material, mass_scale=args.mass_scale, record_every_s=args.record_every,
                               snapshot_times_s=args.snapshots, max_settle_steps=args.settle_steps,
-                              progress=progress_printer(f"A={amp * 1e3:.1f} mm ", quiet=args.quiet))
+                              steady_window_s=args.steady_window or None,
+                              rest_tol=args.rest_tol if args.rest_tol > 0 and amp == amps[0] else None,
+                              threads=args.threads, progress=progress_printer(f"A={amp * 1e3:.1f} mm ", quiet=args.quiet))
         except DemInstabilityError as e:
             raise DemInstabilityError(f"A = {amp} m: {e}") from e
         tag = f"vib_{amp * 1e3:g}mm"
@@ -95,7 +142,7 @@ def _vibrate(args) -> int:
               f"({100 * (i1 - i0) / i0:+.2f} %), spheres {rows[-1]['porosity_spheres_before']:.4f} -> "
               f"{rows[-1]['porosity_spheres_after']:.4f}, wall {s['wall_time_s']:.0f} s")
     if len(rows) > 1:
-        (out / "series.json").write_text(json.dumps({"freq_hz": args.freq, "duration_s": args.duration,
+        (out / "series.json").write_text(json.dumps({"freq_hz": args.freq, "duration_s": duration,
                                                      "mass_scale": args.mass_scale, "n_spheres": len(radii),
                                                      "rows": rows}, indent=1))
         best = min(rows, key=lambda r: r["porosity_interior_after"])

@@ -1,0 +1,68 @@
+"""Grain and wall properties: the thesis's Table 3.1 soybean in a Plexiglas bin by default."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from ._contacts import series_stiffness
+
+__all__ = ["Material", "SOYBEAN"]
+
+
+@dataclass(frozen=True)
+class Material:
+    """Grain and wall properties (defaults: soybean in Plexiglas, thesis Table 3.1).
+
+    Stiffnesses are per-entity values as in PFC3D; a contact uses the series
+    combination (:func:`dem._contacts.series_stiffness`).
+    """
+
+    density_kg_m3: float = 1285.0
+    kn_n_m: float = 4.0e6
+    ks_n_m: float = 2.0e6
+    friction: float = 0.47
+    wall_kn_n_m: float = 1.8e7
+    wall_ks_n_m: float = 0.9e7
+    wall_friction: float = 0.3
+    damping_ratio: float = 0.1
+    radius_min_m: float = 0.00275
+    radius_max_m: float = 0.00375
+
+    def __post_init__(self):
+        for name in ("density_kg_m3", "kn_n_m", "ks_n_m", "wall_kn_n_m", "wall_ks_n_m"):
+            v = getattr(self, name)
+            if not (np.isfinite(v) and v > 0):
+                raise ValueError(f"{name} must be positive and finite, got {v}")
+        for name in ("friction", "wall_friction"):
+            v = getattr(self, name)
+            if not (np.isfinite(v) and v >= 0):
+                raise ValueError(f"{name} must be >= 0, got {v}")
+        if not 0 <= self.damping_ratio < 1:
+            raise ValueError(f"damping_ratio must be in [0, 1), got {self.damping_ratio}")
+        if not 0 < self.radius_min_m <= self.radius_max_m:
+            raise ValueError(
+                f"need 0 < radius_min_m <= radius_max_m, got {self.radius_min_m}, {self.radius_max_m}"
+            )
+
+    @property
+    def kn_pp(self):
+        """Particle–particle contact normal stiffness, N/m."""
+        return float(series_stiffness(self.kn_n_m, self.kn_n_m))
+
+    @property
+    def ks_pp(self):
+        return float(series_stiffness(self.ks_n_m, self.ks_n_m))
+
+    @property
+    def kn_pw(self):
+        """Particle–wall contact normal stiffness, N/m."""
+        return float(series_stiffness(self.kn_n_m, self.wall_kn_n_m))
+
+    @property
+    def ks_pw(self):
+        return float(series_stiffness(self.ks_n_m, self.wall_ks_n_m))
+
+
+SOYBEAN = Material()
