@@ -95,3 +95,14 @@ def test_finney_against_the_drag_laws_at_three_reynolds_numbers():
     assert err[2] == pytest.approx(-0.189, abs=0.01)
     np.testing.assert_allclose(case.error["hill_koch_ladd"], [0.0094, -0.0571, -0.2021],
                                atol=0.003)
+
+
+@pytest.mark.skipif(not FINNEY_PATH.exists(), reason="Finney data not available")
+def test_finney_onset_law_at_three_reynolds_numbers():
+    # laminar expansion profile + Re^2 onset with X_c = 1 (docs/inertial-flow.md): the excess
+    # grows like Re^2 at small Re; values recorded at the commit that added this test
+    case = finney_inertial_case([1.0, 2.0, 10.0], crossover=1.0, profile="laminar")
+    assert case.converged
+    excess = case.k_ratio - 1.0
+    assert excess[1] / excess[0] == pytest.approx(4.0, rel=0.15)
+    np.testing.assert_allclose(case.error["beetstra"], [0.0002, 0.0001, -0.0388], atol=0.002)
