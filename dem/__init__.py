@@ -1,4 +1,4 @@
-"""grainflow.dem: a numpy discrete-element packer for grain beds (thesis sections 3.1–3.3).
+"""grainflow.dem: a discrete-element packer for grain beds (thesis sections 3.1–3.3), numba kernels.
 
 Public API
 ----------
@@ -23,10 +23,8 @@ porosity_in_spheres, porosity_in_region, coordination_numbers, Region, lens_volu
 generate_spheres, thesis_particle_count, intensity_g
     Random sequential addition, Eq. 3.10, Eq. 3.11's Γ = Aω²/g.
 write_packing, read_packing
-    CSV ``x,y,z,r`` (m) + JSON summary.
-
-CLIs: ``python -m dem.pack``, ``python -m dem.vibrate`` (``--study thesis``: the thesis's vibration study,
-:mod:`dem.study`), ``python -m dem.bench``.
+    CSV ``x,y,z,r`` (m) + JSON summary. CLIs: ``python -m dem.pack``, ``python -m dem.vibrate``
+    (``--study thesis``: the thesis's vibration study, :mod:`dem.study`), ``python -m dem.bench``.
 
 Model and approximations (each measured by ``dem.bench`` or stated in the JSON summaries)
 -------------------------------------------------------------------------------------------
@@ -37,8 +35,7 @@ Model and approximations (each measured by ``dem.bench`` or stated in the JSON s
   i.e. all stiffnesses ÷ S; Δt grows by √S. Overlaps under load grow S-fold (still < 1 % of a
   radius in the 0.25 m beds); its effect on porosity and coordination is measured with
   ``python -m dem.bench --mass-scale-study``.
-* Equilibrium: mean unbalanced-force ratio below ``tol`` (default 2e-3).
-* Vibration runs shorter than the thesis's 16 s where stated; the histories show how far the bed got.
+* Equilibrium: mean unbalanced-force ratio below ``tol`` (default 2e-3). Speed: ``docs/dem-speed.md``.
 """
 
 from ._contacts import damping_coefficient, linear_contact_forces, restitution_coefficient, series_stiffness
