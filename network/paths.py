@@ -37,11 +37,12 @@ import time
 
 import numpy as np
 
-from ._cli import (CliError, CliParser, add_air, add_packing, bad_input, check_outputs,
+from ._cli import (CliParser, add_air, add_packing, bad_input, check_outputs,
                    check_plot, computing, load_packing, run)
 from ._air import check_positive
 from .airpaths import (bed_depth, branched_table, face_graph, plot_paths, pore_pressure_array,
                        pressure_along_path, random_entry_points, trace_paths)
+from .conductance import POLICIES
 from .flow import DEFAULT_DEPTH_M, asabe_d272_gradient, ergun_gradient, solve_network
 from .packing import UNITS, Packing, random_packing
 from .pores import Region, axis_index, tessellate, tie_groups
@@ -106,7 +107,7 @@ def _parser():
                    help="solve the network model (network.solve) and report the pressure along "
                         "the paths on the tessellation (thesis 4.2.3) at the first --velocity")
     p.add_argument("--policy", default="shape-factor",
-                   choices=("shape-factor", "table-only", "table+fe", "fe-only"),
+                   choices=POLICIES,
                    help="Q* source of the network model for --pressure")
     p.add_argument("--json", metavar="OUT.json", help="write every number here (default: not "
                                                       "written)")

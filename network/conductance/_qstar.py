@@ -16,14 +16,13 @@ import time
 import numpy as np
 
 import throats
-from cache import lookup_qstar
+from cache import POLICIES, lookup_qstar
 
 __all__ = ["POLICIES", "QstarResult", "check_policy", "throat_qstar", "qstar_from_function"]
 
 log = logging.getLogger(__name__)
 
-#: Q* policies, as named by ``cache.lookup_qstar``.
-POLICIES = ("shape-factor", "table-only", "table+fe", "fe-only")
+# POLICIES: the Q* policies, as ``cache`` names and defines them (one definition).
 
 
 @dataclasses.dataclass(frozen=True)
