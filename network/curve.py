@@ -15,13 +15,11 @@ Ergun refitted (:func:`network.flow.fit_curve`). The packing is read in ``--unit
 
 from __future__ import annotations
 
-import argparse
 import csv
 import json
 import logging
 import sys
 import time
-from pathlib import Path
 
 import numpy as np
 
