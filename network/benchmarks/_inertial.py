@@ -6,6 +6,7 @@ solid_fraction=0.60)``, as the scaling part makes it; the sample is the default 
 tessellation, conductances, the Stokes solve and the Newton curve each timed, with Newton
 iterations per velocity and the 1-minute load average. :func:`inertial_validation` runs the
 drag-law cases of :mod:`network.validation` (Finney's packing and periodic random packings)
+for the default quadratic law and the laminar-profile + onset law (:data:`INERTIAL_LAWS`),
 and :func:`inertial_lines` prints both. Measurements: ``docs/inertial-flow.md``.
 """
 
@@ -20,7 +21,8 @@ from ..packing import random_packing
 from ..pores import default_region
 from ..validation import finney_inertial_case, random_inertial_case, solve_sample_curve
 
-__all__ = ["INERTIAL_REYNOLDS", "inertial_lines", "inertial_speed", "inertial_validation"]
+__all__ = ["INERTIAL_LAWS", "INERTIAL_REYNOLDS", "inertial_lines", "inertial_speed",
+           "inertial_validation"]
 
 #: Reynolds numbers of the validation table.
 INERTIAL_REYNOLDS = (1.0, 2.0, 5.0, 10.0, 20.0, 50.0, 100.0, 200.0)
@@ -42,7 +44,8 @@ def inertial_speed(n_spheres: int = 20_000, *, seed: int = 1, n_points: int = 12
     k, _, pts, t = solve_sample_curve(pk, region, us, axis=2, policy=policy, db=db,
                                       viscosity_pa_s=1.932e-5, density_kg_m3=1.2)
     stokes = t["tessellate"] + t["conductance"] + t["stokes"]
-    return {"n_spheres": int(n_spheres), "generate_s": gen, **{f"{k2}_s": v for k2, v in t.items()},
+    return {"n_spheres": int(n_spheres), "generate_s": gen,
+            **{f"{k2}_s": v for k2, v in t.items()},
             "stokes_pipeline_s": stokes, "curve_total_s": stokes + t["inertial"],
             "curve_over_stokes": (stokes + t["inertial"]) / stokes,
             "newton_iterations": [p.iterations for p in pts],
@@ -51,14 +54,23 @@ def inertial_speed(n_spheres: int = 20_000, *, seed: int = 1, n_points: int = 12
             "load_before": load0, "load_after": _load()}
 
 
+#: Laws of the validation table: name -> (profile, crossover) (``docs/inertial-flow.md``).
+INERTIAL_LAWS = {"quadratic": ("uniform", None), "onset": ("laminar", 1.0)}
+
+
 def inertial_validation(*, reynolds=INERTIAL_REYNOLDS, solid_fractions=(0.55, 0.60, 0.64),
                         n_spheres: int = 800, seed: int = 1, policy: str = "table-only",
-                        db=None, crossover=None) -> list[dict]:
-    """Rows (case, Re, network k/k_app, each law's ratio and error) for Finney + random."""
-    rows = finney_inertial_case(reynolds, policy=policy, db=db, crossover=crossover).rows()
-    for phi in solid_fractions:
-        rows += random_inertial_case(phi, reynolds, n_spheres=n_spheres, rng=seed,
-                                     policy=policy, db=db, crossover=crossover).rows()
+                        db=None, laws=tuple(INERTIAL_LAWS)) -> list[dict]:
+    """Rows (law, case, Re, network k/k_app, each drag law's ratio and error) for Finney's
+    packing and the random packings, per conduit law of :data:`INERTIAL_LAWS`."""
+    rows = []
+    for law in laws:
+        profile, crossover = INERTIAL_LAWS[law]
+        kw = dict(policy=policy, db=db, crossover=crossover, profile=profile)
+        cases = [finney_inertial_case(reynolds, **kw)]
+        cases += [random_inertial_case(phi, reynolds, n_spheres=n_spheres, rng=seed, **kw)
+                  for phi in solid_fractions]
+        rows += [{"law": law} | r for c in cases for r in c.rows()]
     return rows
 
 
@@ -73,11 +85,12 @@ def inertial_lines(speed: dict | None, rows: list[dict]) -> list[str]:
                    f"iterations {speed['newton_iterations']}, load {speed['load_before']:.1f}"
                    f"-{speed['load_after']:.1f}")
     if rows:
-        out.append(f"{'case':<34} {'Re_p':>6} {'k/k_app':>8} {'Beetstra':>9} {'err %':>7} "
-                   f"{'HKL':>7} {'err %':>7}")
+        out.append(f"{'law':<9} {'case':<34} {'Re_p':>6} {'k/k_app':>8} {'Beetstra':>9} "
+                   f"{'err %':>7} {'HKL':>7} {'err %':>7}")
         for r in rows:
-            out.append(f"{r['case']:<34} {r['reynolds_particle']:6g} {r['k_over_k_app']:8.4f} "
-                       f"{r['beetstra_ratio']:9.4f} {100 * r['beetstra_error']:+7.2f} "
+            out.append(f"{r['law']:<9} {r['case']:<34} {r['reynolds_particle']:6g} "
+                       f"{r['k_over_k_app']:8.4f} {r['beetstra_ratio']:9.4f} "
+                       f"{100 * r['beetstra_error']:+7.2f} "
                        f"{r.get('hill_koch_ladd_ratio', float('nan')):7.4f} "
                        f"{100 * r.get('hill_koch_ladd_error', float('nan')):+7.2f}")
     return out

@@ -1,14 +1,16 @@
 r"""Inertial validation cases: the resistance curve of a known packing against the drag laws.
 
-Each case builds a packing, runs the one pipeline (:func:`network.solve_network` with
-``inertia=True``, conduit model) at viscosity 1 and density 1 with the superficial velocities
-:math:`U = Re/d`, so that :math:`Re_p = \rho U d/\mu` is the requested Reynolds number, and
-returns an :class:`InertialCase`: the network's :math:`k/k_{app}` (pressure gradient over its
-Darcy value, k the sample's Stokes permeability) beside the laws'
+Each case builds a packing, runs the inertial pipeline (:func:`solve_sample_curve`: the steps
+of :func:`network.solve_network` with ``inertia=True``, conduit model, stages timed) at
+viscosity 1 and density 1 with the superficial velocities :math:`U = Re/d`, so that
+:math:`Re_p = \rho U d/\mu` is the requested Reynolds number, and returns an
+:class:`InertialCase`: the network's :math:`k/k_{app}` (pressure gradient over its Darcy value,
+k the sample's Stokes permeability) beside the laws'
 :math:`F(\phi, Re)/F(\phi, 0)` (:mod:`._drag_laws`).
 
-``crossover`` selects the weak-inertia onset of :func:`network.flow.conduit_flow` (None: the
-purely quadratic law of the pipeline). :func:`solve_sample_curve` is that pipeline, stages timed.
+``crossover`` selects the weak-inertia onset of :func:`network.flow.conduit_flow` and
+``profile`` the expansion loss of :func:`network.conductance.inertial_coefficients` (None and
+'uniform': the purely quadratic law that ``network.solve`` uses).
 
 * :func:`random_inertial_case`: periodic random packing (:func:`network.random_packing`),
   copied 3 x 3 x 3, the middle two periods as the sample, as
@@ -29,6 +31,7 @@ import time
 from pathlib import Path
 
 import numpy as np
+from scipy.spatial import cKDTree
 
 from ..conductance import inertial_coefficients, throat_conductance
 from ..flow import darcy_permeability, solve_fixed_pressure, solve_inertial
@@ -172,7 +175,6 @@ def finney_inertial_case(reynolds, *, half_side: float = 8.0, axis: int = 0,
 
 
 def _box_solid_fraction(packing: Packing, region: Region, n_points: int = 200_000) -> float:
-    from scipy.spatial import cKDTree
     rng = np.random.default_rng(0)
     pts = region.lo + rng.random((n_points, 3)) * (region.hi - region.lo)
     d, i = cKDTree(packing.centers).query(pts)
@@ -182,7 +184,7 @@ def _box_solid_fraction(packing: Packing, region: Region, n_points: int = 200_00
 def lattice_inertial_case(kind: str, solid_fraction: float, reynolds, *, n_cells: int = 7,
                           axis: int = 0, policy: str = "table-only", db=None,
                           offset: float = 0.137, crossover=None,
-                         profile="uniform") -> InertialCase:
+                          profile="uniform") -> InertialCase:
     """Simple-cubic / BCC / FCC array, lattice constant 1, sample box as
     :func:`lattice_sample_permeability`; ``law_ratio`` holds the random-packing laws for
     information only (an ordered array is not a random bed)."""
