@@ -189,9 +189,10 @@ def contact_count(r, s, rbar, *, gap_tol=1e-9):
 def validate_throats(radii, sides):
     """Row-wise checks of N throats; never raises for a bad row.
 
-    A row is invalid when it holds NaN/inf, a radius or side <= 0, sides that violate the
-    triangle inequality or form a (nearly) collinear triangle (area <= 1e-9 * longest side²),
-    or a disk that contains another vertex (r_i >= l_ij: overlap too deep for a throat).
+    A row is invalid when it holds NaN/inf, a radius or side <= 0, or sides that violate the
+    triangle inequality or form a (nearly) collinear triangle (area <= 1e-9 * longest side²).
+    Every other row is a triangle of disks and has an answer, deep overlaps included (a disk
+    containing another vertex, r_i >= l_ij: open, or closed with Q* = 0; issue 13 item 9).
 
     Parameters
     ----------
@@ -207,7 +208,7 @@ def validate_throats(radii, sides):
     ValueError
         If the arrays are not both of shape (N, 3) (a programming error, not a bad row).
     """
-    return check_rows(*as_throats(radii, sides), deep_overlap=True)
+    return check_rows(*as_throats(radii, sides), deep_overlap=False)
 
 
 def check_rows(r, s, *, deep_overlap):

@@ -45,6 +45,9 @@ logger = logging.getLogger(__name__)
 
 #: default width (units of r̄) below which a passage is closed by a no-slip cut
 DELTA_DEFAULT = 0.01
+#: second try (rows whose boundary failed): a cut lower (disk-disk) or shorter (disk-edge) than
+#: this, in units of ``delta``, is not made (see :func:`build_geometries`)
+CUT_MIN = 1e-2
 
 NOSLIP, SYMMETRY, FLUID = 1, 2, 3
 
@@ -88,8 +91,12 @@ def _left(v):
     return np.stack([-v[..., 1], v[..., 0]], axis=-1)
 
 
-def _closing_rules(verts, radii, delta, feature_width):
-    """Cut segments and removed rectangles of the closing rules, vectorised (see module)."""
+def _closing_rules(verts, radii, delta, feature_width, robust=False):
+    """Cut segments and removed rectangles of the closing rules, vectorised (see module).
+
+    ``robust`` (second try, :func:`build_geometries`): no sliver cuts (``CUT_MIN``), and a
+    disk-disk cut only where the circles' radical line meets the edge inside the cut's strip.
+    """
     N = verts.shape[0]
     segs_a, segs_b, owner, present = [], [], [], []
     rect = {k: [] for k in ("origin", "e", "n", "x0", "x1", "s1", "present")}
@@ -110,6 +117,9 @@ def _closing_rules(verts, radii, delta, feature_width):
             x = (dd**2 + ri**2 - rj**2) / (2 * dd)
             s1 = np.sqrt(ri**2 - x**2)
             on = (length - ri - rj < delta) & (x**2 < ri**2) & (s1 < np.minimum(ri, rj))
+            if robust:
+                xc = (length**2 + ri**2 - rj**2) / (2 * length)
+                on &= (s1 > CUT_MIN * delta) & (xc > x + 0.05 * delta) & (xc < x + 0.95 * delta)
             a = ci + e * (x - 0.5 * delta)[:, None] + n * s1[:, None]
             b = ci + e * (x + 1.5 * delta)[:, None] + n * s1[:, None]
             # fluid (above the chord, +n) must be on the left of the direction
@@ -132,6 +142,8 @@ def _closing_rules(verts, radii, delta, feature_width):
             n = _unit(ci - foot)
             xs = np.sqrt(ri**2 - (h - 0.5 * delta) ** 2)
             on = (h - ri < 0.5 * delta) & np.isfinite(xs)
+            if robust:
+                on &= xs > CUT_MIN * delta
             lo, hi = -0.5 * delta, min(delta, 1.0)
             # orient each cut so that the fluid (x > x* on the right cut, x < -x* on the
             # left one) is on its left; whether the left normal of +n is +e depends on the
@@ -179,13 +191,31 @@ def build_geometries(radii_star, sides_star, *, delta=DELTA_DEFAULT, feature_wid
     -------
     list of ThroatGeometry (length N); a throat whose disks cover the triangle has no loops
     and area 0.
+
+    Notes
+    -----
+    Rows whose boundary cannot be assembled are built a second time with ``robust`` rules:
+    no cut lower/shorter than ``CUT_MIN * delta`` (a gap exactly ``delta`` gave a 1e-8 sliver
+    cut), and no disk-disk cut where the circles cross at a wide angle (deep overlaps; the
+    cut is meant for cusps, whose corner lies inside the cut's strip).  Rows that succeed the
+    first time keep their geometry bit for bit.
     """
     r = np.atleast_2d(np.asarray(radii_star, dtype=float))
     s = np.atleast_2d(np.asarray(sides_star, dtype=float))
     verts = triangle_vertices(s)
-    la, lb, owner, present, rects, xl, xc = _closing_rules(verts, r, delta, feature_width)
+    out = _geometries(verts, r, delta, feature_width, False)
+    again = [q for q, g in enumerate(out) if g.error]
+    if again:   # second try for these rows only: the others keep their first geometry
+        for q, g in zip(again, _geometries(verts[again], r[again], delta, feature_width, True)):
+            out[q] = g if not g.error else out[q]
+    return out
+
+
+def _geometries(verts, r, delta, feature_width, robust):
+    la, lb, owner, present, rects, xl, xc = _closing_rules(verts, r, delta, feature_width,
+                                                           robust)
     res = region_boundary(verts, verts, r, la, lb, owner, present, rects,
-                           extra_lt=xl, extra_cu=xc)
+                          extra_lt=xl, extra_cu=xc)
     return [_extract(res, verts, r, q) for q in range(r.shape[0])]
 
 
