@@ -16,10 +16,10 @@ permeability in the units of the radius or diameter passed in, squared:
 
 from __future__ import annotations
 
+import functools
 import logging
 
 import numpy as np
-from scipy.interpolate import PchipInterpolator
 
 from ..packing import TOUCHING_FRACTION
 
@@ -71,7 +71,17 @@ STOKES_CELL_FCC = np.array([
     [0.72, 1.10398e-04],
 ])
 
-_ZH_SC_LOGK = PchipInterpolator(ZICK_HOMSY_SC[:, 0], np.log(ZICK_HOMSY_SC[:, 1]), extrapolate=False)
+
+@functools.lru_cache(maxsize=None)
+def _log_interpolant(name):
+    """Monotone (PCHIP) interpolant of ln K or ln k of a table, built on first use (scipy's
+    interpolate module costs 0.2-0.4 s to import, which network.solve does not need)."""
+    from scipy.interpolate import PchipInterpolator
+
+    table = {"ZICK_HOMSY_SC": ZICK_HOMSY_SC, "STOKES_CELL_BCC": STOKES_CELL_BCC,
+             "STOKES_CELL_FCC": STOKES_CELL_FCC}[name]
+    return PchipInterpolator(table[:, 0], np.log(table[:, 1]),
+                             extrapolate=False if name == "ZICK_HOMSY_SC" else True)
 
 
 def _phi(solid_fraction, upper=1.0, name="solid_fraction"):
@@ -138,7 +148,7 @@ def zick_homsy_sc_drag(solid_fraction):
     hi = phi >= TOUCHING_FRACTION["sc"] * (1.0 - 1e-9)   # the table's 0.5236 is touching
     mid = ~lo & ~hi
     out = np.empty_like(phi)
-    out[mid] = np.exp(_ZH_SC_LOGK(phi[mid]))
+    out[mid] = np.exp(_log_interpolant("ZICK_HOMSY_SC")(phi[mid]))
     out[hi] = ZICK_HOMSY_SC[-1, 1]
     out[lo] = sangani_acrivos_sc_drag(phi[lo])
     return out[()] if out.ndim == 0 else out
@@ -307,5 +317,5 @@ def computed_lattice_permeability(kind: str, solid_fraction, lattice_constant=1.
             np.any(phi > table[-1, 0] + 1e-12):
         raise ValueError(f"solid_fraction must lie in [{table[0, 0]}, {table[-1, 0]}] for "
                          f"{k}, got {solid_fraction!r}")
-    f = PchipInterpolator(table[:, 0], np.log(table[:, 1]))
+    f = _log_interpolant(f"STOKES_CELL_{k.upper()}")
     return np.exp(f(np.clip(phi, table[0, 0], table[-1, 0]))) * float(lattice_constant) ** 2
