@@ -41,6 +41,12 @@ __all__ = ["Simulation", "DemInstabilityError"]
 
 log = logging.getLogger(__name__)
 
+#: Default Verlet skin over the largest radius. Measured (CPU time, same packing bit for bit):
+#: 823-sphere 'sediment' pack 6.6e6 particle-steps/s at 0.1 (1138 rebuilds), 8.0e6 at 0.2,
+#: 8.1-8.9e6 at 0.4 (283), 9.0e6 at 0.6-0.8; vibrating 1818 spheres at 2 mm: 9.4e6 at 0.1,
+#: 1.17e7 at 0.4, 1.11e7 at 0.8.
+SKIN_FRACTION = 0.4
+
 
 class DemInstabilityError(RuntimeError):
     """The simulation blew up (energy growth, NaN, particles through walls)."""
@@ -71,7 +77,8 @@ class Simulation:
     dt_safety : float
         Safety factor s of the time step.
     skin_m : float | None
-        Verlet skin; default 0.1 · r_max.
+        Verlet skin; default :data:`SKIN_FRACTION` · r_max. No result depends on it (only how
+        often the list is rebuilt).
     bounds_m : (2, 3) array | None
         Box that every centre must stay in; leaving it raises DemInstabilityError.
     threads : int | None
@@ -109,7 +116,7 @@ class Simulation:
         self._w = np.zeros((n, 3))
         self._force = np.zeros((n, 3))
         self._torque = np.zeros((n, 3))
-        skin = skin_m if skin_m is not None else 0.1 * float(radii.max())
+        skin = skin_m if skin_m is not None else SKIN_FRACTION * float(radii.max())
         self.verlet = VerletList(skin)
         self._set_pairs(np.zeros((0, 4)))
         self._set_radii(radii)

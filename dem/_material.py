@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 from dataclasses import dataclass
+from functools import cached_property
 
 import numpy as np
 
@@ -46,21 +47,21 @@ class Material:
                 f"need 0 < radius_min_m <= radius_max_m, got {self.radius_min_m}, {self.radius_max_m}"
             )
 
-    @property
+    @cached_property
     def kn_pp(self):
         """Particle–particle contact normal stiffness, N/m."""
         return float(series_stiffness(self.kn_n_m, self.kn_n_m))
 
-    @property
+    @cached_property
     def ks_pp(self):
         return float(series_stiffness(self.ks_n_m, self.ks_n_m))
 
-    @property
+    @cached_property
     def kn_pw(self):
         """Particle–wall contact normal stiffness, N/m."""
         return float(series_stiffness(self.kn_n_m, self.wall_kn_n_m))
 
-    @property
+    @cached_property
     def ks_pw(self):
         return float(series_stiffness(self.ks_n_m, self.wall_ks_n_m))
 

@@ -166,6 +166,15 @@ def max_displacement(x, ref):
     return np.sqrt(m)
 
 
+@numba.njit(cache=True, error_model="numpy")
+def _reach_used(x, ref, r, ref_r):
+    """2 (largest displacement) + 2 (largest growth) since the reference, m."""
+    g = -np.inf
+    for p in range(r.shape[0]):
+        g = max(g, r[p] - ref_r[p])
+    return 2.0 * max_displacement(x, ref) + 2.0 * g
+
+
 class VerletList:
     """Pair list plus the state needed to know when it must be rebuilt.
 
@@ -196,9 +205,7 @@ class VerletList:
         """True when a particle moved more than skin/2 (or grew) since the last build."""
         if self._ref is None or len(self._ref) != len(centers):
             return True
-        moved = float(max_displacement(centers, self._ref))
-        grown = float(np.max(radii - self._ref_radii))
-        return 2.0 * moved + 2.0 * grown > self.skin
+        return _reach_used(centers, self._ref, radii, self._ref_radii) > self.skin
 
     def build(self, centers, radii):
         """Rebuild; returns the old keys so callers can remap pair history."""
