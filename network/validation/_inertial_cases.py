@@ -34,7 +34,7 @@ import numpy as np
 from scipy.spatial import cKDTree
 
 from ..conductance import inertial_coefficients, throat_conductance
-from ..flow import darcy_permeability, solve_fixed_pressure, solve_inertial
+from ..flow import AMGSolver, darcy_permeability, solve_fixed_pressure, solve_inertial
 from ..packing import Packing, lattice_packing, periodic_copies, random_packing, read_packing
 from ..pores import Region, merge_pores, prune_disconnected, select_sample, tessellate
 from ._drag_laws import DRAG_LAWS, drag_ratio
@@ -81,7 +81,8 @@ class InertialCase:
 def solve_sample_curve(packing, region, velocities_m_s, *, axis=0, policy="table-only",
                        db=None, viscosity_pa_s=1.0, density_kg_m3=1.0, crossover=None,
                        profile="uniform"):
-    """The inertial pipeline of :func:`network.solve_network` (conduit model, bodies merged),
+    """The inertial pipeline of :func:`network.solve_network` (conduit model, bodies merged;
+    one AMG hierarchy, built for the Stokes solve and reused by every Newton step),
     with the onset ``crossover`` of :func:`network.flow.solve_inertial` and the expansion
     ``profile`` of :func:`network.conductance.inertial_coefficients` selectable:
     ``(permeability_m2, length_m, points, seconds)``, ``seconds`` a dict by stage."""
@@ -102,15 +103,21 @@ def solve_sample_curve(packing, region, velocities_m_s, *, axis=0, policy="table
                                                                            sample.throats)]
     t["conductance"] = time.perf_counter() - t0
     t0 = time.perf_counter()
+    held = {}
+
+    def amg_solve(A, b):        # the Stokes hierarchy, kept for the Newton solves
+        held["amg"] = AMGSolver(A, smoother="forward-backward")
+        return held["amg"].solve(b, tol=1e-10)[0]
+
     _, _, check = solve_fixed_pressure(sample.n_pores, sample.conns, g, sample.inlet,
-                                       sample.outlet, p_in=1.0, p_out=0.0)
+                                       sample.outlet, p_in=1.0, p_out=0.0, solver=amg_solve)
     k = darcy_permeability(check["q_in"], 1.0, sample.length_m, sample.area_m2,
                            viscosity_pa_s=viscosity_pa_s)
     t["stokes"] = time.perf_counter() - t0
     t0 = time.perf_counter()
     pts = solve_inertial(sample.n_pores, sample.conns, g, K, sample.inlet, sample.outlet,
                          np.asarray(velocities_m_s, dtype=float) * sample.area_m2,
-                         crossover=crossover)
+                         crossover=crossover, amg=held.get("amg"))
     t["inertial"] = time.perf_counter() - t0
     return k, sample.length_m, pts, t
 
