@@ -94,18 +94,13 @@ def _network_numbers(name, data):
         keys = ("pressure_drop_pa", "pressure_gradient_pa_per_m", "permeability_m2", "pressure_drop_stokes_pa",
                 "porosity", "velocity_m_s", "depth_m", "n_pores", "n_throats")
         return {k: data.get(k) for k in keys}
-    flat = {}
-
-    def walk(d, prefix=""):
-        for k, v in d.items():
-            key = f"{prefix}{k}"
-            if isinstance(v, dict):
-                walk(v, key + ".")
-            elif isinstance(v, (int, float)) and ("tortuos" in key or "width" in key):
-                flat[key] = v
-
-    walk(data)
-    return flat
+    # network.paths: per path kind (widest, narrowest, ...), the mean over its traced paths
+    by_kind = {}
+    for path in data.get("paths", []):
+        if path.get("tortuosity") is not None and path.get("duplicate_of") is None:
+            by_kind.setdefault(path["kind"], []).append(path)
+    return {kind: {"n_paths": len(ps), **{k: float(np.mean([p[k] for p in ps])) for k in (
+        "tortuosity", "mean_width_m", "bottleneck_width_m")}} for kind, ps in by_kind.items()}
 
 
 def _row(amp, freq, s, coord_before):
@@ -147,13 +142,13 @@ def _progress(label, duration_s, quiet):
     """tqdm bar over simulated seconds (stderr), fed by vibrate_bed's progress callback."""
     from tqdm import tqdm  # optional pretty display; the study runs without it
 
-    bar = tqdm(total=round(duration_s, 3), desc=label, unit="s sim", disable=quiet, file=sys.stderr,
+    bar = tqdm(total=round(duration_s, 3), desc=label, unit="s sim", disable=quiet, file=sys.stderr, mininterval=1.0,
                bar_format="{desc}: {percentage:3.0f}%|{bar}| {n:.2f}/{total:.2f} s [{elapsed}<{remaining}{postfix}]")
     t0 = time.perf_counter()
 
     def progress(stage, sim, force):
         if stage == "vibrate":
-            bar.update(round(sim.time_s - bar.n, 3))
+            bar.update(max(0.0, round(min(sim.time_s, bar.total) - bar.n, 3)))
         rate = (sim.steps - progress.steps0) * sim.n / max(time.perf_counter() - t0, 1e-9)
         bar.set_postfix_str(f"{stage}, {rate:.2e} particle-steps/s", refresh=False)
 
@@ -247,13 +242,29 @@ def _material(summary):
     return Material(**summary["material"]) if summary and "material" in summary else SOYBEAN
 
 
+def _net(network, step, kind, key):
+    """One number of a bed's network results, or None."""
+    d = ((network or {}).get(step) or {})
+    d = d.get(kind) if kind else d
+    return (d or {}).get(key) if isinstance(d, dict) else None
+
+
 def _print_table(study):
+    """The summary table: porosity, pressure drop (network.solve) and the widest paths'
+    tortuosity and mean width (network.paths) before and after each vibration."""
     print(f"{'A mm':>5} {'Γ g':>5} {'φ before':>9} {'φ after':>8} {'change':>7} {'min local':>9} {'Δp before':>10} "
-          f"{'Δp after':>9} {'vibrated':>9}")
-    dp0 = ((study["bed"]["network"] or {}).get("solve") or {}).get("pressure_drop_pa")
+          f"{'Δp after':>9} {'τ before':>8} {'τ after':>7} {'w before':>8} {'w after':>7} {'vibrated':>9}")
+    fmt = lambda v, w, p: f"{v:{w}.{p}f}" if isinstance(v, (int, float)) else f"{'-':>{w}}"  # noqa: E731
+    before = study["bed"]["network"]
     for r in study["rows"]:
-        dp1 = ((r["network_after"] or {}).get("solve") or {}).get("pressure_drop_pa")
-        fmt = lambda v: f"{v:10.3f}" if isinstance(v, (int, float)) else f"{'-':>10}"  # noqa: E731
+        after = r["network_after"]
+        dp = [_net(n, "solve", None, "pressure_drop_pa") for n in (before, after)]
+        tau = [_net(n, "paths", "widest", "tortuosity") for n in (before, after)]
+        w = [_net(n, "paths", "widest", "mean_width_m") for n in (before, after)]
+        w = [None if v is None else 1e3 * v for v in w]
         print(f"{r['amplitude_m'] * 1e3:5.1f} {r['intensity_g']:5.2f} {r['porosity_global_before']:9.4f} "
               f"{r['porosity_global_after']:8.4f} {100 * r['relative_change_global']:+6.2f}% "
-              f"{r['min_local_porosity_during']:9.4f} {fmt(dp0)} {fmt(dp1)[1:]} {r['vibrated_s']:8.2f}s")
+              f"{r['min_local_porosity_during']:9.4f} {fmt(dp[0], 10, 3)} {fmt(dp[1], 9, 3)} {fmt(tau[0], 8, 3)} "
+              f"{fmt(tau[1], 7, 3)} {fmt(w[0], 8, 2)} {fmt(w[1], 7, 2)} {r['vibrated_s']:8.2f}s")
+    print("(φ: global porosity; Δp: network.solve pressure drop, Pa; τ, w: tortuosity and mean width (mm) of "
+          "the widest paths, network.paths)")
