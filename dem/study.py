@@ -30,6 +30,7 @@ from pathlib import Path
 import numpy as np
 
 from ._container import SCENE_DEFAULTS, default_measure_spheres
+from ._integrate import DemInstabilityError
 from ._io import read_packing, write_packing, write_summary
 from ._material import SOYBEAN, Material
 from ._plots import plot_study
@@ -195,6 +196,8 @@ def run_study(args, container, amplitudes) -> int:
                                   rest_tol=args.rest_tol if resume is None else None, progress=progress,
                                   checkpoint=_checkpointer(ck_path), checkpoint_every_s=args.checkpoint_every,
                                   resume=resume, threads=args.threads)
+            except DemInstabilityError as e:
+                raise DemInstabilityError(f"A = {amp} m: {e}; what was saved stays in {out}") from e
             finally:
                 bar.close()
             s = res.summary
