@@ -17,7 +17,11 @@ reason; a rerun skips them unless ``retry_failed=True``.
 from __future__ import annotations
 
 import concurrent.futures as cf
+import contextlib
 import logging
+import os
+import signal
+import threading
 import time
 from dataclasses import dataclass, field
 
@@ -25,6 +29,7 @@ import numpy as np
 
 import throats
 
+from ._claims import claim, new_owner, release
 from ._signature import as_throats, shape_keys, signature
 
 logger = logging.getLogger(__name__)
@@ -102,6 +107,19 @@ def _solve_chunk(solver, radii, sides, rtol):
     return out
 
 
+def _worker_init(parent_pid):
+    """Pool worker: Ctrl-C is the parent's to handle, and the worker exits within 0.5 s of
+    its parent's death (``kill -9``), instead of waiting for work forever."""
+    signal.signal(signal.SIGINT, signal.SIG_IGN)
+
+    def watch():
+        while os.getppid() == parent_pid:
+            time.sleep(0.5)
+        os._exit(1)
+
+    threading.Thread(target=watch, daemon=True).start()
+
+
 def _drain(pool, chunks, window, solve_args, write, stop):
     """Solve ``chunks`` on ``pool`` (any ``concurrent.futures.Executor``: a process pool or a
     Dask client's executor) with at most ``window`` batches in flight; ``write(chunk, result)``
@@ -126,6 +144,10 @@ def _drain(pool, chunks, window, solve_args, write, stop):
                 if not stop():
                     submit_next()
     except KeyboardInterrupt:
+        for fut in pending:
+            fut.cancel()           # not started: dropped; running: finished and written
+        running = [f for f in pending if not f.cancelled()]
+        cf.wait(running, timeout=60)
         for fut, chunk in list(pending.items()):
             if fut.done() and not fut.cancelled() and fut.exception() is None:
                 write(pending.pop(fut), fut.result())
@@ -220,7 +242,7 @@ def precompute_throats(store, radii, sides, *, rtol=1e-3, solver=None, solver_ve
     hit = have["found"]
     done_ok = hit & np.isin(have["status"], ["ok", "closed"])
     done_bad = hit & ~done_ok
-    summary.reused = int(done_ok.sum())
+    summary.reused = n_reused0 = int(done_ok.sum())
     summary.reused_failed = int(done_bad.sum()) if not retry_failed else 0
     todo = uniq[~done_ok & (retry_failed | ~done_bad)]
 
@@ -256,26 +278,54 @@ def precompute_throats(store, radii, sides, *, rtol=1e-3, solver=None, solver_ve
     def solve_args(chunk):
         return solver, canon_r[chunk], canon_s[chunk], rtol
 
-    try:
-        if executor is None and workers == 1:
-            for chunk in chunks:
+    owner = new_owner()
+    done_st = ("ok", "closed") if retry_failed else ("ok", "closed", "failed", "invalid")
+    others = []                     # shapes another run claimed: checked again at the end
+
+    def claimed(batches):
+        """Each batch cut to the shapes this run claims (module _claims)."""
+        for chunk in batches:
+            mine, stored = claim(store, keys[chunk], solver_version=solver_version, rtol=rtol,
+                                 owner=owner, done_statuses=done_st)
+            summary.reused += int(stored.sum())
+            others.extend(chunk[~mine & ~stored].tolist())
+            processed[0] += int(stored.sum())
+            if mine.any():
+                yield chunk[mine]
+
+    def run(batches, pool):
+        if pool is None:
+            for chunk in claimed(batches):
                 if out_of_time():
                     break
                 write(chunk, _solve_chunk(*solve_args(chunk)))
-        elif executor is None:
-            with cf.ProcessPoolExecutor(max_workers=workers) as pool:
-                _drain(pool, chunks, 2 * workers, solve_args, write, out_of_time)
         else:
-            _drain(executor, chunks, 2 * workers, solve_args, write, out_of_time)
+            _drain(pool, claimed(batches), 2 * workers, solve_args, write, out_of_time)
+
+    try:
+        with contextlib.ExitStack() as stack:
+            pool = executor
+            if executor is None and workers > 1:
+                pool = stack.enter_context(cf.ProcessPoolExecutor(
+                    max_workers=workers, initializer=_worker_init, initargs=(os.getpid(),)))
+            run(chunks, pool)
+            while others and not out_of_time():   # wait for the other runs' shapes
+                again = np.array(others)
+                others.clear()
+                run([again[i:i + batch_size] for i in range(0, len(again), batch_size)], pool)
+                if others:
+                    time.sleep(0.5)
     except KeyboardInterrupt:
         summary.extra["interrupted"] = True
         logger.warning("interrupted: %d solved shapes stored in this run; rerun to resume",
                        summary.solved + summary.failed)
     finally:
+        release(store, owner)
         if bar is not None:
             bar.close()
+    summary.extra["solved_by_other_runs"] = int(summary.reused - n_reused0)
     summary.seconds = time.perf_counter() - t0
-    summary.extra["remaining"] = int(len(todo) - processed[0])
+    summary.extra["remaining"] = int(len(todo) - processed[0])   # others' shapes included
     return summary
 
 

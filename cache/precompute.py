@@ -17,7 +17,9 @@ batches of ``--batch-size`` shapes are Dask tasks and only this process writes t
     python -m cache.precompute --db throats.sqlite --grid g1 --dask local --workers 2
 
 Rerunning the same command resumes (solved shapes are reused); ``--retry-failed`` solves the
-recorded failures again; Ctrl-C stores the finished batches and says how many.  A summary
+recorded failures again; Ctrl-C finishes and stores the running batches and says how many;
+pool workers exit when the parent is killed (``kill -9``); two runs on one ``--db`` split the
+shapes between them through claims in the table (``docs/cache-precompute.md``).  A summary
 (solved, reused, failed, seconds) is printed as JSON.  Exit status: 0 done, 1 interrupted,
 2 bad input or an unreachable scheduler (nothing written).
 """
@@ -61,6 +63,16 @@ def build_parser():
 
 
 def main(argv=None) -> int:
+    """Run the command; exit 0 done, 1 interrupted, 2 bad input (one ``error:`` line)."""
+    try:
+        return _main(argv)
+    except KeyboardInterrupt:   # before or after the solve loop (that one reports itself)
+        print("interrupted: no shape was being solved; what earlier batches stored is kept",
+              file=sys.stderr)
+        return 1
+
+
+def _main(argv):
     args = build_parser().parse_args(argv)
     logging.basicConfig(level=logging.INFO, format="%(levelname)s %(name)s: %(message)s")
     os.environ.setdefault("DASK_LOGGING__DISTRIBUTED", "warning")   # Dask's cluster chatter
