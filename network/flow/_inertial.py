@@ -200,7 +200,7 @@ def solve_inertial(n_pores, conns, g, K, inlet, outlet, flows_m3_s, *, tol: floa
     order = np.argsort(flows)
     out: list[InertialPoint | None] = [None] * flows.size
     p = np.zeros(n_pores)
-    hist: list[tuple[float, float]] = []
+    hist: list[tuple[float, np.ndarray]] = []
     for n_done, k in enumerate(order):
         Q = flows[k]
         t0 = time.perf_counter()
