@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import csv
+import os
 
 import numpy as np
 
@@ -11,10 +12,11 @@ __all__: list[str] = []
 SHAPE_COLUMNS = ("r1", "r2", "r3", "l12", "l13", "l23")
 
 
-def read_throat_csv(path):
+def read_throat_csv(path, parse_errors=None):
     """Read a throat CSV: ``(header list, rows list of lists, radii (N,3), sides (N,3))``.
 
-    Cells that do not parse as numbers become NaN (the row is then reported as invalid).
+    Cells that do not parse as numbers become NaN (the row is then reported as invalid); with
+    a dict ``parse_errors``, row index -> "cannot parse l12='abc'" is filled in.
     """
     with open(path, newline="") as fh:
         reader = csv.reader(fh)
@@ -33,18 +35,28 @@ def read_throat_csv(path):
             try:
                 vals[i, j] = float(row[c])
             except (ValueError, IndexError):
-                pass
+                if parse_errors is not None and i not in parse_errors:
+                    cell = row[c] if c < len(row) else ""
+                    parse_errors[i] = f"cannot parse {SHAPE_COLUMNS[j]}={cell!r}"
     return header, rows, vals[:, :3], vals[:, 3:]
+
+
+def row_problems(path, ok, messages, parse_errors):
+    """``"PATH row N: message"`` for each bad row, N counted as a spreadsheet (header = 1)."""
+    return [f"{path} row {i + 2}: {parse_errors.get(i, messages[i])}"
+            for i in np.flatnonzero(~np.asarray(ok, bool))]
 
 
 def write_csv(path, header, rows, extra):
     """Write ``rows`` (lists of str) with extra columns ``extra`` (dict name -> (N,) array)."""
     names = list(extra)
-    with open(path, "w", newline="") as fh:
+    tmp = f"{path}.part"
+    with open(tmp, "w", newline="") as fh:   # complete file or none: renamed when written
         w = csv.writer(fh)
         w.writerow(list(header) + names)
         for i, row in enumerate(rows):
             w.writerow(list(row) + [_fmt(extra[k][i]) for k in names])
+    os.replace(tmp, path)
 
 
 def _fmt(v):

@@ -14,31 +14,43 @@ of ``python -m throats.solve --csv``, with the same meanings) and ``source, mess
 * ``source``: exact (stored FE value), interp (grid table), fe, shape-factor, closed, failed.
 
 Default policy ``table+fe``; ``table-only`` and ``table+fe`` use values already stored in
-``--db`` before interpolating.  Invalid rows are reported on stderr with their row number
-(header = row 1) and written with empty values.
+``--db`` before interpolating.  Invalid rows are reported on stderr as ``FILE row N: ...``
+(header = row 1, as a spreadsheet counts) and written with empty values.  Exit status: 0 every
+row answered, 1 some row not (or Ctrl-C: no output written), 2 bad options or files (one
+``error:`` line, checked before anything is computed or written).
 """
 
 from __future__ import annotations
 
-import argparse
 import json
 import logging
+import os
+import sqlite3
 import sys
 
 import numpy as np
 
 import throats
+from throats.solve import OneLineParser, check_output
 
-from ._csvio import read_throat_csv, write_csv
+from ._csvio import read_throat_csv, row_problems, write_csv
 from ._lookup import POLICIES, lookup_qstar
 from ._store import CacheFileError
 
 
 def build_parser():
-    p = argparse.ArgumentParser(prog="python -m cache.lookup", description=__doc__.split("\n")[0])
-    p.add_argument("--db", default=None, help="throat table (default: cache.default_db_path())")
-    p.add_argument("--csv", required=True, help="input, columns r1,r2,r3,l12,l13,l23")
-    p.add_argument("--out", required=True, help="output CSV")
+    p = OneLineParser(prog="python -m cache.lookup", description=__doc__.split("\n")[0])
+    p.add_argument("--db", default=None, metavar="DB.sqlite",
+                   help="throat table, SQLite: stored values are used first, FE results are "
+                        "stored in it (default: cache.default_db_path(), $GRAINFLOW_CACHE_DB or "
+                        "~/.cache/grainflow/throats.sqlite)")
+    p.add_argument("--csv", required=True, metavar="IN.csv",
+                   help="input, columns r1,r2,r3,l12,l13,l23 in any one length unit (other "
+                        "columns are copied; required)")
+    p.add_argument("--out", required=True, metavar="OUT.csv",
+                   help="output CSV, the input columns plus qstar (r-bar units), open_area "
+                        "(input unit squared), contact_type, error_estimate (relative), source, "
+                        "message; its folder must exist (required)")
     p.add_argument("--policy", choices=POLICIES, default="table+fe",
                    help="where Q* comes from (default table+fe): table+fe = stored value, else "
                         "the grid table, else FE where the table's error estimate exceeds "
@@ -46,22 +58,44 @@ def build_parser():
                         "grid table, else the shape factor (never FE); fe-only = stored value, "
                         "else FE; shape-factor = closed-form estimate (median error ~20%%)")
     p.add_argument("--rtol", type=float, default=1e-3,
-                   help="relative tolerance of table+fe and of FE solves (default 1e-3)")
-    p.add_argument("--workers", type=int, default=1, help="processes for FE (default 1)")
-    p.add_argument("--grid", default=None, help="grid name (default: newest in --db, else shipped)")
-    p.add_argument("--quiet", action="store_true")
+                   help="relative tolerance of table+fe and of FE solves, in (0, 1) "
+                        "(default 1e-3)")
+    p.add_argument("--workers", type=int, default=1, help="processes for FE, >= 1 (default 1)")
+    p.add_argument("--grid", default=None,
+                   help="grid name (default: the newest in --db, else the shipped g1)")
+    p.add_argument("--quiet", action="store_true",
+                   help="no progress bar and no statistics on stdout (default: both)")
     return p
 
 
 def main(argv=None) -> int:
+    """Run the command; exit 0 every row answered, 1 some row not (or Ctrl-C), 2 bad input."""
+    try:
+        return _main(argv)
+    except KeyboardInterrupt:
+        print("interrupted: nothing written to the output (FE results already stored in the "
+              "table are kept)", file=sys.stderr)
+        return 1
+
+
+def _main(argv):
     args = build_parser().parse_args(argv)
     logging.basicConfig(level=logging.WARNING, format="%(levelname)s %(name)s: %(message)s")
+    errors = {}
     try:
-        header, rows, radii, sides = read_throat_csv(args.csv)
+        if not 0 < args.rtol < 1:
+            raise ValueError(f"--rtol must be in (0, 1), got {args.rtol}")
+        if args.workers < 1:
+            raise ValueError(f"--workers must be >= 1, got {args.workers}")
+        check_output(args.out)
+        if args.db is not None and os.path.isdir(args.db):
+            raise ValueError(f"--db {args.db} is a folder, not a file")
+        header, rows, radii, sides = read_throat_csv(args.csv, errors)
         res = lookup_qstar(radii, sides, db=args.db, policy=args.policy, rtol=args.rtol,
                            workers=args.workers, progress=not args.quiet, grid=args.grid)
-    except (OSError, ValueError, CacheFileError) as e:
-        print(f"error: {e}", file=sys.stderr)
+    except (OSError, ValueError, CacheFileError, sqlite3.OperationalError) as e:
+        msg = f"{e.strerror}: {e.filename}" if isinstance(e, OSError) and e.filename else e
+        print(f"error: {msg}", file=sys.stderr)
         return 2
     ok = res.source != "failed"
     area = np.full(len(rows), np.nan)
@@ -69,14 +103,14 @@ def main(argv=None) -> int:
     if ok.any():
         area[ok] = throats.open_area(radii[ok], sides[ok])        # input units squared
         ctype[ok] = throats.contact_type(radii[ok], sides[ok])
-    for i in np.flatnonzero(~ok):
-        print(f"row {i + 2}: {res.message[i]}", file=sys.stderr)  # +2: header, 1-based
+    for line in row_problems(args.csv, ok, res.message, errors):
+        print(line, file=sys.stderr)
     write_csv(args.out, header, rows, {"qstar": res.qstar, "open_area": area,
                                       "contact_type": ctype, "error_estimate": res.error_estimate,
                                       "source": res.source, "message": res.message})
     if not args.quiet:
         print(json.dumps(res.stats, indent=1))
-    return 0
+    return 0 if ok.all() else 1
 
 
 if __name__ == "__main__":

@@ -26,15 +26,18 @@ shapes between them through claims in the table (``docs/cache-precompute.md``). 
 
 from __future__ import annotations
 
-import argparse
 import contextlib
 import json
 import logging
 import os
+import sqlite3
 import sys
 
+import throats
+from throats.solve import OneLineParser, check_output
+
 from ._build import precompute_grid, precompute_throats, resolve_solver
-from ._csvio import read_throat_csv
+from ._csvio import read_throat_csv, row_problems
 from ._dask import DaskConnectError, dask_executor
 from ._interp import GRIDS
 from ._lookup import export_grid
@@ -42,23 +45,35 @@ from ._store import CacheFileError, open_store
 
 
 def build_parser():
-    p = argparse.ArgumentParser(prog="python -m cache.precompute", description=__doc__.split("\n")[0])
-    p.add_argument("--db", required=True, help="SQLite throat table (created if missing)")
+    p = OneLineParser(prog="python -m cache.precompute", description=__doc__.split("\n")[0])
+    p.add_argument("--db", required=True, metavar="DB.sqlite",
+                   help="SQLite throat table; created if missing, its folder must exist "
+                        "(required)")
     src = p.add_mutually_exclusive_group(required=True)
-    src.add_argument("--csv", help="throat shapes, columns r1,r2,r3,l12,l13,l23")
+    src.add_argument("--csv", metavar="IN.csv",
+                     help="throat shapes, columns r1,r2,r3,l12,l13,l23 in any one length unit "
+                          "(as written by python -m network.throats); a bad row is refused "
+                          "before anything is written")
     src.add_argument("--grid", choices=sorted(GRIDS), help="named interpolation grid to fill")
-    p.add_argument("--rtol", type=float, default=1e-3, help="FE tolerance (default 1e-3)")
+    p.add_argument("--rtol", type=float, default=1e-3,
+                   help="relative FE tolerance, in (0, 1) (default 1e-3)")
     p.add_argument("--workers", type=int, default=1,
-                   help="local processes, or the LocalCluster's with --dask local (default 1)")
+                   help="local processes, or the LocalCluster's with --dask local, >= 1 "
+                        "(default 1: this process)")
     p.add_argument("--dask", metavar="ADDRESS",
                    help="run the FE batches on Dask: 'local' (a LocalCluster of --workers "
                         "processes) or a scheduler address such as tcp://host:8786 "
                         "(default: no Dask, multiprocessing)")
-    p.add_argument("--batch-size", type=int, default=16, help="solves per transaction (default 16)")
-    p.add_argument("--retry-failed", action="store_true", help="solve recorded failures again")
-    p.add_argument("--max-hours", type=float, default=None, help="stop submitting after this long")
-    p.add_argument("--export", metavar="NPZ", help="after a --grid run, write the grid as .npz")
-    p.add_argument("--quiet", action="store_true", help="no progress bar")
+    p.add_argument("--batch-size", type=int, default=16,
+                   help="shapes per task and per transaction, >= 1 (default 16)")
+    p.add_argument("--retry-failed", action="store_true",
+                   help="solve recorded failures again (default: skip them)")
+    p.add_argument("--max-hours", type=float, default=None,
+                   help="stop submitting batches after this many hours, > 0 (default: no limit)")
+    p.add_argument("--export", metavar="NPZ",
+                   help="after a complete --grid run, write the grid as .npz; its folder must "
+                        "exist (default: not written)")
+    p.add_argument("--quiet", action="store_true", help="no progress bar (default: a bar)")
     return p
 
 
@@ -72,19 +87,44 @@ def main(argv=None) -> int:
         return 1
 
 
+def _check(args):
+    """Every option and the CSV, before anything is written: ValueError/OSError."""
+    if not 0 < args.rtol < 1:
+        raise ValueError(f"--rtol must be in (0, 1), got {args.rtol}")
+    if args.workers < 1 or args.batch_size < 1:
+        raise ValueError(f"--workers and --batch-size must be >= 1, got {args.workers} and "
+                         f"{args.batch_size}")
+    if args.max_hours is not None and not args.max_hours > 0:
+        raise ValueError(f"--max-hours must be > 0, got {args.max_hours}")
+    check_output(args.db, "--db")
+    if args.export:
+        if not args.grid:
+            raise ValueError("--export needs --grid")
+        check_output(args.export, "--export")
+    if not args.csv:
+        return None, None
+    errors = {}
+    _, _, radii, sides = read_throat_csv(args.csv, errors)
+    if len(radii) == 0:
+        raise ValueError(f"{args.csv}: no throat rows after the header")
+    ok, msg = throats.validate_throats(radii, sides)
+    bad = row_problems(args.csv, ok, msg, errors)
+    if bad:
+        more = f" (and {len(bad) - 1} more bad rows)" if len(bad) > 1 else ""
+        raise ValueError(f"{bad[0]}{more}; nothing written")
+    return radii, sides
+
+
 def _main(argv):
     args = build_parser().parse_args(argv)
     logging.basicConfig(level=logging.INFO, format="%(levelname)s %(name)s: %(message)s")
     os.environ.setdefault("DASK_LOGGING__DISTRIBUTED", "warning")   # Dask's cluster chatter
-    if args.workers < 1 or args.batch_size < 1:
-        print("error: --workers and --batch-size must be >= 1", file=sys.stderr)
-        return 2
     try:
+        radii, sides = _check(args)
         solver, version = resolve_solver(None, None)
-        if args.csv:
-            _, _, radii, sides = read_throat_csv(args.csv)
     except (ImportError, OSError, ValueError) as e:
-        print(f"error: {e}", file=sys.stderr)
+        msg = f"{e.strerror}: {e.filename}" if isinstance(e, OSError) and e.filename else e
+        print(f"error: {msg}", file=sys.stderr)
         return 2
     with contextlib.ExitStack() as stack:
         executor, slots = None, args.workers
@@ -97,7 +137,7 @@ def _main(argv):
                 return 2
         try:
             store = stack.enter_context(open_store(args.db))
-        except CacheFileError as e:
+        except (CacheFileError, OSError, sqlite3.OperationalError) as e:
             print(f"error: {e}", file=sys.stderr)
             return 2
         kw = dict(rtol=args.rtol, solver=solver, solver_version=version, workers=slots,

@@ -21,6 +21,7 @@ done, 1 failed, 2 bad input: one ``error:`` line (docs/cli.md).
 from __future__ import annotations
 
 import logging
+import os
 import sys
 import time
 
@@ -41,11 +42,14 @@ def build_parser() -> CliParser:
                     "1 failed, 2 bad input (docs/cli.md).")
     add_packing(ap)
     ap.add_argument("--out", required=True, metavar="OUT.csv",
-                    help=f"output CSV, columns {HEADER} (lengths in m; required)")
+                    help=f"output CSV, columns {HEADER} (lengths in m, 17 significant digits; "
+                         "its folder must exist; required)")
     add_sample(ap, cylinder=False)
     ap.add_argument("--all", dest="everything", action="store_true",
-                    help="every interior face of the whole tessellation, not only the sample")
-    ap.add_argument("--quiet", "-q", action="store_true", help="no progress on stderr")
+                    help="every interior face of the whole tessellation (default: only the "
+                         "faces of the flow sample, as network.solve uses)")
+    ap.add_argument("--quiet", "-q", action="store_true",
+                    help="no progress on stderr (default: progress shown)")
     return ap
 
 
@@ -75,8 +79,10 @@ def _main(args) -> int:
             idx = sample.throats
         data = np.column_stack([tess.throat_radii[idx], tess.throat_sides[idx], idx,
                                 tess.throat_pores[idx]])
-        np.savetxt(args.out, data, delimiter=",", fmt=["%.17g"] * 6 + ["%d"] * 3, comments="",
+        part = f"{args.out}.part"            # complete file or none (Ctrl-C, full disk)
+        np.savetxt(part, data, delimiter=",", fmt=["%.17g"] * 6 + ["%d"] * 3, comments="",
                    header=HEADER)
+        os.replace(part, args.out)
     print(f"wrote {args.out}: {idx.size} throats of {tess.n_throats} "
           f"({packing.n} spheres, {path}, read in {args.units}) in "
           f"{time.perf_counter() - t0:.2f} s")

@@ -154,15 +154,22 @@ def test_clis_round_trip(tmp_path, monkeypatch, capsys):
         w.writerow(["id", "r1", "r2", "r3", "l12", "l13", "l23"])
         for i in range(40):
             w.writerow([i, *(r[i] * 3e-3), *(s[i] * 3e-3)])
-        w.writerow([40, 1, 1, 1, 1, 1, 5])  # not a triangle: reported, still written
+    good = tmp_path / "good.csv"
+    good.write_text("".join(src.read_text().splitlines(keepends=True)[:41]))
+    with open(src, "a", newline="") as fh:
+        csv.writer(fh).writerow([40, 1, 1, 1, 1, 1, 5])   # not a triangle
     db = tmp_path / "cli.sqlite"
-    assert precompute_cli.main(["--db", str(db), "--csv", str(src), "--quiet"]) == 0
+    # precompute refuses the file before writing anything (issue 13), naming the row
+    assert precompute_cli.main(["--db", str(db), "--csv", str(src), "--quiet"]) == 2
+    assert "in.csv row 42: sides" in capsys.readouterr().err and not db.exists()
+    assert precompute_cli.main(["--db", str(db), "--csv", str(good), "--quiet"]) == 0
     assert '"solved": 40' in capsys.readouterr().out
-    assert precompute_cli.main(["--db", str(db), "--csv", str(src), "--quiet"]) == 0
+    assert precompute_cli.main(["--db", str(db), "--csv", str(good), "--quiet"]) == 0
     assert '"reused": 40' in capsys.readouterr().out
     out = tmp_path / "out.csv"
+    # lookup answers the other rows, reports the bad one (written empty) and exits 1
     assert lookup_cli.main(["--db", str(db), "--csv", str(src), "--out", str(out),
-                            "--policy", "fe-only", "--quiet"]) == 0
+                            "--policy", "fe-only", "--quiet"]) == 1
     assert "row 42" in capsys.readouterr().err
     with open(out) as fh:
         rows = list(csv.DictReader(fh))
@@ -173,7 +180,7 @@ def test_clis_round_trip(tmp_path, monkeypatch, capsys):
     assert {"open_area", "contact_type", "error_estimate"} <= set(rows[0])
     bad = tmp_path / "bad.sqlite"
     bad.write_bytes(b"not a database at all" * 100)
-    assert precompute_cli.main(["--db", str(bad), "--csv", str(src), "--quiet"]) == 2
+    assert precompute_cli.main(["--db", str(bad), "--csv", str(good), "--quiet"]) == 2
     assert "not an SQLite database" in capsys.readouterr().err
 
 

@@ -50,8 +50,8 @@ def test_csv_mode_writes_valid_rows_and_names_bad_ones(tmp_path, capsys):
     rc = main(["--csv", str(src), "--out", str(dst), "--no-progress"])
     assert rc == 1
     err = capsys.readouterr().err
-    assert "row 2 (line 3)" in err and "cannot parse l12" in err
-    assert "row 5 (line 6)" in err and "radius <= 0" in err
+    assert "row 3:" in err and "cannot parse l12" in err
+    assert "row 6:" in err and "radius <= 0" in err
     rows = list(csv.DictReader(dst.open()))
     assert [r["id"] for r in rows] == ["a", "b", "c", "d", "e"]
     assert [r["status"] for r in rows] == ["ok", "invalid", "ok", "closed", "invalid"]

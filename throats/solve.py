@@ -16,10 +16,12 @@ message`` added (the columns of ``python -m cache.lookup``, with the same meanin
 * ``open_area``: open (fluid) area of the cross-section in the input's length unit squared
   (m² for a CSV in metres), not scaled by r̄.
 
-Default method ``fem``.  A bad row (unparsable, NaN, non-positive radius, impossible or collinear
-triangle) is reported on stderr with its row and line number; the valid rows are still
-written.  Exit status: 0 when every row is 'ok' or 'closed', 1 when some row is invalid or
-failed, 2 for usage errors.
+Default method ``fem``.  Every triangle of disks gets an answer (``status`` 'ok' or 'closed',
+Q* possibly 0).  A bad row (unparsable, NaN, non-positive radius, impossible or collinear
+triangle) is reported on stderr as ``FILE row N: ...`` with N counted as a spreadsheet does
+(header = row 1); the other rows are still written.  Exit status: 0 when every row has an
+answer, 1 when some row is invalid or failed (or Ctrl-C), 2 for bad options or files (one
+``error:`` line, checked before anything is computed or written).
 """
 
 from __future__ import annotations
@@ -27,6 +29,7 @@ from __future__ import annotations
 import argparse
 import csv
 import json
+import os
 import sys
 import time
 
@@ -37,30 +40,56 @@ from ._geometry import contact_type, validate_throats
 from ._shape_factor import FIT, shape_factor_qstar
 from ._solve import solve_fem
 
+__all__ = ["OneLineParser", "check_output", "main"]
+
 COLUMNS = ["r1", "r2", "r3", "l12", "l13", "l23"]
 METHODS = ("fem", "shape-factor")
 
 
+class OneLineParser(argparse.ArgumentParser):
+    """``ArgumentParser`` whose usage errors are one ``error:`` line and exit 2."""
+
+    def error(self, message):
+        print(f"error: {message} (see {self.prog} --help)", file=sys.stderr)
+        raise SystemExit(2)
+
+
+def check_output(path, option="--out"):
+    """ValueError naming ``option`` if ``path`` cannot be written (folder missing, a folder)."""
+    folder = os.path.dirname(os.path.abspath(path))
+    if os.path.isdir(path):
+        raise ValueError(f"{option} {path} is a folder, not a file")
+    if not os.path.isdir(folder):
+        raise ValueError(f"{option} {path}: folder {folder} does not exist")
+
+
 def _parser():
-    p = argparse.ArgumentParser(
+    p = OneLineParser(
         prog="python -m throats.solve",
         description="Dimensionless throat flow Q* (units of the mean radius) by finite "
                     "elements or the shape-factor estimate.")
     src = p.add_mutually_exclusive_group(required=True)
     src.add_argument("--radii", nargs=3, type=float, metavar=("R1", "R2", "R3"),
-                     help="radii of the three spheres (with --sides)")
+                     help="radii of the three spheres, any length unit, the same as --sides "
+                          "(one throat, printed as JSON)")
     src.add_argument("--csv", metavar="IN.csv",
-                     help="CSV with columns r1,r2,r3,l12,l13,l23")
+                     help="CSV with columns r1,r2,r3,l12,l13,l23 (any one length unit; other "
+                          "columns are copied)")
     p.add_argument("--sides", nargs=3, type=float, metavar=("L12", "L13", "L23"),
-                   help="side lengths between the sphere centres (with --radii)")
-    p.add_argument("--out", metavar="OUT.csv", help="output CSV (with --csv)")
+                   help="side lengths between the sphere centres, the unit of --radii")
+    p.add_argument("--out", metavar="OUT.csv",
+                   help="output CSV (required with --csv): the input columns plus qstar "
+                        "(r-bar units), open_area (input unit squared), contact_type, "
+                        "error_estimate (relative), status, message")
     p.add_argument("--method", choices=METHODS, default="fem",
                    help="fem (default: finite elements to --rtol) or shape-factor (closed-form "
                         "estimate, median error ~20%%)")
     p.add_argument("--rtol", type=float, default=1e-3,
-                   help="relative tolerance of the FE solve (default 1e-3)")
-    p.add_argument("--workers", type=int, default=1, help="processes for FE (default 1)")
-    p.add_argument("--no-progress", action="store_true", help="no progress bar")
+                   help="relative tolerance of the FE solve, in (0, 1) (default 1e-3)")
+    p.add_argument("--workers", type=int, default=1,
+                   help="processes for FE, >= 1 (default 1)")
+    p.add_argument("--no-progress", action="store_true",
+                   help="no progress bar on stderr (default: a bar for more than 20 rows)")
     return p
 
 
@@ -110,6 +139,15 @@ def _read_csv(path):
 
 
 def main(argv=None) -> int:
+    """Run the command; exit 0 every row answered, 1 some row not (or Ctrl-C), 2 bad input."""
+    try:
+        return _main(argv)
+    except KeyboardInterrupt:
+        print("interrupted: nothing written", file=sys.stderr)
+        return 1
+
+
+def _main(argv):
     parser = _parser()
     args = parser.parse_args(argv)
     if not (0 < args.rtol < 1):
@@ -135,9 +173,11 @@ def main(argv=None) -> int:
     if not args.out:
         parser.error("--csv needs --out OUT.csv")
     try:
+        check_output(args.out)
         rows, fields, vals, parse_err = _read_csv(args.csv)
     except (OSError, ValueError) as exc:
-        print(f"error: {exc}", file=sys.stderr)
+        msg = f"{exc.strerror}: {exc.filename}" if isinstance(exc, OSError) else exc
+        print(f"error: {msg}", file=sys.stderr)
         return 2
     progress = (not args.no_progress) and len(rows) > 20
     res = _compute(vals[:, :3], vals[:, 3:], args.method, args.rtol, args.workers, progress)
@@ -147,10 +187,10 @@ def main(argv=None) -> int:
     for k in range(len(rows)):
         if res["status"][k] in ("invalid", "failed"):
             bad += 1
-            print(f"row {k + 1} (line {k + 2}): {res['status'][k]}: {res['message'][k]}",
-                  file=sys.stderr)
+            print(f"{args.csv} row {k + 2}: {res['status'][k]}: {res['message'][k]}",
+                  file=sys.stderr)   # header = row 1, as in a spreadsheet
     extra = ["qstar", "open_area", "contact_type", "error_estimate", "status", "message"]
-    with open(args.out, "w", newline="") as fh:
+    with open(f"{args.out}.part", "w", newline="") as fh:   # renamed once complete
         w = csv.DictWriter(fh, fieldnames=[f for f in fields if f not in extra] + extra)
         w.writeheader()
         for k, row in enumerate(rows):
@@ -161,6 +201,7 @@ def main(argv=None) -> int:
                     v = "" if not np.isfinite(v) else repr(float(v))
                 row[key] = str(v)
             w.writerow(row)
+    os.replace(f"{args.out}.part", args.out)
     n_ok = len(rows) - bad
     print(f"wrote {args.out}: {n_ok} of {len(rows)} rows solved ({args.method})",
           file=sys.stderr)
