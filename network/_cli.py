@@ -25,6 +25,7 @@ from pathlib import Path
 
 from ._air import MU_AIR_PA_S, RHO_AIR_KG_M3, check_positive
 from .packing import UNITS, default_packing_path, read_packing, scale_warning
+from .flow import INERTIAL_LAWS
 
 __all__ = ["EXIT_OK", "EXIT_FAILED", "EXIT_BAD_INPUT", "CliError", "CliParser", "bad_input",
            "computing", "run", "add_packing", "add_sample", "add_air", "check_outputs",
@@ -168,6 +169,10 @@ def add_air(ap, *, density: bool = True) -> None:
     if density:
         ap.add_argument("--density", type=float, default=RHO_AIR_KG_M3,
                         help="air density for the inertial losses, kg/m^3, > 0")
+        ap.add_argument("--inertial-law", default="onset", choices=tuple(INERTIAL_LAWS),
+                        help="per-conduit inertial loss: onset = laminar-jet expansion with the "
+                             "Re^2 onset, quadratic = flat-profile K q|q| from the start "
+                             "(docs/inertial-flow.md)")
 
 
 # ------------------------------------------------------------------ checks

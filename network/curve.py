@@ -182,7 +182,8 @@ def _main(args) -> int:
         res = solve_network(packing, axis=args.axis, region=region, policy=args.policy,
                             viscosity_pa_s=args.viscosity, velocity_m_s=us[0],
                             depth_m=args.depth, rtol=args.rtol, db=args.db, inertia=True,
-                            density_kg_m3=args.density, curve_velocities_m_s=us[1:])
+                            density_kg_m3=args.density, curve_velocities_m_s=us[1:],
+                            inertial_law=args.inertial_law)
         pts = [{k: p[k] for k in KEYS} | {"newton_iterations": p["newton_iterations"],
                                           "cg_iterations": p["cg_iterations"]}
                for p in res.curve_points()]

@@ -125,7 +125,8 @@ def test_amg_solver_builds_once_and_keeps_evolution():
     assert amg.builds == 1 and i1.setup_s > 0 and i2.setup_s == 0.0
     np.testing.assert_allclose(x2, 2 * x1, rtol=1e-8)
     x_ref, _ = solve_pressure(A_ii, b_i)
-    np.testing.assert_allclose(x1, x_ref, rtol=1e-12)   # solve_pressure: one AMGSolver solve
+    # solve_pressure is one AMGSolver solve: the same answer to the CG tolerance (1e-10)
+    np.testing.assert_allclose(x1, x_ref, rtol=1e-8)
     rng = np.random.default_rng(11)
     idx, c = grid_network(14, 14, 14)
     g = 10.0 ** rng.uniform(0, 12, len(c))

@@ -32,7 +32,7 @@ from ._linear import solve_fixed_pressure
 from ._result import FlowResult
 
 __all__ = ["solve_network", "solve_axes", "DEFAULT_VELOCITY_M_S", "DEFAULT_DEPTH_M",
-           "CORE_MARGIN_DIAMETERS", "CORE_MIN_DIAMETERS"]
+           "CORE_MARGIN_DIAMETERS", "CORE_MIN_DIAMETERS", "INERTIAL_LAWS"]
 
 log = logging.getLogger(__name__)
 
@@ -55,7 +55,7 @@ def solve_network(packing: Packing, *, axis="z", region: Region | None = None,
                   qstar_fn: Callable | None = None, model_options: dict | None = None,
                   core_margin_m: float | None = None, inertia: bool = False,
                   density_kg_m3: float = RHO_AIR_KG_M3,
-                  curve_velocities_m_s=None) -> FlowResult:
+                  curve_velocities_m_s=None, inertial_law: str = "onset") -> FlowResult:
     """Permeability and pressure drop of a packing by the Delaunay network model.
 
     Parameters
@@ -115,6 +115,10 @@ def solve_network(packing: Packing, *, axis="z", region: Region | None = None,
         ρ of the inertial loss (default 1.20 kg/m³).
     curve_velocities_m_s : sequence of float, optional
         More superficial velocities (m/s, > 0) for the resistance curve.
+    inertial_law : {'onset', 'quadratic'}
+        Per-conduit inertial loss (:data:`INERTIAL_LAWS`): 'onset' (default) the expansion
+        with the laminar jet profile and the Re² onset (crossover 1); 'quadratic' the
+        flat-profile loss K q|q| from the start (``docs/inertial-flow.md`` compares them).
 
     Returns
     -------
@@ -131,6 +135,9 @@ def solve_network(packing: Packing, *, axis="z", region: Region | None = None,
         check_policy(policy)
     if core_margin_m is not None:
         core_margin_m = check_positive("core_margin_m", core_margin_m)
+    if inertial_law not in INERTIAL_LAWS:
+        raise ValueError(f"unknown inertial law {inertial_law!r}; choose one of "
+                         f"{', '.join(INERTIAL_LAWS)}")
     density_kg_m3 = check_density(density_kg_m3)
     curve_u = [check_positive("velocity_m_s", u) for u in (curve_velocities_m_s or [])]
     if inertia and (conductance is not None or conductance_model != "conduit"):
@@ -181,13 +188,16 @@ def solve_network(packing: Packing, *, axis="z", region: Region | None = None,
     inertial = None
     if inertia:
         with stage("inertial"):
+            profile, crossover = INERTIAL_LAWS[inertial_law]
             K = inertial_coefficients(tess, throats_before, cres.h_m, internal=cres.internal,
-                                      density_kg_m3=density_kg_m3)
+                                      density_kg_m3=density_kg_m3, profile=profile)
             K = K[np.searchsorted(throats_before, sample.throats)]
             us = [velocity_m_s] + curve_u
             pts = solve_inertial(sample.n_pores, sample.conns, g, K, sample.inlet,
-                                 sample.outlet, np.asarray(us) * sample.area_m2)
-            inertial = {"density_kg_m3": density_kg_m3, "velocities_m_s": us, "points": pts}
+                                 sample.outlet, np.asarray(us) * sample.area_m2,
+                                 crossover=crossover)
+            inertial = {"density_kg_m3": density_kg_m3, "velocities_m_s": us, "points": pts,
+                        "law": inertial_law}
     times["assemble"] = info.assemble_s
     times["solve"] -= info.assemble_s
     if not check["ok"]:
@@ -237,6 +247,9 @@ def solve_network(packing: Packing, *, axis="z", region: Region | None = None,
         permeability_core_m2=k_core, core_margin_m=core_margin, inertial=inertial,
         throat_qstar=None if window_qstar is None else window_qstar[sample.throats])
 
+
+#: Per-conduit inertial laws: (velocity profile of the expansion, crossover X_c of the onset).
+INERTIAL_LAWS = {"onset": ("laminar", 1.0), "quadratic": ("uniform", None)}
 
 #: Core margin of :func:`_core_estimate`, in mean sphere diameters.
 CORE_MARGIN_DIAMETERS = 2.0
