@@ -56,7 +56,7 @@ def claim(store, keys, *, solver_version, rtol, owner, done_statuses):
     m = len(keys)
     now = time.time()
     conn = store.conn
-    with store._transaction():
+    with store.transaction():
         conn.execute(_SCHEMA)
         have = store.lookup_keys(keys, solver_version=solver_version, rtol=rtol)
         stored = have["found"] & np.isin(have["status"], list(done_statuses))
@@ -82,7 +82,7 @@ def claim(store, keys, *, solver_version, rtol, owner, done_statuses):
 def release(store, owner):
     """Drop every claim of ``owner`` (its run ended); never raises."""
     try:
-        with store._transaction():
+        with store.transaction():
             store.conn.execute(_SCHEMA)
             store.conn.execute("DELETE FROM claims WHERE owner = ?", (owner,))
     except Exception:  # noqa: BLE001 - a claim left behind expires on its own

@@ -268,9 +268,11 @@ class ThroatStore:
     def meta(self):
         return {r["key"]: r["value"] for r in self.db.query("SELECT key, value FROM grainflow_meta")}
 
-    # -- internals ------------------------------------------------------------------------
-    def _transaction(self):
+    def transaction(self):
+        """``with store.transaction():`` one ``BEGIN IMMEDIATE`` … ``COMMIT`` (rollback on error)."""
         return _Transaction(self.conn, self.path)
+
+    _transaction = transaction
 
 
 class _Transaction:
