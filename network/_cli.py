@@ -16,6 +16,7 @@ the packing file's unit (``--units``, default m); physical quantities (``--depth
 from __future__ import annotations
 
 import argparse
+import logging
 import contextlib
 import os
 import re
@@ -97,6 +98,12 @@ def computing():
 def warn(message: str) -> None:
     """One ``warning:`` line on stderr."""
     print(f"warning: {' '.join(str(message).split())}", file=sys.stderr)
+
+
+def progress_log(args, fmt: str = "[%(relativeCreated)7.0f ms] %(message)s") -> None:
+    """Stage progress on stderr (INFO log lines) unless ``--quiet``."""
+    if not getattr(args, "quiet", False):
+        logging.basicConfig(level=logging.INFO, format=fmt, stream=sys.stderr)
 
 
 def run(body, parser: argparse.ArgumentParser, argv=None) -> int:

@@ -17,7 +17,6 @@ from __future__ import annotations
 
 import csv
 import json
-import logging
 import sys
 import time
 
@@ -25,7 +24,8 @@ import numpy as np
 
 from ._air import check_positive
 from ._cli import (CliError, CliParser, add_air, add_packing, add_sample, bad_input, check_common,
-                   check_outputs, check_plot, computing, load_packing, run, sample_box_m)
+                   check_outputs, check_plot, computing, load_packing, progress_log, run,
+                   sample_box_m)
 from .conductance import POLICIES
 from .flow import (ASABE_SOYBEAN_A, ASABE_SOYBEAN_B, DEFAULT_DEPTH_M, GRAINS,
                    asabe_d272_gradient, ergun_gradient, fit_curve, solve_network)
@@ -167,9 +167,7 @@ def main(argv=None) -> int:
 
 
 def _main(args) -> int:
-    if not args.quiet:
-        logging.basicConfig(level=logging.INFO, format="[%(relativeCreated)7.0f ms] %(message)s",
-                            stream=sys.stderr)
+    progress_log(args)
     t0 = time.perf_counter()
     with bad_input():
         us = _check_options(args)

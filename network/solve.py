@@ -16,7 +16,6 @@ done, 1 the computation failed, 2 bad input: one ``error:`` line (docs/cli.md).
 from __future__ import annotations
 
 import json
-import logging
 import sys
 import time
 from pathlib import Path
@@ -24,7 +23,7 @@ from pathlib import Path
 import numpy as np
 
 from ._cli import (CliError, CliParser, add_air, add_packing, add_sample, bad_input, check_common,
-                   check_outputs, computing, load_packing, run, sample_box_m)
+                   check_outputs, computing, load_packing, progress_log, run, sample_box_m)
 from .conductance import MODELS, POLICIES, throat_qstar
 from .flow import (DEFAULT_DEPTH_M, DEFAULT_VELOCITY_M_S, combined_summary, solve_axes,
                    write_network_vtu)
@@ -207,9 +206,7 @@ def main(argv=None) -> int:
 
 
 def _main(args) -> int:
-    if not args.quiet:
-        logging.basicConfig(level=logging.INFO, format="[%(relativeCreated)7.0f ms] %(message)s",
-                            stream=sys.stderr)
+    progress_log(args)
     t0 = time.perf_counter()
     axes = ["x", "y", "z"] if args.axis == "all" else [args.axis]
     with bad_input():

@@ -20,7 +20,6 @@ done, 1 failed, 2 bad input: one ``error:`` line (docs/cli.md).
 
 from __future__ import annotations
 
-import logging
 import os
 import sys
 import time
@@ -28,7 +27,7 @@ import time
 import numpy as np
 
 from ._cli import (CliParser, add_packing, add_sample, bad_input, check_common, check_outputs,
-                   computing, load_packing, run, sample_box_m)
+                   computing, load_packing, progress_log, run, sample_box_m)
 from .pores import sample_region, select_sample, tessellate, tie_groups
 
 HEADER = "r1,r2,r3,l12,l13,l23,throat,pore1,pore2"
@@ -59,8 +58,7 @@ def main(argv=None) -> int:
 
 
 def _main(args) -> int:
-    if not args.quiet:
-        logging.basicConfig(level=logging.INFO, format="%(message)s", stream=sys.stderr)
+    progress_log(args, "%(message)s")
     t0 = time.perf_counter()
     with bad_input():
         check_common(args)
