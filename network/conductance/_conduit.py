@@ -289,7 +289,9 @@ def conduit_conductance(tessellation, throats_idx=None, *, viscosity_pa_s: float
     -------
     ConductanceResult
         ``g`` (M,) m³ Pa⁻¹ s⁻¹, window ``qstar``, conduit heights ``h_m`` (M, 2), ``internal``;
-        ``stats``: sections, n_sections, merge summary, n_internal, qstar_stats, seconds.
+        ``stats``: sections, n_sections, merge summary, n_internal, qstar_stats (the windows),
+        section_qstar_stats (the sections away from the windows: count and Q* sources, e.g.
+        how many ran FE), seconds.
 
     Raises
     ------
@@ -341,6 +343,7 @@ def conduit_conductance(tessellation, throats_idx=None, *, viscosity_pa_s: float
     g = np.zeros(idx.size)
     qstar = np.full(idx.size, np.nan)
     qstats = {}
+    section_stats = {"n_sections": 0, "sources": {}}
     if need.any():
         r_n, s_n = radii[need], sides[need]
         qres = throat_qstar(r_n, s_n, policy=policy, rtol=rtol, db=db, workers=workers,
@@ -365,6 +368,10 @@ def conduit_conductance(tessellation, throats_idx=None, *, viscosity_pa_s: float
                 rb = rr[live].mean(axis=1)
                 qq = np.asarray(res.qstar, dtype=float) * rb**4
                 src = np.asarray(res.source, dtype=str)
+                section_stats["n_sections"] += int(src.size)
+                for kind, count in zip(*np.unique(src, return_counts=True)):
+                    section_stats["sources"][str(kind)] = (
+                        section_stats["sources"].get(str(kind), 0) + int(count))
                 if policy != "shape-factor":
                     # outside the table the cache falls back to the shape factor, which is
                     # 2-10 times off for these open sections: continue by ratios instead
@@ -385,7 +392,7 @@ def conduit_conductance(tessellation, throats_idx=None, *, viscosity_pa_s: float
     seconds = time.perf_counter() - t0
     stats = jsonable({"model": "conduit", "sections": sections, "n_sections": int(n_sections),
                       "merge": pm, "n_internal": int(internal.sum()), "qstar_stats": qstats,
-                      "seconds": seconds})
+                      "section_qstar_stats": section_stats, "seconds": seconds})
     logger.info("conduit conductance of %d throats (%d inside merged bodies) in %.2f s",
                 idx.size, int(internal.sum()), seconds)
     return ConductanceResult(g, "conduit", qstar, stats, h_m=h, internal=internal)
