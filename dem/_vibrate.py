@@ -98,8 +98,9 @@ def vibrate_bed(centers, radii, container, *, freq_hz=15.0, amplitude_m=0.002, d
     tol : float
         Equilibrium criterion of the final settling (after the walls stop).
     steady_window_s : float, optional
-        Stop the vibration early once the global porosity has been steady this long: over the
-        last window its least-squares slope times the window is below ``steady_tol``.
+        Stop the vibration early once the global porosity has been steady this long: the means
+        of the window's two halves differ by less than ``steady_tol`` including two standard
+        errors (per-period values that still fluctuate are not steady).
     rest_tol : float, optional
         Refuse (ValueError) a packing that is not at rest: one whose spheres move on average
         more than ``rest_tol`` mean radii in :data:`REST_PROBE_S` with the walls still
@@ -212,12 +213,16 @@ def vibrate_bed(centers, radii, container, *, freq_hz=15.0, amplitude_m=0.002, d
 
 
 def _steady(hist, window_s, tol):
-    """True when the global porosity's least-squares change over the last ``window_s`` is below tol."""
+    """True when the global porosity has been steady over the last ``window_s``: the means of
+    its two halves differ by less than ``tol`` with two standard errors added, so a bed whose
+    per-period porosity still fluctuates (a bed in flight above 1 g) is never called steady."""
     t = np.asarray(hist["times_s"])
     if t[-1] - t[0] < window_s:
         return False
-    sel = t >= t[-1] - window_s
-    if sel.sum() < 3:
+    p = np.asarray(hist["porosity_global"])
+    a = p[(t >= t[-1] - window_s) & (t < t[-1] - window_s / 2)]
+    b = p[t >= t[-1] - window_s / 2]
+    if len(a) < 3 or len(b) < 3:
         return False
-    slope = np.polyfit(t[sel], np.asarray(hist["porosity_global"])[sel], 1)[0]
-    return abs(slope) * window_s < tol
+    err = np.sqrt(a.var(ddof=1) / len(a) + b.var(ddof=1) / len(b))
+    return abs(b.mean() - a.mean()) + 2 * err < tol

@@ -87,7 +87,7 @@ def test_interrupted_vibration_resumes_to_the_same_numbers(bed):
 
 def test_vibration_stops_when_the_porosity_is_steady(bed):
     res = vibrate_bed(bed.centers, bed.radii, TINY, freq_hz=15.0, amplitude_m=0.0005, duration_s=1.0,
-                      record_every_s=1 / 15, steady_window_s=0.2, steady_tol=0.01, max_settle_steps=100)
+                      record_every_s=1 / 150, steady_window_s=0.2, steady_tol=0.01, max_settle_steps=100)
     assert res.summary["stopped_by"] == "steady"
     assert 0.2 <= res.summary["vibrated_s"] < 1.0
 
