@@ -52,9 +52,13 @@ def test_solve_default_scene(default_run, capsys):
     assert vtu["pressure"].shape == (out["n_pores"],)
     assert vtu["flow"].shape == vtu["conductance"].shape == (out["n_throats"],)
     assert vtu["Points"].shape == (out["n_pores"], 3)
-    # pressures of the flow-imposed Stokes problem (the .vtu holds the Stokes field) span its drop
+    # pressures of the flow-imposed Stokes problem (the .vtu holds the Stokes field: v over the
+    # whole cross-section) span mu v H / k_whole
     dp = vtu["pressure"].max() - vtu["pressure"].min()
-    assert np.isclose(dp, out["pressure_gradient_stokes_pa_per_m"] * out["sample_length_m"], rtol=1e-9)
+    assert np.isclose(dp, mu * v * out["sample_length_m"] / out["permeability_whole_m2"],
+                      rtol=1e-9)
+    assert out["sample_estimator"] == "inset"
+    assert abs(out["permeability_m2"] / out["permeability_whole_m2"] - 1) < 0.05
 
 
 def test_solve_all_axes(tmp_path):

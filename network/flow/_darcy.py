@@ -27,7 +27,7 @@ def darcy_permeability(q_m3_s, dp_pa, length_m, area_m2, *, viscosity_pa_s=MU_AI
 
 
 def core_permeability(sample, g, p, *, margin_m: float, viscosity_pa_s: float = 1.0,
-                      n_planes: int = 9):
+                      n_planes: int = 9, axial_margin_m: float | None = None):
     r"""Permeability of the core of a solved sample, free of its boundary layer, m².
 
     The whole-box estimate :math:`k = \mu Q H/(A\,\Delta p)` includes the layer of pores
@@ -65,6 +65,9 @@ def core_permeability(sample, g, p, *, margin_m: float, viscosity_pa_s: float = 
         μ used for ``g`` (default 1).
     n_planes : int, keyword-only
         Flux planes (default 9).
+    axial_margin_m : float, keyword-only
+        Margin at the inlet and outlet ends, m (default ``margin_m``); ``margin_m`` is then
+        the lateral one.
 
     Returns
     -------
@@ -80,10 +83,15 @@ def core_permeability(sample, g, p, *, margin_m: float, viscosity_pa_s: float = 
     margin = float(margin_m)
     if not (np.isfinite(margin) and margin > 0):
         raise ValueError(f"margin_m must be positive, got {margin_m!r}")
+    end = margin if axial_margin_m is None else float(axial_margin_m)
+    if not (np.isfinite(end) and end >= 0):
+        raise ValueError(f"axial_margin_m must be >= 0, got {axial_margin_m!r}")
     ax = int(sample.axis)
     lat = [i for i in range(3) if i != ax]
-    lo = np.asarray(sample.region.lo, dtype=float) + margin
-    hi = np.asarray(sample.region.hi, dtype=float) - margin
+    inset = np.full(3, margin)
+    inset[int(sample.axis)] = end
+    lo = np.asarray(sample.region.lo, dtype=float) + inset
+    hi = np.asarray(sample.region.hi, dtype=float) - inset
     if np.any(hi <= lo):
         raise ValueError(f"margin_m={margin_m!r} leaves no core in the region")
     x = np.asarray(sample.pore_xyz, dtype=float)

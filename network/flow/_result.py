@@ -61,6 +61,11 @@ class FlowResult:
     #: or a core too small), m²; see :func:`network.flow.core_permeability`.
     permeability_core_m2: float | None = None
     core_margin_m: float | None = None
+    #: mu Q H / (A dP) over the whole sample, m² (= permeability_m2 when ``sample_estimator``
+    #: is 'whole'; see ``docs/sample-boundary.md``).
+    permeability_whole_m2: float | None = None
+    #: 'inset': permeability_m2 from the window inside the lateral boundary layer; 'whole'.
+    sample_estimator: str = "whole"
     #: Window Q* of each sample throat (mean-radius units; NaN inside a merged pore body; None
     #: with a custom conductance function), indexed like ``throat_ids``.
     throat_qstar: np.ndarray | None = dataclasses.field(default=None, repr=False)
@@ -80,7 +85,7 @@ class FlowResult:
         rho = self.inertial["density_kg_m3"]
         rows = []
         for u, pt in zip(self.inertial["velocities_m_s"], self.inertial["points"]):
-            grad = pt.dp_pa / self.length_m
+            grad = self._inertial_gradient(pt)
             rows.append({"velocity_m_s": float(u),
                          "reynolds_particle": self.reynolds_particle(u, rho),
                          "pressure_gradient_pa_per_m": float(grad),
@@ -125,6 +130,13 @@ class FlowResult:
             "conductance_model": self.conductance_model,
             "policy": self.policy,
             "permeability_m2": self.permeability_m2,
+            "sample_estimator": self.sample_estimator,
+            "permeability_whole_m2": self.permeability_whole_m2,
+            "permeability_note": (
+                "inset: Darcy's law in the window 1.5 grain diameters in from the lateral faces "
+                "and 1 from the ends, free of the layer the cut lateral conduits leave (the "
+                "whole-sample value, permeability_whole_m2, is low by about 1/width); whole: "
+                "mu Q H / (A dP), for samples too narrow for the window (docs/sample-boundary.md)"),
             "permeability_core_m2": self.permeability_core_m2,
             "permeability_core_note": (
                 "Darcy's law in the sample's core, core_margin_m in from every face, free of "
@@ -164,12 +176,20 @@ class FlowResult:
             "seconds": self.timings_s,
         } | self._inertial_summary()
 
+    def _inertial_gradient(self, point) -> float:
+        r"""Pressure gradient of an inertial point, Pa/m: :math:`\Delta p / H` of the whole
+        sample times :math:`k_\mathrm{whole}/k` (the ratio k_app/k is taken from the whole
+        sample, whose lateral boundary layer lowers both alike; k from ``sample_estimator``).
+        """
+        whole = self.permeability_whole_m2 or self.permeability_m2
+        return point.dp_pa / self.length_m * whole / self.permeability_m2
+
     def _inertial_summary(self) -> dict:
         """Inertial value at ``velocity_m_s`` with the Stokes values beside it (issue 14)."""
         if self.inertial is None:
             return {}
         pt = self.inertial["points"][0]
-        grad = pt.dp_pa / self.length_m
+        grad = self._inertial_gradient(pt)
         return {"pressure_gradient_pa_per_m": grad,
                 "pressure_drop_pa": grad * self.depth_m,
                 "pressure_gradient_stokes_pa_per_m": self.pressure_gradient_pa_per_m,

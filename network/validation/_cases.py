@@ -98,7 +98,7 @@ def _network_permeability(tess, region, *, model, policy, qstar_fn, n_sections, 
                         viscosity_pa_s=1.0, db=db, rtol=rtol, workers=workers,
                         porosity_points=0,
                         core_margin_m=float(margin) if estimator == "core" else None)
-    return res.permeability_core_m2 if estimator == "core" else res.permeability_m2
+    return res.permeability_core_m2 if estimator == "core" else res.permeability_whole_m2
 
 
 #: Periodic copies per axis of the random validation packings (the sample is the middle
