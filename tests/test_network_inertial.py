@@ -61,10 +61,11 @@ def test_solve_reports_inertia_and_stokes_keeps_old_answer(tmp_path):
     i, s = json.loads(out_i.read_text()), json.loads(out_s.read_text())
     # the whole-sample Stokes answer of issue 12 (4.2023528e-08 m2, 1.4941630 Pa over 0.25 m)
     # and the boundary-free one reported since the inset estimator (commit of
-    # docs/sample-boundary.md's change): 4.19194e-08 m2, 1.49788 Pa
+    # docs/sample-boundary.md's change, faces weighted by their area in the window):
+    # 4.22808e-08 m2, 1.48507 Pa
     assert s["permeability_whole_m2"] == pytest.approx(4.2023528e-08, rel=1e-7)
-    assert s["permeability_m2"] == pytest.approx(4.19194e-08, rel=1e-5)
-    assert s["pressure_drop_pa"] == pytest.approx(1.4941630 * 4.2023528 / 4.19194, rel=1e-5)
+    assert s["permeability_m2"] == pytest.approx(4.22808e-08, rel=1e-5)
+    assert s["pressure_drop_pa"] == pytest.approx(1.4941630 * 4.2023528 / 4.22808, rel=1e-5)
     assert i["permeability_m2"] == pytest.approx(s["permeability_m2"], rel=1e-12)
     assert i["pressure_drop_stokes_pa"] == pytest.approx(s["pressure_drop_pa"], rel=1e-12)
     assert i["pressure_drop_pa"] > i["pressure_drop_stokes_pa"]

@@ -214,7 +214,8 @@ def solve_network(packing: Packing, *, axis="z", region: Region | None = None,
     q1 = check["q_in"]
     k_whole = darcy_permeability(q1, 1.0, sample.length_m, sample.area_m2,
                                  viscosity_pa_s=viscosity_pa_s)
-    k_inset = _inset_estimate(sample, g, p, reg, packing.grain_diameter, viscosity_pa_s)
+    faces = tess.packing.centers[tess.throat_vertices[sample.throats]]
+    k_inset = _inset_estimate(sample, g, p, reg, packing.grain_diameter, viscosity_pa_s, faces)
     k = k_whole if k_inset is None else k_inset
     # pressures and flows of the flow-imposed problem (thesis BC): Q = v A
     scale = velocity_m_s * sample.area_m2 / q1
@@ -267,7 +268,7 @@ INSET_DIAMETERS = (1.5, 1.0)
 INSET_MIN_DIAMETERS = 4.0
 
 
-def _inset_estimate(sample, g, p, region, grain_diameter_m, viscosity_pa_s):
+def _inset_estimate(sample, g, p, region, grain_diameter_m, viscosity_pa_s, faces):
     """k of the sample without its lateral boundary layer, or None (cylinder, too narrow).
 
     The conduits cut by the lateral faces leave a layer 1-2 grains thick that carries less
@@ -292,7 +293,7 @@ def _inset_estimate(sample, g, p, region, grain_diameter_m, viscosity_pa_s):
         return None
     try:
         k = core_permeability(sample, g, p, margin_m=lat * d, axial_margin_m=end * d,
-                              viscosity_pa_s=viscosity_pa_s)
+                              viscosity_pa_s=viscosity_pa_s, faces=faces)
     except ValueError as exc:
         log.warning("no boundary-free estimate (%s): permeability_m2 is the whole-sample value",
                     exc)
