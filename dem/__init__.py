@@ -50,6 +50,7 @@ from ._procedures import PROCEDURES, PackResult, pack_bed
 from ._summary import summarize, surface_height
 from ._vibrate import VibrationResult, intensity_g, rest_motion, vibrate_bed
 from ._walls import CylinderWall, PlaneWall
+from .grains import GRAIN_FIELDS, GRAINS, Grain, Sourced, grain
 
 __all__ = [
     "Material", "SOYBEAN", "Simulation", "DemInstabilityError",
@@ -61,4 +62,6 @@ __all__ = [
     # added by issue 12 (public names the tests and CLIs use instead of private modules)
     "PlaneWall", "CylinderWall", "generate_spheres", "default_measure_spheres", "surface_height",
     "lens_volume", "sphere_volume", "intensity_g", "rest_motion",
+    # the grain library (issue 16): kernel axes, densities, porosity, friction, each sourced
+    "GRAINS", "GRAIN_FIELDS", "Grain", "Sourced", "grain",
 ]
