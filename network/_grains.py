@@ -19,7 +19,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
-__all__ = ["D272Constants", "D272"]
+__all__ = ["D272Constants", "D272", "GRAIN_ALIASES", "d272_constants", "grains_with_d272"]
 
 
 @dataclass(frozen=True)
@@ -55,3 +55,34 @@ D272: dict[str, D272Constants] = {
     "canola": D272Constants(None, None, None, None, "ASABE D272.3", "not found", _NOT_FOUND),
     "sorghum": D272Constants(None, None, None, None, "ASABE D272.3", "not found", _NOT_FOUND),
 }
+
+
+#: Other names people use for the grains of :data:`D272`.
+GRAIN_ALIASES = {"soybeans": "soybean", "corn": "shelled_corn", "maize": "shelled_corn",
+                 "rice": "rough_rice", "paddy": "rough_rice", "rapeseed": "canola",
+                 "milo": "sorghum"}
+
+
+def grains_with_d272() -> list[str]:
+    """The grains whose D272 constants have a source here."""
+    return [k for k, v in D272.items() if v.a_pa_s2_m3 is not None]
+
+
+def d272_constants(name: str) -> tuple[float, float]:
+    """(a Pa s²/m³, b s/m) of a grain (names as in :data:`D272` or :data:`GRAIN_ALIASES`).
+
+    ValueError for an unknown grain (listing the known ones) or one whose constants no source
+    here gives (saying so).
+
+    >>> d272_constants("soybeans")
+    (10200.0, 16.0)
+    """
+    key = GRAIN_ALIASES.get(str(name).lower(), str(name).lower())
+    if key not in D272:
+        raise ValueError(f"unknown grain {name!r}; known grains: {', '.join(D272)} (with D272 "
+                         f"constants: {', '.join(grains_with_d272())})")
+    c = D272[key]
+    if c.a_pa_s2_m3 is None:
+        raise ValueError(f"no sourced ASABE D272 constants for {key} (docs/grain-library.md); "
+                         f"grains with constants: {', '.join(grains_with_d272())}")
+    return float(c.a_pa_s2_m3), float(c.b_s_m)

@@ -27,15 +27,14 @@ from ._cli import (CliError, CliParser, add_air, add_packing, add_sample, bad_in
                    check_outputs, check_plot, computing, load_packing, progress_log, run,
                    sample_box_m)
 from .conductance import POLICIES
-from .flow import (ASABE_SOYBEAN_A, ASABE_SOYBEAN_B, DEFAULT_DEPTH_M, GRAINS,
+from ._grains import GRAIN_ALIASES, d272_constants
+from .flow import (DEFAULT_DEPTH_M, GRAINS,
                    asabe_d272_gradient, ergun_gradient, fit_curve, solve_network)
 from .packing import read_container
 from .pores import sample_region
 
 #: Default: 12 velocities spaced logarithmically over aeration and drying, m/s.
 DEFAULT_VELOCITIES = "0.005:0.3:12"
-#: D272 constants by grain (Pa s²/m³, m² s/m³): only those with a source in the package.
-D272 = {"soybeans": (ASABE_SOYBEAN_A, ASABE_SOYBEAN_B)}
 #: Thesis section 4.2.3: measured drops over 0.25 m of soybeans, (m/s, Pa/m).
 THESIS_POINTS = [(0.013, 2.44 / 0.25), (0.027, 6.80 / 0.25)]
 KEYS = ["velocity_m_s", "reynolds_particle", "pressure_gradient_pa_per_m",
@@ -84,7 +83,8 @@ def build_parser() -> CliParser:
     ap.add_argument("--depth", type=float, default=DEFAULT_DEPTH_M,
                     help="bed depth, m, > 0 (reported; the gradient does not depend on it)")
     ap.add_argument("--grain", default="soybeans",
-                    help=f"D272 line to compare with (known: {', '.join(D272)})")
+                    help=f"D272 line to compare with (grains with sourced constants: "
+                         f"{', '.join(GRAINS)})")
     ap.add_argument("--policy", default="table-only", choices=POLICIES,
                     help="Q* source (see python -m network.solve --help)")
     ap.add_argument("--rtol", type=float, default=1e-3,
@@ -112,14 +112,14 @@ def plot_curve(path, points, *, grain, porosity, diameter_m, viscosity_pa_s, den
     uu = np.geomspace(u.min() / 1.5, u.max() * 1.5, 100)
     fig, ax = plt.subplots(figsize=(5.5, 4.2))
     ax.loglog(u, gr, "o-", label="network (inertial)")
-    a, b = D272[grain]
+    a, b = d272_constants(grain)
     ax.loglog(uu, [asabe_d272_gradient(v, a=a, b=b) for v in uu], "--", label=f"ASABE D272 {grain}")
     if 0 < porosity < 1:
         ax.loglog(uu, [ergun_gradient(v, porosity=porosity, diameter_m=diameter_m,
                                       viscosity_pa_s=viscosity_pa_s,
                                       density_kg_m3=density_kg_m3) for v in uu], ":",
                   label="Ergun")
-    if grain == "soybeans":
+    if GRAIN_ALIASES.get(grain, grain) == "soybean":
         tu, tg = zip(*THESIS_POINTS)
         ax.loglog(tu, tg, "ks", label="thesis measured")
     ax.set_xlabel("airflow U (m/s)")
@@ -133,8 +133,7 @@ def plot_curve(path, points, *, grain, porosity, diameter_m, viscosity_pa_s, den
 
 def _check_options(args) -> list[float]:
     check_common(args)
-    if args.grain not in D272:
-        raise ValueError(f"--grain {args.grain!r} unknown; known grains: {', '.join(GRAINS)}")
+    d272_constants(args.grain)          # an unknown or unsourced grain: ValueError naming them
     check_outputs(json=args.json_out, csv=args.csv_out, plot=args.plot)
     if args.plot:
         check_plot()

@@ -85,7 +85,7 @@ def test_fit_curve_recovers_forchheimer():
 @pytest.mark.parametrize("argv, match", [
     (["--velocities", "0,0.1"], "0.0"), (["--velocities", "nan"], "nan"),
     (["--velocities", ""], "empty"), (["--density", "0"], "--density"),
-    (["--viscosity", "-1"], "--viscosity"), (["--grain", "wheat"], "soybeans")])
+    (["--viscosity", "-1"], "--viscosity"), (["--grain", "wheat"], "grains with constants: soybean")])
 def test_curve_bad_input_exit_2(argv, match, capsys):
     assert curve.main(["-q"] + argv) == 2
     err = capsys.readouterr().err

@@ -25,14 +25,14 @@ from __future__ import annotations
 import numpy as np
 
 from .._air import MU_AIR_PA_S, RHO_AIR_KG_M3
+from .._grains import d272_constants
 
 __all__ = ["ergun_gradient", "kozeny_carman_gradient", "asabe_d272_gradient",
            "ASABE_SOYBEAN_A", "ASABE_SOYBEAN_B"]
 
-#: ASABE D272 Hukill–Ives constant a for soybeans, Pa·s²/m³.
-ASABE_SOYBEAN_A = 1.02e4
-#: ASABE D272 Hukill–Ives constant b for soybeans, s/m.
-ASABE_SOYBEAN_B = 16.0
+#: ASABE D272 Hukill–Ives constants a (Pa·s²/m³) and b (s/m) for soybeans, from the grain
+#: library (network._grains, with their source).
+ASABE_SOYBEAN_A, ASABE_SOYBEAN_B = d272_constants("soybean")
 
 
 def _check(porosity, diameter_m, velocity_m_s):

@@ -15,10 +15,12 @@ from __future__ import annotations
 import numpy as np
 from scipy.optimize import minimize_scalar
 
+from .._grains import grains_with_d272
+
 __all__ = ["fit_curve", "GRAINS"]
 
-#: D272 constants available now (network.flow._empirical; a later issue adds a grain library).
-GRAINS = {"soybeans": "ASABE_SOYBEAN"}
+#: The grains whose D272 constants have a source (the grain library, network._grains).
+GRAINS = tuple(grains_with_d272())
 
 
 def _rms_rel(pred, grad):
