@@ -19,7 +19,8 @@ SIZES = (300, 600)
 ROW_KEYS = {"wall_s", "read_s", "stages_s", "iterations", "n_unknowns", "solver_setup_s",
             "solver_solve_s", "n_pores", "n_throats", "permeability_m2", "mass_balance_ok",
             "qstar_sources", "traced_peak_mb", "max_rss_mb", "n_spheres", "policy",
-            "conductance_model", "repeats", "subprocess_s", "loadavg_1min_before"}
+            "conductance_model", "repeats", "subprocess_s", "loadavg_1min_before",
+             "us_per_sphere", "kb_per_sphere"}
 
 
 @pytest.fixture(scope="module")

@@ -69,7 +69,7 @@ def run_one(path: Path, policy: str, db, repeats: int, trace: bool = True,
         t0 = time.perf_counter()
         pk = read_packing(path)
         t_read = time.perf_counter() - t0
-        res = solve_network(pk, axis="z", policy=policy, db=db, porosity_points=0,
+        res = solve_network(pk, axis="z", policy=policy, db=db,
                             trace_memory=False, conductance_model=model)
         wall = time.perf_counter() - t0
         if best is None or wall < best["wall_s"]:
@@ -83,7 +83,7 @@ def run_one(path: Path, policy: str, db, repeats: int, trace: bool = True,
     # one more pass with tracemalloc for per-stage traced peaks (slower; not timed)
     if trace:
         pk = read_packing(path)
-        res = solve_network(pk, axis="z", policy=policy, db=db, porosity_points=0,
+        res = solve_network(pk, axis="z", policy=policy, db=db,
                             trace_memory=True, conductance_model=model)
         best["traced_peak_mb"] = res.timings_s.get("peak_memory_mb", {})
     best["max_rss_mb"] = max(walls_rss, resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024.0)
@@ -122,10 +122,15 @@ def scaling(sizes, workdir, policy, db, seed, repeats, timeout, model="conduit")
         row["loadavg_1min_before"] = load0
         rows.append(row)
         st = row["stages_s"]
+        row["us_per_sphere"] = 1e6 * row["wall_s"] / row["n_spheres"]
+        row["kb_per_sphere"] = 1024.0 * row["max_rss_mb"] / row["n_spheres"]
         print(f"  {n:>7d} spheres: wall {row['wall_s']:7.2f} s (read {row['read_s']:.2f}, "
-              f"tess {st['tessellate']:.2f}, cond {st['conductance']:.2f}, "
-              f"asm {st['assemble']:.2f}, solve {st['solve']:.2f}); {row['iterations']} it; "
-              f"{row['n_unknowns']} unknowns; max RSS {row['max_rss_mb']:.0f} MB", flush=True)
+              f"tess {st['tessellate']:.2f}, sample {st['sample']:.2f}, cond "
+              f"{st['conductance']:.2f}, asm {st['assemble']:.2f}, AMG setup "
+              f"{row['solver_setup_s']:.2f}, solve {st['solve']:.2f}, porosity "
+              f"{st.get('porosity', 0.0):.2f}); {row['iterations']} it; {row['n_unknowns']} "
+              f"unknowns; max RSS {row['max_rss_mb']:.0f} MB; {row['us_per_sphere']:.0f} us and "
+              f"{row['kb_per_sphere']:.1f} kB per sphere", flush=True)
     return rows
 
 
