@@ -66,8 +66,8 @@ def test_solve_reports_inertia_and_stokes_keeps_old_answer(tmp_path):
     assert s["permeability_whole_m2"] == pytest.approx(4.2023528e-08, rel=1e-7)
     assert s["permeability_m2"] == pytest.approx(4.22808e-08, rel=1e-5)
     assert s["pressure_drop_pa"] == pytest.approx(1.4941630 * 4.2023528 / 4.22808, rel=1e-5)
-    assert i["permeability_m2"] == pytest.approx(s["permeability_m2"], rel=1e-12)
-    assert i["pressure_drop_stokes_pa"] == pytest.approx(s["pressure_drop_pa"], rel=1e-12)
+    assert i["permeability_m2"] == pytest.approx(s["permeability_m2"], rel=1e-9)   # AMG noise
+    assert i["pressure_drop_stokes_pa"] == pytest.approx(s["pressure_drop_pa"], rel=1e-9)
     assert i["pressure_drop_pa"] > i["pressure_drop_stokes_pa"]
     assert i["reynolds_particle"] == pytest.approx(5.34, abs=0.01)
 
