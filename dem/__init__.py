@@ -50,7 +50,11 @@ from ._procedures import PROCEDURES, PackResult, pack_bed
 from ._summary import summarize, surface_height
 from ._vibrate import VibrationResult, intensity_g, rest_motion, vibrate_bed
 from ._walls import CylinderWall, PlaneWall
+from .clumps import ClumpSimulation
 from .grains import GRAIN_FIELDS, GRAINS, Grain, Sourced, grain
+from .templates import (LIBRARY_MAX_SPHERES, ROW_SPACING, TEMPLATE_GRAINS, Template, check_template,
+                        library_template, read_template, resolve_template, sphere_template,
+                        template_from_axes)
 
 __all__ = [
     "Material", "SOYBEAN", "Simulation", "DemInstabilityError",
@@ -64,4 +68,8 @@ __all__ = [
     "lens_volume", "sphere_volume", "intensity_g", "rest_motion",
     # the grain library (issue 16): kernel axes, densities, porosity, friction, each sourced
     "GRAINS", "GRAIN_FIELDS", "Grain", "Sourced", "grain",
+    # multi-sphere grains (issue 15): templates from measured axes, the rigid-grain engine
+    "ClumpSimulation", "LIBRARY_MAX_SPHERES", "ROW_SPACING", "TEMPLATE_GRAINS", "Template",
+    "check_template", "library_template", "read_template", "resolve_template", "sphere_template",
+    "template_from_axes",
 ]
