@@ -169,6 +169,14 @@ def add_sample(ap, *, cylinder: bool = True) -> None:
                              "axis")
 
 
+def add_table(ap) -> None:
+    """``--rtol`` and ``--db``: the Q* tolerance and the throat table of the FE policies."""
+    ap.add_argument("--rtol", type=float, default=1e-3,
+                    help="Q* relative tolerance of table+fe and fe-only, > 0")
+    ap.add_argument("--db", default=None,
+                    help="throat table, SQLite (default: the cache's default database)")
+
+
 def add_air(ap, *, density: bool = True) -> None:
     """``--viscosity`` (and ``--density``), SI."""
     ap.add_argument("--viscosity", type=float, default=MU_AIR_PA_S,

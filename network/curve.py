@@ -23,8 +23,8 @@ import time
 import numpy as np
 
 from ._air import check_positive
-from ._cli import (CliError, CliParser, add_air, add_packing, add_sample, bad_input, check_common,
-                   check_outputs, check_plot, computing, load_packing, progress_log, run,
+from ._cli import (CliError, CliParser, add_air, add_packing, add_sample, add_table, bad_input,
+                   check_common, check_outputs, check_plot, computing, load_packing, progress_log, run,
                    sample_box_m)
 from .conductance import POLICIES
 from ._grains import GRAIN_ALIASES, d272_constants
@@ -87,10 +87,7 @@ def build_parser() -> CliParser:
                          f"{', '.join(GRAINS)})")
     ap.add_argument("--policy", default="table-only", choices=POLICIES,
                     help="Q* source (see python -m network.solve --help)")
-    ap.add_argument("--rtol", type=float, default=1e-3,
-                    help="Q* relative tolerance of table+fe and fe-only, > 0")
-    ap.add_argument("--db", default=None,
-                    help="throat table, SQLite (default: the cache's default database)")
+    add_table(ap)
     ap.add_argument("--json", dest="json_out", default=None, metavar="OUT.json",
                     help="write points, fits and timings here (default: not written)")
     ap.add_argument("--csv", dest="csv_out", default=None, metavar="OUT.csv",

@@ -22,8 +22,8 @@ from pathlib import Path
 
 import numpy as np
 
-from ._cli import (CliError, CliParser, add_air, add_packing, add_sample, bad_input, check_common,
-                   check_outputs, computing, load_packing, progress_log, run, sample_box_m)
+from ._cli import (CliError, CliParser, add_air, add_packing, add_sample, add_table, bad_input,
+                   check_common, check_outputs, computing, load_packing, progress_log, run, sample_box_m)
 from .conductance import MODELS, POLICIES, throat_qstar
 from .flow import (DEFAULT_DEPTH_M, DEFAULT_VELOCITY_M_S, combined_summary, solve_axes,
                    write_network_vtu)
@@ -63,10 +63,7 @@ def build_parser() -> CliParser:
                          "shape-factor (fast closed form)")
     ap.add_argument("--conductance-model", default="conduit", choices=MODELS,
                     help="throat conductance model (thesis = Eq. 3.41, L = 2 r̄)")
-    ap.add_argument("--rtol", type=float, default=1e-3,
-                    help="Q* relative tolerance of table+fe and fe-only, > 0")
-    ap.add_argument("--db", default=None,
-                    help="throat table, SQLite (default: the cache's default database)")
+    add_table(ap)
     ap.add_argument("--workers", type=int, default=1, help="processes for FE solves, >= 1")
     ap.add_argument("--json", dest="json_out", default=None, metavar="OUT.json",
                     help="write every number here (default: not written)")
