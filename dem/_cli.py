@@ -2,8 +2,10 @@
 
 ``python -m dem.pack`` and ``python -m dem.vibrate`` (and the vibration study) run their body
 through :func:`run_main`: malloc tuning (:mod:`dem._perf`), argument parsing, and one mapping
-of failures to exit codes: 2 for bad input (``ValueError``, ``OSError``), 3 for a simulation
-that went unstable (:class:`~dem._integrate.DemInstabilityError`). No physics here.
+of failures to exit codes, the project's convention: 2 for bad input (``ValueError``,
+``OSError``), 1 for a computation that failed (a simulation that went unstable,
+:class:`~dem._integrate.DemInstabilityError`, an unconverged packing) or was interrupted
+(Ctrl-C). No physics here.
 """
 
 from __future__ import annotations
@@ -15,18 +17,22 @@ from ._container import SCENES, Container
 from ._integrate import DemInstabilityError
 from ._perf import tune_malloc
 
-__all__ = ["EXIT_BAD_INPUT", "EXIT_UNSTABLE", "run_main", "progress_printer", "resolve_container"]
+__all__ = ["EXIT_BAD_INPUT", "EXIT_FAILED", "EXIT_UNSTABLE", "run_main", "progress_printer",
+           "resolve_container"]
 
 EXIT_BAD_INPUT = 2
-EXIT_UNSTABLE = 3
+#: A computation that failed: unstable, not converged, interrupted (the same code as network's).
+EXIT_FAILED = 1
+EXIT_UNSTABLE = EXIT_FAILED
 
 
 def run_main(parser, body, argv=None) -> int:
     """Parse ``argv`` with ``parser`` and return ``body(args)``, mapping failures to exit codes.
 
     A ``ValueError`` or ``OSError`` prints ``error: ...`` and returns 2; a
-    ``DemInstabilityError`` prints ``unstable: ...`` and returns 3 (what was written before it
-    stays). argparse's own errors exit 2 as usual.
+    ``DemInstabilityError`` prints ``unstable: ...`` and Ctrl-C ``interrupted: ...``, both
+    returning 1 (what was written before stays: packings are written whole at the end, the
+    vibration study keeps its checkpoints). argparse's own errors exit 2 as usual.
     """
     tune_malloc()
     args = parser.parse_args(argv)
@@ -38,6 +44,10 @@ def run_main(parser, body, argv=None) -> int:
     except DemInstabilityError as e:
         print(f"unstable, not written: {e}", file=sys.stderr)
         return EXIT_UNSTABLE
+    except KeyboardInterrupt:
+        print("interrupted: nothing more written (a packing is written whole at the end; a "
+              "vibration study resumes from its last checkpoint)", file=sys.stderr)
+        return EXIT_FAILED
 
 
 def progress_printer(label="", *, quiet=False, every_steps=2000):

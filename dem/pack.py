@@ -13,17 +13,19 @@ clumps (:mod:`dem.clumps`, :mod:`dem._clump_pack`): the CSV gains ``grain_id`` a
 ``<stem>.grains.csv`` has one row per grain; ``--scene box`` alone means 0.04 x 0.04 x 0.04 m.
 
 Writes the packing CSV (``x,y,z,r``, m) and its JSON summary (same stem). Exit status 0
-on success, 2 on bad arguments, 3 when the simulation went unstable (nothing written).
+on success, 2 on bad arguments, 1 when the simulation went unstable (nothing written) or
+stopped at the step limit before equilibrium (written, marked ``"converged": false``).
 """
 
 from __future__ import annotations
 
 import argparse
+import sys
 from dataclasses import replace
 
 import numpy as np
 
-from ._cli import progress_printer, resolve_container, run_main
+from ._cli import EXIT_FAILED, progress_printer, resolve_container, run_main
 from ._container import SCENE_DEFAULTS, SCENES, default_measure_spheres
 from ._material import Material
 from ._io import summary_path, write_packing
@@ -165,15 +167,30 @@ def _pack(args) -> int:
     s["scene"] = args.scene
     s["procedure_options"] = opts
     s["seed"] = args.seed
+    stuck = [name for name, st in s.get("stages", {}).items()
+             if name != "expand" and not st.get("converged", True)]
+    s["converged"] = not stuck
     write_packing(args.out, res.centers, res.radii, s)
     print(f"{s['n_spheres']} spheres -> {args.out} (+ {summary_path(args.out).name})")
     print(f"porosity: interior {s['porosity_interior']:.4f}, global (surface {s['bed_height_surface_m']:.4f} m) "
           f"{s['porosity_global_surface']:.4f}, measurement spheres {s['measure_spheres']['mean']:.4f}")
     c = s["coordination"]
-    print(f"coordination: 1.05 d_max cutoff {c['cutoff_mean']:.2f}, true contacts {c['contact_mean']:.2f}")
+    print("coordination: 1.05 d_max cutoff " + _num(c["cutoff_mean"]) + ", true contacts "
+          + _num(c["contact_mean"]) + ("" if c["cutoff_mean"] is not None
+                                       else " (no interior sphere to count)"))
     print(f"{s['steps']} steps, simulated {s['simulated_time_s']:.3f} s (mass scale {s['mass_scale']:g}), "
           f"wall {s['wall_time_s']:.1f} s, {s['particle_steps_per_s']:.3e} particle-steps/s")
+    if stuck:
+        st = s["stages"][stuck[0]]
+        print(f"error: not at equilibrium: stage {stuck[0]} stopped at the step limit (unbalanced "
+              f"force ratio {st['ratio']:.3g} > tol {s['tol_unbalanced_ratio']:.3g}); written with "
+              f"\"converged\": false (give --max-steps or --tol)", file=sys.stderr)
+        return EXIT_FAILED
     return 0
+
+
+def _num(v) -> str:
+    return "n/a" if v is None else f"{v:.2f}"
 
 
 def main(argv=None) -> int:

@@ -10,7 +10,7 @@ The container comes from the packing's JSON summary (written by ``dem.pack``) or
 container and no ``--scene``, or a packing not at rest (``--rest-tol``) is refused. Writes ``<out>/vib_<A>mm.json`` (histories and summary), the final packing
 ``<out>/vib_<A>mm.csv`` and snapshots ``<out>/vib_<A>mm_t<T>.csv``; with several
 amplitudes also ``<out>/series.json`` (porosity change against intensity).
-Exit status 0 on success, 2 on bad arguments, 3 when the run went unstable.
+Exit status 0 on success, 2 on bad arguments, 1 when the run went unstable or was interrupted.
 """
 
 from __future__ import annotations

@@ -1,0 +1,25 @@
+"""dem command lines follow the project's exit codes (issue 13): 0 done, 1 computation failed
+(unstable, not converged, interrupted), 2 bad input."""
+
+import json
+
+from dem import pack
+
+
+def test_unconverged_packing_is_written_marked_and_exits_1(tmp_path, capsys):
+    out = tmp_path / "bed.csv"
+    code = pack.main(["--scene", "box", "--size", "0.03", "0.03", "--height", "0.03",
+                      "--max-steps", "300", "--out", str(out), "--quiet", "--seed", "1"])
+    assert code == 1
+    summary = json.loads(out.with_suffix(".json").read_text())
+    assert summary["converged"] is False
+    err = capsys.readouterr().err
+    assert "error: not at equilibrium: stage" in err and "Traceback" not in err
+
+
+def test_bad_input_exits_2(tmp_path, capsys):
+    code = pack.main(["--scene", "box", "--size", "0.03", "--height", "0.03", "--out",
+                      str(tmp_path / "b.csv")])
+    assert code == 2
+    assert "box needs 2 size value(s)" in capsys.readouterr().err
+    assert not (tmp_path / "b.csv").exists()
