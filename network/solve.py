@@ -23,7 +23,8 @@ from pathlib import Path
 import numpy as np
 
 from ._cli import (CliError, CliParser, add_air, add_packing, add_sample, add_table, bad_input,
-                   check_common, check_outputs, computing, load_packing, progress_log, run, sample_box_m)
+                   check_common, check_outputs, computing, load_packing, progress_log, run,
+                   sample_box_m)
 from .conductance import MODELS, POLICIES, throat_qstar
 from .flow import (DEFAULT_DEPTH_M, DEFAULT_VELOCITY_M_S, combined_summary, solve_axes,
                    write_network_vtu)
