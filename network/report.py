@@ -1,0 +1,346 @@
+"""``python -m network.report``: the engineer's report of a grain bed (issue 16 items 2 and 3).
+
+Examples
+--------
+    python -m network.report --grain soybean                      # the bundled soybean scene
+    python -m network.report --grain soybean --depth 3 --diameter 6 --fan fan.csv --html r.html
+    python -m network.report --grain wheat --packing bed.csv --particle-density 1240 --json r.json
+
+The inertial resistance curve (vertical z and horizontal x) of a packing, with ASABE D272 and
+Ergun beside it and the fits of :func:`network.flow.fit_curve`; the porosity band (d ln(ΔP/L)/dε
+computed by packing and solving neighbouring porosities, :mod:`network._report_band`); the
+system curve of a bin and, with ``--fan``, its operating point (:mod:`network._report_system`).
+The porosity reported is the packing's own (interior Monte-Carlo porosity of the sample).
+Exit 0 done, 1 a solve failed, 2 bad input: one ``error:`` line (docs/cli.md, docs/report.md).
+"""
+
+from __future__ import annotations
+
+import json
+import sys
+import time
+from pathlib import Path
+
+import numpy as np
+
+from ._cli import (CliError, CliParser, add_air, add_sample, bad_input, check_common,
+                   check_outputs, check_plot, computing, load_packing, progress_log, run,
+                   sample_box_m)
+from ._grains import D272, GRAIN_ALIASES, grains_with_d272
+from ._report_band import BAND_OFFSETS, band_gradients, pack_band, slope_at
+from ._report_html import write_figures, write_html
+from ._report_system import (AIRFLOW_UNITS, bulk_density, curve_range, dense_system, floor_area,
+                             operating_point, read_fan, system_rows, velocity_from_airflow)
+from .curve import DEFAULT_VELOCITIES, parse_velocities
+from .flow import DEFAULT_DEPTH_M, asabe_d272_gradient, ergun_gradient, fit_curve, solve_network
+from .packing import UNITS, read_container
+from .pores import sample_region
+
+#: soybean kernel density, kg/m^3: thesis Table 3.1 (DESIGN.md), also dem.grains' soybean entry
+SOYBEAN_PARTICLE_DENSITY = 1285.0
+KEYS = ["velocity_m_s", "reynolds_particle", "pressure_gradient_pa_per_m",
+        "apparent_permeability_m2", "converged"]
+
+
+def build_parser() -> CliParser:
+    ap = CliParser(prog="python -m network.report",
+                   description="Airflow resistance report of a grain bed: inertial curve "
+                               "(vertical and horizontal) beside D272 and Ergun, porosity band, "
+                               "system curve of a bin and a fan's operating point. Exit status "
+                               "0 done, 1 a solve failed, 2 bad input.")
+    ap.add_argument("--grain", default="soybean",
+                    help=f"crop: {', '.join(D272)} (D272 constants sourced for "
+                         f"{', '.join(grains_with_d272())})")
+    ap.add_argument("--packing", default=None, metavar="FILE",
+                    help="packing of that grain (any format the readers take); default for "
+                         "soybean: the bundled scene; other grains need one (dem.pack)")
+    ap.add_argument("--units", default="m", type=str.lower, choices=list(UNITS),
+                    help="length unit of the packing file")
+    add_sample(ap, cylinder=False)
+    add_air(ap)
+    ap.add_argument("--velocities", default=DEFAULT_VELOCITIES,
+                    help="superficial velocities, m/s: a,b,c or start:stop:n (log-spaced)")
+    ap.add_argument("--particle-density", type=float, default=None,
+                    help="kernel (true) density, kg/m^3, for the bulk density rho_p (1 - "
+                         "porosity); default for soybean 1285 (thesis Table 3.1, dem.grains); "
+                         "other grains: give it (python -c \"import dem; print(dem.grain('wheat')"
+                         ".particle_density_kg_m3)\")")
+    ap.add_argument("--depth", type=float, default=DEFAULT_DEPTH_M, help="bed depth, m, > 0")
+    area = ap.add_mutually_exclusive_group()
+    area.add_argument("--diameter", type=float, default=None, help="round bin diameter, m")
+    area.add_argument("--floor-area", type=float, default=None,
+                      help="floor area, m^2 (default without --diameter: 1 m^2)")
+    ap.add_argument("--airflow", nargs=2, default=None, metavar=("VALUE", "UNIT"),
+                    help=f"an airflow to report, UNIT one of {', '.join(AIRFLOW_UNITS)}")
+    ap.add_argument("--fan", default=None, metavar="FILE",
+                    help="fan curve CSV airflow_m3_s,static_pressure_pa: operating point")
+    ap.add_argument("--seed", type=int, default=1,
+                    help="first seed of the porosity band's packings (seed, seed + 1)")
+    ap.add_argument("--no-band", action="store_true", help="skip the porosity band (~15 s)")
+    ap.add_argument("--json", dest="json_out", default=None, metavar="OUT.json",
+                    help="write everything here")
+    ap.add_argument("--html", default=None, metavar="OUT.html",
+                    help="self-contained HTML report with embedded plots (needs matplotlib)")
+    ap.add_argument("--plot-dir", default=None, metavar="DIR",
+                    help="also write the plots as PNG files into this folder")
+    ap.add_argument("--quiet", "-q", action="store_true", help="no stage progress on stderr")
+    return ap
+
+
+def grain_key(name: str) -> str:
+    """Library name of a grain (aliases accepted); ValueError listing the known ones."""
+    key = GRAIN_ALIASES.get(str(name).lower(), str(name).lower())
+    if key not in D272:
+        raise ValueError(f"unknown grain {name!r}; known grains: {', '.join(D272)}")
+    return key
+
+
+def _check(args) -> dict:
+    """Every option checked before any solve; returns the parsed pieces."""
+    check_common(args)
+    key = grain_key(args.grain)
+    for opt in ("particle_density", "diameter", "floor_area"):
+        v = getattr(args, opt)
+        if v is not None and not (np.isfinite(v) and v > 0):
+            raise ValueError(f"--{opt.replace('_', '-')} must be finite and > 0, got {v!r}")
+    rho_p = args.particle_density
+    if rho_p is None:
+        if key != "soybean":
+            raise ValueError(f"--particle-density is needed for {key} (the soybean default "
+                             "1285 kg/m^3 does not apply); dem.grains has sourced values: "
+                             f"python -c \"import dem; print(dem.grain('{key}')"
+                             ".particle_density_kg_m3)\"")
+        rho_p = SOYBEAN_PARTICLE_DENSITY
+    if args.packing is None and key != "soybean":
+        raise ValueError(f"no bundled packing for {key}: pack one with python -m dem.pack "
+                         f"--scene box --grain {key} --out bed.csv (about 1.5 min), then add "
+                         "--packing bed.csv")
+    airflow = None
+    if args.airflow is not None:
+        value, unit = args.airflow
+        if unit not in AIRFLOW_UNITS:
+            raise ValueError(f"--airflow unit {unit!r}: use one of {', '.join(AIRFLOW_UNITS)}")
+        try:
+            airflow = (float(value), unit)
+        except ValueError:
+            raise ValueError(f"--airflow value {value!r} is not a number") from None
+        if not (np.isfinite(airflow[0]) and airflow[0] > 0):
+            raise ValueError(f"--airflow must be finite and > 0, got {value}")
+    fan = None
+    if args.fan is not None:
+        if args.diameter is None and args.floor_area is None:
+            raise ValueError("--fan needs the bin: --diameter (round) or --floor-area")
+        fan = read_fan(args.fan)
+    check_outputs(json=args.json_out, html=args.html)
+    if args.plot_dir is not None and not Path(args.plot_dir).is_dir():
+        raise ValueError(f"--plot-dir {args.plot_dir}: not an existing folder")
+    if args.html or args.plot_dir:
+        check_plot("--html/--plot-dir")
+    return {"grain": key, "particle_density": rho_p, "airflow": airflow, "fan": fan,
+            "velocities": parse_velocities(args.velocities)}
+
+
+def _solve(args, packing, container, box, margin, axis, us, porosity=None):
+    region = sample_region(packing, box=box, margin=margin, container=container, axis=axis)
+    us = sorted(us)
+    return solve_network(packing, axis=axis, region=region, viscosity_pa_s=args.viscosity,
+                         velocity_m_s=us[0], depth_m=args.depth, inertia=True,
+                         density_kg_m3=args.density, curve_velocities_m_s=us[1:],
+                         inertial_law=args.inertial_law, porosity=porosity)
+
+
+def _points(res):
+    return [{k: p[k] for k in KEYS} for p in res.curve_points()]
+
+
+def _fits(points, res, args):
+    ok = [p for p in points if p["converged"]]
+    if len(ok) < 2:
+        return {}
+    return fit_curve([p["velocity_m_s"] for p in ok], [p["pressure_gradient_pa_per_m"] for p in ok],
+                     viscosity_pa_s=args.viscosity, density_kg_m3=args.density,
+                     porosity=res.porosity, diameter_m=res.sauter_diameter_m)
+
+
+def build_report(args, opts, path, packing) -> dict:
+    """All the numbers of the report (the JSON document)."""
+    t0 = time.perf_counter()
+    box, margin = sample_box_m(args)
+    container = None if box else read_container(path)
+    us = list(opts["velocities"])
+    rz = _solve(args, packing, container, box, margin, "z", us)
+    e, d32 = rz.porosity, rz.sauter_diameter_m
+    rho_b = bulk_density(opts["particle_density"], e)
+    u_air = None
+    if opts["airflow"]:
+        u_air = velocity_from_airflow(*opts["airflow"], depth_m=args.depth,
+                                      bulk_density_kg_m3=rho_b)
+        if all(abs(u_air - u) > 1e-12 * u for u in us):
+            us.append(u_air)
+            rz = _solve(args, packing, container, box, margin, "z", us,
+                        (rz.porosity, rz.porosity_std))
+    rx = _solve(args, packing, container, box, margin, "x", us)
+    pts, pts_x = _points(rz), _points(rx)
+    band = None
+    if not args.no_band:
+        ub = sorted(us)
+        band = pack_band(packing, e, velocities_m_s=[ub[0], float(np.sqrt(ub[0] * ub[-1])),
+                                                     ub[-1]],
+                         seeds=(args.seed, args.seed + 1), viscosity_pa_s=args.viscosity,
+                         density_kg_m3=args.density, inertial_law=args.inertial_law)
+    c = D272[opts["grain"]]
+    for p, px in zip(pts, pts_x):
+        u = p["velocity_m_s"]
+        p["d272_pressure_gradient_pa_per_m"] = (
+            None if c.a_pa_s2_m3 is None else
+            float(asabe_d272_gradient(u, a=c.a_pa_s2_m3, b=c.b_s_m)))
+        p["ergun_pressure_gradient_pa_per_m"] = float(ergun_gradient(
+            u, porosity=e, diameter_m=d32, viscosity_pa_s=args.viscosity,
+            density_kg_m3=args.density))
+        p["pressure_gradient_horizontal_pa_per_m"] = px["pressure_gradient_pa_per_m"]
+        p["band_slope"] = None if band is None else slope_at(u, band["velocities_m_s"],
+                                                             band["slopes"])
+        p["pressure_gradient_band_pa_per_m"] = (
+            None if band is None else
+            dict(zip([f"{o:+.2f}" for o in BAND_OFFSETS],
+                     band_gradients(p["pressure_gradient_pa_per_m"], p["band_slope"]))))
+    area = floor_area(args.diameter, args.floor_area)
+    ok = [p for p in pts if p["converged"]]
+    su = [p["velocity_m_s"] for p in ok]
+    sg = [p["pressure_gradient_pa_per_m"] for p in ok]
+    system = system_rows(su, sg, depth_m=args.depth, area_m2=area, bulk_density_kg_m3=rho_b)
+    out = {"grain": opts["grain"], "packing": str(path), "n_spheres": packing.n,
+           "n_grains": packing.n_grains, "porosity": e, "porosity_std": rz.porosity_std,
+           "porosity_source": "packing: the interior Monte-Carlo porosity of the packing's own "
+                              "sample (the grain's measured loose-fill porosity and --porosity "
+                              "are not implemented yet)",
+           "sauter_diameter_m": d32, "viscosity_pa_s": args.viscosity,
+           "air_density_kg_m3": args.density, "particle_density_kg_m3": opts["particle_density"],
+           "particle_density_source": ("thesis Table 3.1 (soybean default)"
+                                       if args.particle_density is None else "--particle-density"),
+           "bulk_density_kg_m3": rho_b,
+           "d272": {"a_pa_s2_m3": c.a_pa_s2_m3, "b_s_m": c.b_s_m, "source": c.source,
+                    "note": c.note},
+           "permeability_stokes_m2": {"z": rz.permeability_m2, "x": rx.permeability_m2},
+           "horizontal_to_vertical_stokes": rz.permeability_m2 / rx.permeability_m2,
+           "fits": _fits(pts, rz, args), "fits_horizontal": _fits(pts_x, rx, args),
+           "points": pts, "band": band,
+           "bin": {"depth_m": args.depth, "diameter_m": args.diameter, "floor_area_m2": area,
+                   "grain_mass_t": rho_b * area * args.depth / 1000.0},
+           "system_curve": system, "airflow": None, "operating_point": None}
+    if u_air is not None:
+        g = next(p["pressure_gradient_pa_per_m"] for p in pts
+                 if abs(p["velocity_m_s"] - u_air) <= 1e-12 * u_air)
+        out["airflow"] = system_rows([u_air], [g], depth_m=args.depth, area_m2=area,
+                                     bulk_density_kg_m3=rho_b)[0]
+    if opts["fan"] is not None:
+        sq, sp = dense_system(su, sg, depth_m=args.depth, area_m2=area)
+        op = operating_point(sq, sp, *opts["fan"])
+        out["fan_curve"] = {"airflow_m3_s": opts["fan"][0].tolist(),
+                            "static_pressure_pa": opts["fan"][1].tolist(), "file": args.fan}
+        if op is None:
+            out["operating_point"] = {"found": False, "message": (
+                "no operating point: " + curve_range("system curve", sq, sp) + "; "
+                + curve_range("fan", *opts["fan"]))}
+        else:
+            row = system_rows([op[0] / area], [op[1] / args.depth], depth_m=args.depth,
+                              area_m2=area, bulk_density_kg_m3=rho_b)[0]
+            out["operating_point"] = {"found": True, **row}
+    out["seconds"] = time.perf_counter() - t0
+    return out
+
+
+def _g(v, fmt="10.4g"):
+    return f"{'-':>{fmt.split('.')[0]}}" if v is None else format(v, fmt)
+
+
+def print_report(r) -> None:
+    """The text report on stdout."""
+    print(f"grain {r['grain']}: packing {r['packing']} ({r['n_spheres']} spheres), porosity "
+          f"{r['porosity']:.4f} +- {r['porosity_std']:.4f} ({r['porosity_source']})")
+    print(f"d32 {r['sauter_diameter_m'] * 1e3:.3f} mm, kernel density "
+          f"{r['particle_density_kg_m3']:g} kg/m^3 ({r['particle_density_source']}), bulk "
+          f"density {r['bulk_density_kg_m3']:.1f} kg/m^3")
+    k = r["permeability_stokes_m2"]
+    print(f"Stokes k: vertical {k['z']:.4e} m^2, horizontal {k['x']:.4e} m^2 (horizontal/"
+          f"vertical resistance {r['horizontal_to_vertical_stokes']:.3f})")
+    if r["d272"]["a_pa_s2_m3"] is None:
+        print(f"D272: no sourced constants for {r['grain']} (column '-')")
+    print(f"{'U m/s':>8} {'Re_p':>6} {'dP/L z':>10} {'dP/L x':>10} {'D272':>10} {'Ergun':>10} "
+          f"{'e-0.02':>10} {'e-0.01':>10} {'e+0.01':>10} {'e+0.02':>10}   (Pa/m)")
+    for p in r["points"]:
+        b = p["pressure_gradient_band_pa_per_m"] or {}
+        print(f"{p['velocity_m_s']:8.4g} {p['reynolds_particle']:6.3g} "
+              f"{p['pressure_gradient_pa_per_m']:10.4g} "
+              f"{p['pressure_gradient_horizontal_pa_per_m']:10.4g} "
+              f"{_g(p['d272_pressure_gradient_pa_per_m'])} "
+              f"{p['ergun_pressure_gradient_pa_per_m']:10.4g} "
+              + " ".join(_g(b.get(f"{o:+.2f}")) for o in BAND_OFFSETS)
+              + ("" if p["converged"] else "  NOT CONVERGED"))
+    band = r["band"]
+    if band:
+        print(f"porosity band: d ln(dP/L)/d(porosity) = "
+              + ", ".join(f"{s:.2f} +- {se:.2f} at {u:.3g} m/s" for s, se, u in
+                          zip(band["slopes"], band["slope_stderrs"], band["velocities_m_s"]))
+              + f"; {len(band['beds'])} beds of {band['packer']}, porosity "
+              f"{min(b['porosity'] for b in band['beds']):.3f}-"
+              f"{max(b['porosity'] for b in band['beds']):.3f}, {band['seconds']:.1f} s")
+    for name, f in (("vertical", r["fits"]), ("horizontal", r["fits_horizontal"])):
+        if f:
+            print(f"fits {name}: k {f['permeability_m2']:.4e} m^2, beta "
+                  f"{f['forchheimer_beta_per_m']:.4g} 1/m; D272-style a {f['d272_a']:.4g} "
+                  f"Pa s^2/m^3, b {f['d272_b']:.4g} s/m; Ergun A {f['ergun_A']:.4g}, "
+                  f"B {f['ergun_B']:.4g}")
+    bn = r["bin"]
+    print(f"system curve: depth {bn['depth_m']:g} m, floor {bn['floor_area_m2']:.4g} m^2, "
+          f"{bn['grain_mass_t']:.4g} t of grain (static pressure of the grain only)")
+    print(f"{'U m/s':>8} {'Q m^3/s':>10} {'m^3/(min t)':>12} {'m^3/(min m^3)':>14} {'P Pa':>10}")
+    for s in r["system_curve"]:
+        print(f"{s['velocity_m_s']:8.4g} {s['airflow_m3_s']:10.4g} {s['airflow_m3_min_t']:12.4g} "
+              f"{s['airflow_m3_min_m3']:14.4g} {s['static_pressure_pa']:10.4g}")
+    if r["airflow"]:
+        a = r["airflow"]
+        print(f"airflow {a['airflow_m3_min_t']:.4g} m^3/(min t) = {a['velocity_m_s']:.4g} m/s: "
+              f"{a['airflow_m3_s']:.4g} m^3/s, static pressure {a['static_pressure_pa']:.4g} Pa")
+    op = r["operating_point"]
+    if op and op["found"]:
+        print(f"operating point: {op['airflow_m3_s']:.4g} m^3/s, {op['airflow_m3_min_t']:.4g} "
+              f"m^3/(min t), {op['airflow_m3_min_m3']:.4g} m^3/(min m^3), static pressure "
+              f"{op['static_pressure_pa']:.4g} Pa, U {op['velocity_m_s']:.4g} m/s")
+    elif op:
+        print(op["message"])
+    print(f"total {r['seconds']:.1f} s")
+
+
+def main(argv=None) -> int:
+    """Run the command; exit status 0 done, 1 the computation failed, 2 bad input."""
+    return run(_main, build_parser(), argv)
+
+
+def _main(args) -> int:
+    progress_log(args)
+    with bad_input():
+        opts = _check(args)
+        path, packing = load_packing(args)
+    with computing():
+        rep = build_report(args, opts, path, packing)
+    print_report(rep)
+    with computing():
+        if args.json_out:
+            with open(args.json_out, "w") as f:
+                json.dump(rep, f, indent=2)
+            print(f"wrote {args.json_out}")
+        figs = write_figures(rep, args.plot_dir) if (args.html or args.plot_dir) else {}
+        for name in figs.get("files", []):
+            print(f"wrote {name}")
+        if args.html:
+            write_html(args.html, rep, figs.get("png", {}))
+            print(f"wrote {args.html}")
+    bad = [p["velocity_m_s"] for p in rep["points"] if not p["converged"]]
+    if bad:
+        raise CliError(f"the nonlinear solve did not converge at U = {bad} m/s", 1)
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
