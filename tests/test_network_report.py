@@ -1,0 +1,117 @@
+"""network.report: fan/system intersection, porosity-band arithmetic, bad input, one full run."""
+
+from __future__ import annotations
+
+import json
+
+import numpy as np
+import pytest
+
+from network._report_band import band_gradients, fit_log_slope, slope_at
+from network._report_system import (bulk_density, curve_range, operating_point, read_fan,
+                                    system_rows, velocity_from_airflow)
+from network.report import main
+
+
+def test_operating_point_exact_crossing():
+    # system P = 1000 Q^2 sampled at Q = 0, 0.1, 0.2 (piecewise linear: 0, 10, 40 Pa);
+    # fan P = 50 - 100 Q: on the segment 0.1-0.2 the system is 10 + 300 (Q - 0.1), so
+    # 50 - 100 Q = 300 Q - 20 gives Q = 0.175, P = 32.5 exactly
+    q, p = operating_point([0.0, 0.1, 0.2], [0.0, 10.0, 40.0], [0.0, 0.5], [50.0, 0.0])
+    assert q == pytest.approx(0.175, rel=1e-12)
+    assert p == pytest.approx(32.5, rel=1e-12)
+
+
+def test_operating_point_at_a_shared_point():
+    # the two curves meet exactly at a breakpoint of both
+    assert operating_point([0, 1, 2], [0, 1, 4], [0, 1, 2], [2, 1, 0]) == (1.0, 1.0)
+
+
+@pytest.mark.parametrize("fan_q, fan_p", [
+    ([0.0, 0.2], [0.9, 0.1]),          # fan too weak: always below the system
+    ([0.3, 0.6], [500.0, 400.0]),      # airflow ranges do not overlap
+])
+def test_no_operating_point(fan_q, fan_p):
+    assert operating_point([0.01, 0.1, 0.2], [1.0, 10.0, 40.0], fan_q, fan_p) is None
+    text = curve_range("fan", fan_q, fan_p)
+    assert text.startswith("fan: airflow") and "Pa" in text
+
+
+def test_band_slope_of_a_synthetic_exponential():
+    # two families with different prefactors, one slope -11.5: the fit gives it back exactly
+    e = np.array([0.38, 0.39, 0.40, 0.41, 0.42] * 2)
+    fam = np.repeat([1, 2], 5)
+    g = np.where(fam == 1, 3.0, 3.6) * np.exp(-11.5 * e)
+    f = fit_log_slope(e, g, fam)
+    assert f["slope"] == pytest.approx(-11.5, rel=1e-10)
+    assert f["rms_residual"] < 1e-12
+    np.testing.assert_allclose(np.exp(f["intercepts"]), [3.0, 3.6], rtol=1e-10)
+    np.testing.assert_allclose(band_gradients(10.0, -11.5, (-0.02, 0.02)),
+                               10.0 * np.exp([0.23, -0.23]), rtol=1e-12)
+    assert slope_at(1e-4, [0.01, 1.0], [-12.0, -10.0]) == -12.0     # held beyond the ends
+
+
+def test_band_fit_refuses_one_porosity():
+    with pytest.raises(ValueError, match="two porosities"):
+        fit_log_slope([0.4, 0.4], [1.0, 2.0])
+
+
+def test_airflow_units_and_system_rows():
+    rho_b = bulk_density(1285.0, 0.4)                                  # 771 kg/m^3
+    u = velocity_from_airflow(1.0, "m3/min/t", depth_m=2.0, bulk_density_kg_m3=rho_b)
+    assert u == pytest.approx(771.0 * 2.0 / 60_000.0, rel=1e-12)
+    (row,) = system_rows([u], [100.0], depth_m=2.0, area_m2=3.0, bulk_density_kg_m3=rho_b)
+    assert row["airflow_m3_min_t"] == pytest.approx(1.0, rel=1e-12)   # round trip
+    assert row["static_pressure_pa"] == pytest.approx(200.0)
+    assert row["airflow_m3_s"] == pytest.approx(3.0 * u)
+
+
+def test_fan_file_bad_rows_are_named(tmp_path):
+    f = tmp_path / "fan.csv"
+    f.write_text("airflow_m3_s,static_pressure_pa\n0,500\n0.1,-20\n")
+    with pytest.raises(ValueError, match="row 3: static_pressure_pa must be finite and >= 0"):
+        read_fan(f)
+    f.write_text("airflow_m3_s,static_pressure_pa\n0,500\nabc,20\n")
+    with pytest.raises(ValueError, match="row 3: airflow_m3_s 'abc' is not a number"):
+        read_fan(f)
+
+
+def test_bad_input_exits_2(tmp_path, capsys):
+    assert main(["--grain", "oats", "-q"]) == 2
+    err = capsys.readouterr().err
+    assert "unknown grain 'oats'" in err and "soybean" in err and "wheat" in err
+    fan = tmp_path / "fan.csv"
+    fan.write_text("airflow_m3_s,static_pressure_pa\n0,500\n-0.1,20\n")
+    assert main(["--fan", str(fan), "--floor-area", "1", "-q"]) == 2
+    assert "row 3" in capsys.readouterr().err
+    assert main(["--grain", "wheat", "--particle-density", "1240", "-q"]) == 2
+    assert "python -m dem.pack --scene box --grain wheat" in capsys.readouterr().err
+    assert main(["--grain", "wheat", "-q"]) == 2
+    assert "--particle-density" in capsys.readouterr().err
+
+
+def test_end_to_end_bundled_scene(tmp_path, capsys):
+    fan = tmp_path / "fan.csv"
+    fan.write_text("airflow_m3_s,static_pressure_pa\n0,600\n0.05,500\n0.1,350\n0.15,100\n")
+    out = tmp_path / "r.json"
+    code = main(["--grain", "soybean", "--velocities", "0.01,0.05,0.2", "--depth", "1",
+                 "--floor-area", "1", "--fan", str(fan), "--json", str(out), "-q"])
+    assert code == 0
+    r = json.loads(out.read_text())
+    for key in ("grain", "porosity", "porosity_source", "fits", "points", "band",
+                "system_curve", "operating_point"):
+        assert key in r
+    assert r["grain"] == "soybean" and r["porosity"] == pytest.approx(0.399, abs=0.002)
+    assert "packing" in r["porosity_source"]
+    for k in ("permeability_m2", "forchheimer_beta_per_m", "d272_a", "d272_b", "ergun_A"):
+        assert k in r["fits"]
+    assert len(r["points"]) == 3
+    for p in r["points"]:
+        assert p["d272_pressure_gradient_pa_per_m"] > 0
+        assert p["pressure_gradient_horizontal_pa_per_m"] > 0
+        band = p["pressure_gradient_band_pa_per_m"]
+        assert list(band) == ["-0.02", "-0.01", "+0.01", "+0.02"]
+        assert band["-0.02"] > band["-0.01"] > p["pressure_gradient_pa_per_m"] > band["+0.02"]
+    assert -20 < r["band"]["slopes"][0] < -6            # issue 16: about -11 near 0.40
+    op = r["operating_point"]
+    assert op["found"] and 0.1 < op["airflow_m3_s"] < 0.15
