@@ -257,7 +257,7 @@ def _g(v, fmt="10.4g"):
 def print_report(r) -> None:
     """The text report on stdout."""
     print(f"grain {r['grain']}: packing {r['packing']} ({r['n_spheres']} spheres), porosity "
-          f"{r['porosity']:.4f} +- {r['porosity_std']:.4f} ({r['porosity_source']})")
+          f"{r['porosity']:.4f} (std error {r['porosity_std']:.1e}; {r['porosity_source']})")
     print(f"d32 {r['sauter_diameter_m'] * 1e3:.3f} mm, kernel density "
           f"{r['particle_density_kg_m3']:g} kg/m^3 ({r['particle_density_source']}), bulk "
           f"density {r['bulk_density_kg_m3']:.1f} kg/m^3")
