@@ -40,7 +40,8 @@ LAYERS = {
         {"flow"},
         {"airpaths"},
         {"validation"},
-        {"__init__", "_cli", "solve", "throats", "paths", "curve", "report", "bench", "benchmarks",
+        {"__init__", "_cli", "solve", "throats", "paths", "curve", "report", "_report_band",
+         "_report_system", "_report_html", "bench", "benchmarks",
          "__main__"},
     ],
 }
