@@ -13,8 +13,6 @@ reports its residual: the RMS relative error of the gradient over the points.
 from __future__ import annotations
 
 import numpy as np
-from scipy.optimize import minimize_scalar
-
 from .._grains import grains_with_d272
 
 __all__ = ["fit_curve", "GRAINS"]
@@ -56,6 +54,8 @@ def fit_curve(velocity_m_s, gradient_pa_per_m, *, viscosity_pa_s, density_kg_m3,
         return float(np.sum((np.log(a_of(b) * u**2 / np.log1p(b * u)) - np.log(gr)) ** 2))
 
     if u.size >= 2:
+        from scipy.optimize import minimize_scalar   # 50 ms to import: only the fits need it
+
         lb = minimize_scalar(cost, bounds=(-3.0, 6.0), method="bounded").x
         b = 10.0**lb
         out["d272_a"], out["d272_b"] = a_of(b), float(b)
