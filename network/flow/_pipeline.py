@@ -212,11 +212,12 @@ def solve_network(packing: Packing, *, axis="z", region: Region | None = None,
         else:
             eps, eps_err = float("nan"), float("nan")
     q1 = check["q_in"]
-    k_whole = darcy_permeability(q1, 1.0, sample.length_m, sample.area_m2,
-                                 viscosity_pa_s=viscosity_pa_s)
-    faces = tess.packing.centers[tess.throat_vertices[sample.throats]]
-    k_inset = _inset_estimate(sample, g, p, reg, packing.grain_diameter, viscosity_pa_s, faces)
-    k = k_whole if k_inset is None else k_inset
+    with stage("permeability"):
+        k_whole = darcy_permeability(q1, 1.0, sample.length_m, sample.area_m2,
+                                     viscosity_pa_s=viscosity_pa_s)
+        k_inset = _inset_estimate(sample, g, p, reg, packing.grain_diameter, viscosity_pa_s,
+                                  tess)
+        k = k_whole if k_inset is None else k_inset
     # pressures and flows of the flow-imposed problem (thesis BC): Q = v A
     scale = velocity_m_s * sample.area_m2 / q1
     d32 = packing.sauter_diameter
@@ -268,7 +269,7 @@ INSET_DIAMETERS = (1.5, 1.0)
 INSET_MIN_DIAMETERS = 4.0
 
 
-def _inset_estimate(sample, g, p, region, grain_diameter_m, viscosity_pa_s, faces):
+def _inset_estimate(sample, g, p, region, grain_diameter_m, viscosity_pa_s, tessellation):
     """k of the sample without its lateral boundary layer, or None (cylinder, too narrow).
 
     The conduits cut by the lateral faces leave a layer 1-2 grains thick that carries less
@@ -283,7 +284,11 @@ def _inset_estimate(sample, g, p, region, grain_diameter_m, viscosity_pa_s, face
     width = np.asarray(region.hi, float) - np.asarray(region.lo, float)
     axis = int(sample.axis)
     lateral = np.delete(width, axis) - 2 * lat * d
-    if region.radius is not None or np.any(lateral < INSET_MIN_DIAMETERS * d) \
+    if region.radius is not None:
+        log.info("cylindrical sample: permeability_m2 is the whole-sample value (no inset "
+                 "window for cylinders)")
+        return None
+    if np.any(lateral < INSET_MIN_DIAMETERS * d) \
             or width[axis] - 2 * end * d < INSET_MIN_DIAMETERS * d:
         log.warning("sample %s grain diameters wide: too narrow for the boundary-free estimate "
                     "(needs %.0f); permeability_m2 is the whole-sample value, low by the cut "
@@ -292,6 +297,7 @@ def _inset_estimate(sample, g, p, region, grain_diameter_m, viscosity_pa_s, face
                     INSET_MIN_DIAMETERS + 2 * lat)
         return None
     try:
+        faces = tessellation.packing.centers[tessellation.throat_vertices[sample.throats]]
         k = core_permeability(sample, g, p, margin_m=lat * d, axial_margin_m=end * d,
                               viscosity_pa_s=viscosity_pa_s, faces=faces)
     except ValueError as exc:

@@ -67,7 +67,7 @@ class Packing:
             g.setflags(write=False)
             object.__setattr__(self, "grain_id", g)
 
-    @property
+    @functools.cached_property
     def n_grains(self) -> int:
         """Number of grains (spheres when there is no ``grain_id``)."""
         return self.n if self.grain_id is None else int(np.unique(self.grain_id).size)
@@ -85,6 +85,11 @@ class Packing:
     def bounds(self) -> np.ndarray:
         """(2, 3) array: lowest and highest centre coordinate along x, y, z (m)."""
         return np.stack([self.centers.min(axis=0), self.centers.max(axis=0)])
+
+    def extent(self) -> np.ndarray:
+        """(2, 3) array: the bed's bounding box, lowest and highest sphere surface (m)."""
+        return np.stack([(self.centers - self.radii[:, None]).min(axis=0),
+                         (self.centers + self.radii[:, None]).max(axis=0)])
 
     @functools.cached_property
     def grain_diameters(self) -> np.ndarray:

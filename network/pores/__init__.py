@@ -9,12 +9,12 @@ from ._merge import PoreMerge, circumspheres, merge_pores
 from ._porosity import region_porosity
 from ._region import (AXES, MIN_INTERIOR_DIAMETERS, OUTSIDE_BED_DIAMETERS, Region, axis_index,
                       check_inside_bed, default_region, sample_region)
-from ._sample import SampleNetwork, prune_disconnected, select_sample
+from ._sample import SampleNetwork, body_centroids, prune_disconnected, select_sample
 from ._tessellation import QHULL_OPTIONS, Tessellation, tessellate, tie_groups
 from ._throat_sample import sample_throats
 
 __all__ = ["AXES", "MIN_INTERIOR_DIAMETERS", "OUTSIDE_BED_DIAMETERS", "QHULL_OPTIONS",
-           "PoreMerge", "Region", "SampleNetwork", "Tessellation", "axis_index",
+           "PoreMerge", "Region", "SampleNetwork", "Tessellation", "axis_index", "body_centroids",
            "check_inside_bed", "circumspheres", "default_region", "merge_pores",
            "prune_disconnected", "region_porosity", "sample_region", "sample_throats",
            "select_sample", "tessellate", "tie_groups"]

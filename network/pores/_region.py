@@ -102,8 +102,7 @@ def default_region(packing, *, margin: float | None = None, cylinder: bool = Fal
     axis : {'x', 'y', 'z'}
         Flow axis (matters for a cylindrical container only).
     """
-    lo = (packing.centers - packing.radii[:, None]).min(axis=0)
-    hi = (packing.centers + packing.radii[:, None]).max(axis=0)
+    lo, hi = packing.extent()
     m = 1.5 * packing.grain_diameter if margin is None else float(margin)
     if m < 0:
         raise ValueError(f"margin must be >= 0, got {m}")
@@ -183,8 +182,7 @@ def check_inside_bed(packing, region: Region, *, tolerance: float = 1e-9) -> Non
     tetrahedra (measured: porosity 0.945 and a pressure drop 12 times too high on the bundled
     scene), so it is refused rather than solved.
     """
-    lo = (packing.centers - packing.radii[:, None]).min(axis=0)
-    hi = (packing.centers + packing.radii[:, None]).max(axis=0)
+    lo, hi = packing.extent()
     tol = tolerance * float(np.max(hi - lo))
     out = np.flatnonzero((region.lo < lo - tol) | (region.hi > hi + tol))
     if out.size:

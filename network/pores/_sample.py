@@ -27,7 +27,7 @@ from scipy.sparse.csgraph import connected_components
 
 from ._region import OUTSIDE_BED_DIAMETERS, Region, axis_index
 
-__all__ = ["SampleNetwork", "select_sample", "prune_disconnected"]
+__all__ = ["SampleNetwork", "body_centroids", "select_sample", "prune_disconnected"]
 
 log = logging.getLogger(__name__)
 
@@ -91,6 +91,22 @@ def _length(xyz, inlet, outlet, axis):
     return float(s[outlet].mean() - s[inlet].mean())
 
 
+def body_centroids(tessellation, labels) -> np.ndarray:
+    """(n_bodies, 3) position of each pore body, m: the volume-weighted centroid of its
+    tetrahedra (their plain mean for a body of zero volume); ``labels`` (Np,) >= 0.
+    """
+    t = tessellation
+    lab = np.asarray(labels, dtype=np.int64)
+    if lab.shape != (t.n_pores,) or lab.min() < 0:
+        raise ValueError(f"groups must be (Np,) = ({t.n_pores},) labels >= 0, got {lab.shape}")
+    ng = int(lab.max()) + 1
+    vol = np.bincount(lab, t.pore_volume, ng)
+    cnt = np.bincount(lab, None, ng)
+    w = np.where(vol[lab] > 0, t.pore_volume / np.where(vol[lab] > 0, vol[lab], 1.0),
+                 1.0 / cnt[lab])
+    return np.column_stack([np.bincount(lab, w * t.pore_centroid[:, k], ng) for k in range(3)])
+
+
 def select_sample(tessellation, region: Region, *, axis="z", groups=None) -> SampleNetwork:
     """Pores of a region, the throats joining them, and the inlet/outlet pores along ``axis``.
 
@@ -121,15 +137,7 @@ def select_sample(tessellation, region: Region, *, axis="z", groups=None) -> Sam
         xyz_all = t.pore_centroid
     else:
         lab = np.asarray(groups, dtype=np.int64)
-        if lab.shape != (t.n_pores,) or lab.min() < 0:
-            raise ValueError(f"groups must be (Np,) = ({t.n_pores},) labels >= 0, got {lab.shape}")
-        ng = int(lab.max()) + 1
-        vol = np.bincount(lab, t.pore_volume, ng)
-        cnt = np.bincount(lab, None, ng)
-        w = np.where(vol[lab] > 0, t.pore_volume / np.where(vol[lab] > 0, vol[lab], 1.0),
-                     1.0 / cnt[lab])
-        xyz_all = np.column_stack([np.bincount(lab, w * t.pore_centroid[:, k], ng)
-                                   for k in range(3)])
+        xyz_all = body_centroids(t, lab)
     inside = region.contains(xyz_all, ax)
     # tetrahedra whose empty sphere is wider than 2 mean diameters lie outside the packed bed
     # (convex-hull artefacts along walls, free surfaces and open sides: a bed has no void

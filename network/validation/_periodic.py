@@ -21,7 +21,7 @@ from scipy.spatial import cKDTree
 
 from ..conductance import throat_conductance
 from ..packing import Packing, periodic_copies
-from ..pores import axis_index, merge_pores, tessellate
+from ..pores import axis_index, body_centroids, merge_pores, tessellate
 
 __all__ = ["periodic_permeability"]
 
@@ -62,10 +62,7 @@ def periodic_permeability(packing: Packing, side: float, *, axes=("x", "y", "z")
     t = tessellate(big)
     pm = merge_pores(t)
     lab = np.asarray(pm.labels)
-    ng = int(lab.max()) + 1
-    vol = np.bincount(lab, t.pore_volume, ng)
-    xyz = np.column_stack([np.bincount(lab, t.pore_volume * t.pore_centroid[:, k], ng)
-                           for k in range(3)]) / vol[:, None]
+    xyz = body_centroids(t, lab)
     mid = np.all((xyz >= L) & (xyz < 2 * L), axis=1)
     cell = np.flatnonzero(mid)
     near, j = cKDTree(np.mod(xyz[cell], L), boxsize=L).query(np.mod(xyz, L))
