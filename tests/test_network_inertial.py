@@ -102,3 +102,11 @@ def test_curve_writes_points_fits_and_plot(tmp_path):
               "ergun_B"):
         assert np.isfinite(d[k])
     assert png.stat().st_size > 1000
+
+
+def test_one_velocity_fits_nothing():
+    """Every fit has two constants: a single velocity gives None for all of them (it gave a
+    minimum-norm 'k' of 0.015 m^2 before), and the curve's result says so the same way."""
+    f = fit_curve([0.01], [5.0], viscosity_pa_s=1.932e-5, density_kg_m3=1.2, porosity=0.4,
+                  diameter_m=0.0066)
+    assert f and all(v is None for v in f.values())

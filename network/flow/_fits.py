@@ -21,6 +21,12 @@ __all__ = ["fit_curve", "GRAINS"]
 GRAINS = tuple(grains_with_d272())
 
 
+#: The keys of :func:`fit_curve` (all None when fewer than two distinct velocities).
+FIT_KEYS = ("permeability_m2", "forchheimer_beta_per_m", "forchheimer_residual",
+            "permeability_residual", "d272_a", "d272_b", "d272_residual", "ergun_A", "ergun_B",
+            "ergun_residual")
+
+
 def _rms_rel(pred, grad):
     return float(np.sqrt(np.mean((pred / grad - 1.0) ** 2)))
 
@@ -37,6 +43,9 @@ def fit_curve(velocity_m_s, gradient_pa_per_m, *, viscosity_pa_s, density_kg_m3,
     u = np.asarray(velocity_m_s, dtype=float)
     gr = np.asarray(gradient_pa_per_m, dtype=float)
     mu, rho, e, d = map(float, (viscosity_pa_s, density_kg_m3, porosity, diameter_m))
+    if np.unique(u).size < 2:
+        # every fit has two constants: one velocity determines none of them
+        return dict.fromkeys(FIT_KEYS)
     out: dict = {}
     # Forchheimer: gr = mu U / k + beta rho U^2, weighted by 1/gr (relative residuals)
     M = np.column_stack([mu * u, rho * u**2]) / gr[:, None]
@@ -53,15 +62,12 @@ def fit_curve(velocity_m_s, gradient_pa_per_m, *, viscosity_pa_s, density_kg_m3,
         b = 10.0**logb
         return float(np.sum((np.log(a_of(b) * u**2 / np.log1p(b * u)) - np.log(gr)) ** 2))
 
-    if u.size >= 2:
-        from scipy.optimize import minimize_scalar   # 50 ms to import: only the fits need it
+    from scipy.optimize import minimize_scalar   # 50 ms to import: only the fits need it
 
-        lb = minimize_scalar(cost, bounds=(-3.0, 6.0), method="bounded").x
-        b = 10.0**lb
-        out["d272_a"], out["d272_b"] = a_of(b), float(b)
-        out["d272_residual"] = _rms_rel(out["d272_a"] * u**2 / np.log1p(b * u), gr)
-    else:
-        out["d272_a"] = out["d272_b"] = out["d272_residual"] = None
+    lb = minimize_scalar(cost, bounds=(-3.0, 6.0), method="bounded").x
+    b = 10.0**lb
+    out["d272_a"], out["d272_b"] = a_of(b), float(b)
+    out["d272_residual"] = _rms_rel(out["d272_a"] * u**2 / np.log1p(b * u), gr)
     if 0 < e < 1 and d > 0:
         c1 = mu * (1 - e) ** 2 * u / (e**3 * d**2)
         c2 = rho * (1 - e) * u**2 / (e**3 * d)
