@@ -146,7 +146,8 @@ def write_html(path, r: dict, png: dict) -> None:
         op_text = op["message"] if op else "No fan curve given (--fan)."
     fits = "".join(f"<li>{html.escape(name)}: " + ", ".join(
         f"{k} = {_f(v)}" for k, v in f.items()) + "</li>"
-        for name, f in (("vertical", r["fits"]), ("horizontal", r["fits_horizontal"])) if f)
+        for name, f in (("vertical", r["fits"]), ("horizontal", r["fits_horizontal"]))
+        if f and f["permeability_m2"] is not None)
     band_text = ("Porosity band skipped (--no-band)." if not band else
                  "d ln(dP/L)/d(porosity) = " + ", ".join(
                      f"{s:.2f} &plusmn; {se:.2f} at {u:.3g} m/s" for s, se, u in

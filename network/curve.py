@@ -28,8 +28,8 @@ from ._cli import (CliError, CliParser, add_air, add_packing, add_sample, add_ta
                    sample_box_m)
 from .conductance import POLICIES
 from ._grains import GRAIN_ALIASES, d272_constants
-from .flow import (DEFAULT_DEPTH_M, GRAINS,
-                   asabe_d272_gradient, ergun_gradient, fit_curve, solve_network)
+from .flow import (DEFAULT_DEPTH_M, GRAINS, asabe_d272_gradient, ergun_gradient,
+                   solve_network)
 from .packing import read_container
 from .pores import sample_region
 
@@ -182,10 +182,7 @@ def _main(args) -> int:
                                           "cg_iterations": p["cg_iterations"]}
                for p in res.curve_points()]
         ok = [p for p in pts if p["converged"]]
-        fits = fit_curve([p["velocity_m_s"] for p in ok],
-                         [p["pressure_gradient_pa_per_m"] for p in ok],
-                         viscosity_pa_s=args.viscosity, density_kg_m3=args.density,
-                         porosity=res.porosity, diameter_m=res.sauter_diameter_m) if ok else {}
+        fits = res.curve_fits()
     print(f"packing {path} ({packing.n} spheres), axis {args.axis}: k (Stokes) = "
           f"{res.permeability_m2:.4e} m2, porosity {res.porosity:.4f}, d32 "
           f"{res.sauter_diameter_m:.4g} m")

@@ -32,7 +32,7 @@ from ._report_html import write_figures, write_html
 from ._report_system import (AIRFLOW_UNITS, bulk_density, curve_range, dense_system, floor_area,
                              operating_point, read_fan, system_rows, velocity_from_airflow)
 from .curve import DEFAULT_VELOCITIES, parse_velocities
-from .flow import DEFAULT_DEPTH_M, asabe_d272_gradient, ergun_gradient, fit_curve, solve_network
+from .flow import DEFAULT_DEPTH_M, asabe_d272_gradient, ergun_gradient, solve_network
 from .packing import UNITS, read_container
 from .pores import sample_region
 
@@ -153,15 +153,6 @@ def _points(res):
     return [{k: p[k] for k in KEYS} for p in res.curve_points()]
 
 
-def _fits(points, res, args):
-    ok = [p for p in points if p["converged"]]
-    if len(ok) < 2:
-        return {}
-    return fit_curve([p["velocity_m_s"] for p in ok], [p["pressure_gradient_pa_per_m"] for p in ok],
-                     viscosity_pa_s=args.viscosity, density_kg_m3=args.density,
-                     porosity=res.porosity, diameter_m=res.sauter_diameter_m)
-
-
 def build_report(args, opts, path, packing) -> dict:
     """All the numbers of the report (the JSON document)."""
     t0 = time.perf_counter()
@@ -223,7 +214,7 @@ def build_report(args, opts, path, packing) -> dict:
                     "note": c.note},
            "permeability_stokes_m2": {"z": rz.permeability_m2, "x": rx.permeability_m2},
            "horizontal_to_vertical_stokes": rz.permeability_m2 / rx.permeability_m2,
-           "fits": _fits(pts, rz, args), "fits_horizontal": _fits(pts_x, rx, args),
+           "fits": rz.curve_fits(), "fits_horizontal": rx.curve_fits(),
            "points": pts, "band": band,
            "bin": {"depth_m": args.depth, "diameter_m": args.diameter, "floor_area_m2": area,
                    "grain_mass_t": rho_b * area * args.depth / 1000.0},
@@ -279,14 +270,14 @@ def print_report(r) -> None:
               + ("" if p["converged"] else "  NOT CONVERGED"))
     band = r["band"]
     if band:
-        print(f"porosity band: d ln(dP/L)/d(porosity) = "
+        print("porosity band: d ln(dP/L)/d(porosity) = "
               + ", ".join(f"{s:.2f} +- {se:.2f} at {u:.3g} m/s" for s, se, u in
                           zip(band["slopes"], band["slope_stderrs"], band["velocities_m_s"]))
               + f"; {len(band['beds'])} beds of {band['packer']}, porosity "
               f"{min(b['porosity'] for b in band['beds']):.3f}-"
               f"{max(b['porosity'] for b in band['beds']):.3f}, {band['seconds']:.1f} s")
     for name, f in (("vertical", r["fits"]), ("horizontal", r["fits_horizontal"])):
-        if f:
+        if f and f["permeability_m2"] is not None:
             print(f"fits {name}: k {f['permeability_m2']:.4e} m^2, beta "
                   f"{f['forchheimer_beta_per_m']:.4g} 1/m; D272-style a {f['d272_a']:.4g} "
                   f"Pa s^2/m^3, b {f['d272_b']:.4g} s/m; Ergun A {f['ergun_A']:.4g}, "

@@ -8,6 +8,7 @@ import numpy as np
 
 from .._air import RHO_AIR_KG_M3
 from ._empirical import asabe_d272_gradient, ergun_gradient, kozeny_carman_gradient
+from ._fits import fit_curve
 
 __all__ = ["FlowResult", "combined_summary"]
 
@@ -94,6 +95,19 @@ class FlowResult:
                          "cg_iterations": pt.cg_iterations, "residual": pt.residual,
                          "seconds": pt.seconds})
         return sorted(rows, key=lambda r: r["velocity_m_s"])
+
+    def curve_fits(self) -> dict:
+        """Darcy-Forchheimer, D272 and Ergun fits (:func:`network.flow.fit_curve`) over the
+        converged inertial points, with this sample's porosity and d32; all None with fewer
+        than two velocities, {} without inertial points."""
+        ok = [p for p in self.curve_points() if p["converged"]]
+        if not ok:
+            return {}
+        return fit_curve([p["velocity_m_s"] for p in ok],
+                         [p["pressure_gradient_pa_per_m"] for p in ok],
+                         viscosity_pa_s=self.viscosity_pa_s,
+                         density_kg_m3=self.inertial["density_kg_m3"], porosity=self.porosity,
+                         diameter_m=self.sauter_diameter_m)
 
     @property
     def k_over_d2(self) -> float:
