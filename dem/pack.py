@@ -37,9 +37,10 @@ from .templates import resolve_template
 
 def _parser():
     p = argparse.ArgumentParser(prog="python -m dem.pack", description=__doc__.split("\n")[1])
-    p.add_argument("--scene", required=True, choices=sorted(SCENES) + ["box", "cylinder"])
+    p.add_argument("--scene", required=True, choices=sorted(SCENES) + ["box", "cylinder"],
+                   help="container: the thesis's rect-bin or cyl-bin, or a box/cylinder sized by --size and --height")
     p.add_argument("--out", required=True, help="packing CSV path (JSON summary written beside it)")
-    p.add_argument("--seed", type=int, default=1)
+    p.add_argument("--seed", type=int, default=1, help="random seed of the insertion (same seed, same packing; default 1)")
     p.add_argument("--size", type=float, nargs="+", help="box: length_x width_y; cylinder: diameter (m)")
     p.add_argument("--height", type=float, help="fill height (m) for box/cylinder")
     p.add_argument("--porosity", type=float, default=0.408, help="target porosity (Table 3.1: 0.408)")
@@ -62,12 +63,22 @@ def _parser():
                    help="'sediment': amplitude falls linearly to 0 over the taps (annealed)")
     p.add_argument("--keep-lid", action="store_true", help="do not remove the lid before the last settling")
     p.add_argument("--tol", type=float, default=2e-3, help="mean unbalanced-force ratio at equilibrium")
-    p.add_argument("--max-steps", type=int, default=200000)
-    p.add_argument("--dt-safety", type=float, default=0.25)
-    for name, default in [("density", 1285.0), ("kn", 4.0e6), ("ks", 2.0e6), ("friction", 0.47),
-                          ("wall-kn", 1.8e7), ("wall-ks", 0.9e7), ("wall-friction", 0.3), ("damping", 0.1),
-                          ("r-min", 0.00275), ("r-max", 0.00375)]:
-        p.add_argument(f"--{name}", type=float, default=default)
+    p.add_argument("--max-steps", type=int, default=200000, help="step limit of each stage (default 200000); a bed not at "
+                   "equilibrium by then is written with \"converged\": false and exit 1")
+    p.add_argument("--dt-safety", type=float, default=0.25, help="time step as this fraction of sqrt(mass_scale m_min / "
+                   "max(k_n, k_s)), the critical step of the lightest sphere (default 0.25)")
+    for name, default, what in [("density", 1285.0, "particle density, kg/m^3"),
+                                ("kn", 4.0e6, "particle normal stiffness, N/m"),
+                                ("ks", 2.0e6, "particle shear stiffness, N/m"),
+                                ("friction", 0.47, "particle friction coefficient"),
+                                ("wall-kn", 1.8e7, "wall normal stiffness, N/m"),
+                                ("wall-ks", 0.9e7, "wall shear stiffness, N/m"),
+                                ("wall-friction", 0.3, "wall friction coefficient"),
+                                ("damping", 0.1, "viscous damping ratio"),
+                                ("r-min", 0.00275, "smallest sphere radius, m"),
+                                ("r-max", 0.00375, "largest sphere radius, m")]:
+        p.add_argument(f"--{name}", type=float, default=default,
+                       help=f"{what} (default {default:g}, thesis Table 3.1)")
     p.add_argument("--measure", type=float, nargs=3, action="append", metavar=("X", "Y", "Z"),
                    help="centre of a measurement sphere (m); repeat for several (default: thesis B1-B5)")
     p.add_argument("--measure-radius", type=float, default=None, help="m (default: width/14 as in Appendix C)")
@@ -75,7 +86,7 @@ def _parser():
                    "barley, canola) or a template CSV x,y,z,r; material from the grain library where it has values")
     p.add_argument("--template-units", choices=["mm", "m"], default="mm", help="units of a template CSV (default mm)")
     p.add_argument("--n-grains", type=int, default=None, help="--grain: number of grains (default from --porosity)")
-    p.add_argument("--quiet", action="store_true")
+    p.add_argument("--quiet", action="store_true", help="no progress lines on stderr")
     return p
 
 
