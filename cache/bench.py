@@ -65,13 +65,13 @@ def build_parser():
     p = argparse.ArgumentParser(prog="python -m cache.bench", description=__doc__.split("\n")[0])
     p.add_argument("--db", default=None, help="table with grid(s) (default: cache.default_db_path())")
     p.add_argument("--n-fe", type=int, default=300, help="held-out throats solved by FE")
-    p.add_argument("--seed", type=int, default=2024)
+    p.add_argument("--seed", type=int, default=2024, help="seed of the held-out throats (default 2024)")
     p.add_argument("--n-batch", type=int, default=1_000_000, help="rows in the throughput batch")
-    p.add_argument("--repeat", type=int, default=3)
+    p.add_argument("--repeat", type=int, default=3, help="timing repeats, best reported (default 3)")
     p.add_argument("--rtols", default="3e-2,1e-2,3e-3,1e-3", help="rtol values for table+fe")
     p.add_argument("--reference", default=None,
                    help="npz to cache the held-out FE reference in (reused when it exists)")
-    p.add_argument("--out", default="cache_bench.json")
+    p.add_argument("--out", default="cache_bench.json", help="output JSON path (default cache_bench.json)")
     return p
 
 

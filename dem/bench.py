@@ -93,14 +93,17 @@ def mass_scale_study(scales=(1.0, 10.0, 100.0), *, seed=1, settle_time_s=0.3, gr
 def main(argv=None) -> int:
     tune_malloc()
     p = argparse.ArgumentParser(prog="python -m dem.bench", description=__doc__.split("\n")[0])
-    p.add_argument("--n", type=int, nargs="+", default=[1000, 2000, 5000, 10000, 20000, 50000])
-    p.add_argument("--repeat", type=int, default=3)
-    p.add_argument("--steps", type=int, default=None)
+    p.add_argument("--n", type=int, nargs="+", default=[1000, 2000, 5000, 10000, 20000, 50000],
+                   help="sphere counts timed (default 1000 ... 50000)")
+    p.add_argument("--repeat", type=int, default=3, help="timing repeats, best and median reported (default 3)")
+    p.add_argument("--steps", type=int, default=None, help="steps per timing (default max(20, 2e6 / N))")
     p.add_argument("--threads", type=int, default=None,
                    help="threads of the step kernels (default: chosen by timing, see dem._threads)")
-    p.add_argument("--mass-scale-study", action="store_true")
-    p.add_argument("--scales", type=float, nargs="+", default=[1.0, 10.0, 100.0])
-    p.add_argument("--json", default="dem_bench.json")
+    p.add_argument("--mass-scale-study", action="store_true",
+                   help="instead of the rates: pack one bed at each --scales mass scale and compare")
+    p.add_argument("--scales", type=float, nargs="+", default=[1.0, 10.0, 100.0],
+                   help="--mass-scale-study: density scalings (default 1 10 100)")
+    p.add_argument("--json", default="dem_bench.json", help="output JSON path (default dem_bench.json)")
     args = p.parse_args(argv)
     meta = {"loadavg_before": os.getloadavg(), "platform": platform.platform(), "cpu_count": os.cpu_count(),
             "python": sys.version.split()[0], "numpy": np.__version__,

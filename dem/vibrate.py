@@ -47,7 +47,8 @@ def _parser():
     p.add_argument("--series", action="store_true", help="the thesis's 0.5, 1, 2, 3, 4 mm")
     p.add_argument("--duration", type=float, default=None, help="s of vibration (default 1; --study: 16 as the "
                    "thesis)")
-    p.add_argument("--mass-scale", type=float, default=100.0)
+    p.add_argument("--mass-scale", type=float, default=100.0,
+                   help="density scaling of the time step (1 = none; default 100, docs/dem-packing.md)")
     p.add_argument("--record-every", type=float, default=None, help="s (default a quarter period)")
     p.add_argument("--snapshots", type=float, nargs="*", default=(), help="times (s) to save packings")
     p.add_argument("--settle-steps", type=int, default=100000, help="step limit of the settling after vibration")
@@ -67,7 +68,7 @@ def _parser():
     p.add_argument("--no-network", action="store_true", help="--study: skip network.solve/paths on the beds")
     p.add_argument("--threads", type=int, default=None, help="threads of the step (default: chosen by timing)")
     p.add_argument("--out", default=None, help="output folder (default vibration_out; --study: vibration_study)")
-    p.add_argument("--quiet", action="store_true")
+    p.add_argument("--quiet", action="store_true", help="no progress lines on stderr")
     return p
 
 

@@ -53,14 +53,16 @@ def main(argv=None) -> int:
                          "500000 for the full run)")
     ap.add_argument("--policy", default="table-only", choices=POLICIES,
                     help="Q* policy of the scaling part (default table-only: a precomputed table)")
-    ap.add_argument("--policies", nargs="*", default=list(POLICIES), choices=POLICIES)
+    ap.add_argument("--policies", nargs="*", default=list(POLICIES), choices=POLICIES,
+                    help="Q* policies of the policy comparison, part 1 (default all)")
     ap.add_argument("--models", nargs="*", default=["conduit", "thesis"], choices=MODELS,
                     help="conductance models of the policy comparison (default both)")
     ap.add_argument("--model", default="conduit", choices=MODELS,
                     help="conductance model of the scaling part (default conduit)")
     ap.add_argument("--policy-spheres", type=int, default=600,
                     help="packing size of the policy comparison (FE cost grows with it)")
-    ap.add_argument("--skip-policies", action="store_true")
+    ap.add_argument("--skip-policies", action="store_true",
+                    help="leave out part 1 (Q* policies: speed against error)")
     ap.add_argument("--skip-references", action="store_true",
                     help="leave out part 3 (permeability error against the references)")
     ap.add_argument("--references-only", action="store_true",
@@ -85,13 +87,14 @@ def main(argv=None) -> int:
     ap.add_argument("--db", default=None,
                     help="throat table with the interpolation grid (default: the cache's default; "
                          "the policy part works on copies)")
-    ap.add_argument("--workers", type=int, default=1, help="FE processes")
+    ap.add_argument("--workers", type=int, default=1, help="FE processes (default 1)")
     ap.add_argument("--workdir", default=None,
                     help="where generated packings are kept (default ~/.cache/grainflow/bench)")
-    ap.add_argument("--seed", type=int, default=1)
+    ap.add_argument("--seed", type=int, default=1, help="seed of the generated packings (default 1)")
     ap.add_argument("--repeats", type=int, default=2, help="repeats per size (minimum reported)")
     ap.add_argument("--timeout", type=float, default=1800.0, help="per-size limit, s")
-    ap.add_argument("--json", dest="json_out", default="network_bench.json")
+    ap.add_argument("--json", dest="json_out", default="network_bench.json",
+                    help="output JSON path (default network_bench.json)")
     ap.add_argument("--inertial", action="store_true",
                     help="run part 4 alone: inertial curve speed and drag-law errors")
     ap.add_argument("--inertial-spheres", type=int, default=20000,

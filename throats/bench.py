@@ -208,7 +208,8 @@ def main(argv=None) -> int:
     p = argparse.ArgumentParser(prog="python -m throats.bench", description=__doc__.split("\n")[0])
     p.add_argument("--n", type=int, default=200, help="packing throats (default 200)")
     p.add_argument("--seed", type=int, default=1, help="packing seed (default 1)")
-    p.add_argument("--rtols", type=float, nargs="+", default=[1e-2, 3e-3, 1e-3, 1e-4])
+    p.add_argument("--rtols", type=float, nargs="+", default=[1e-2, 3e-3, 1e-3, 1e-4],
+                   help="FE tolerances compared (default 1e-2 3e-3 1e-3 1e-4)")
     p.add_argument("--json", default="throats_bench.json", help="output JSON path")
     p.add_argument("--fit", action="store_true", help="refit the shape-factor constants")
     args = p.parse_args(argv)
