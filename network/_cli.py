@@ -25,7 +25,7 @@ import warnings
 from pathlib import Path
 
 from ._air import MU_AIR_PA_S, RHO_AIR_KG_M3, check_positive
-from .packing import UNITS, default_packing_path, read_packing, scale_warning
+from .packing import UNITS, default_packing_path, read_container, read_packing, scale_warning
 from .flow import INERTIAL_LAWS
 
 __all__ = ["EXIT_OK", "EXIT_FAILED", "EXIT_BAD_INPUT", "CliError", "CliParser", "bad_input",
@@ -232,9 +232,11 @@ def check_common(args) -> None:
 
 def load_packing(args):
     """(path, packing in metres) of ``args.packing`` (bundled scene if None) in ``args.units``;
-    the scale warning, if any, as one stderr line."""
+    the scale warning, if any, as one stderr line. A companion JSON whose container is of an
+    unknown kind or malformed is refused here, before any work (:func:`read_container`)."""
     path = Path(args.packing) if args.packing else default_packing_path()
     packing = read_packing(path, units=args.units)
+    read_container(path)
     msg = scale_warning(packing)
     if msg:
         warn(msg)

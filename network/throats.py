@@ -28,6 +28,7 @@ import numpy as np
 
 from ._cli import (CliParser, add_packing, add_sample, bad_input, check_common, check_outputs,
                    computing, load_packing, progress_log, run, sample_box_m)
+from .packing import read_container
 from .pores import sample_region, select_sample, tessellate, tie_groups
 
 HEADER = "r1,r2,r3,l12,l13,l23,throat,pore1,pore2"
@@ -65,7 +66,8 @@ def _main(args) -> int:
         check_outputs(out=args.out)
         path, packing = load_packing(args)
         box, margin = sample_box_m(args)
-        region = None if args.everything else sample_region(packing, box=box, margin=margin)
+        region = None if args.everything else sample_region(
+            packing, box=box, margin=margin, container=None if box else read_container(path))
     with computing():
         tess = tessellate(packing)
         if args.everything:

@@ -76,7 +76,7 @@ def test_solve_bad_file(tmp_path, capsys):
     p = tmp_path / "bad.csv"
     p.write_text("x,y,z,r\n1,2,3\n")
     assert solve_cli.main([str(p), "-q"]) == 2
-    assert "line 2" in capsys.readouterr().err
+    assert "row 2" in capsys.readouterr().err
     assert solve_cli.main([str(tmp_path / "missing.csv"), "-q"]) == 2
 
 

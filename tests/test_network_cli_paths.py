@@ -100,7 +100,7 @@ def test_bad_options_exit_2(argv, words, capsys):
 @pytest.mark.parametrize("content, words", [
     ("", "bad.csv"),
     ("x,y,z,r\n" + "".join(f"{i},{i},{i % 2},0.003\n" for i in range(6)) + "nan,0,0,0.003\n",
-     "line 8"),
+     "row 8"),
     ("x,y,z,r\n0,0,0,1\n1,0,0,1\n0,1,0,1\n", "too few spheres"),
     ("x,y,z,r\n" + "".join(f"{i % 3 * 0.01},{i // 3 * 0.01},0.05,0.003\n" for i in range(9)),
      "coplanar"),

@@ -85,7 +85,7 @@ def test_bad_row_names_file_and_line(tmp_path, capsys):
                  + "9,9,9,nan\n")
     assert solve_cli.main([str(p), "-q"]) == 2
     err = capsys.readouterr().err
-    assert err.count("\n") == 1 and "bad.csv" in err and "line 8" in err
+    assert err.count("\n") == 1 and "bad.csv" in err and "row 8" in err
 
 
 def test_axis_any_case_and_tables(beds, tmp_path, capsys):

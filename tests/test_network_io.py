@@ -49,11 +49,11 @@ def test_lammps_dump(tmp_path):
 
 @pytest.mark.parametrize("bad, match", [
     ("x,y,z,r\n" + "0,0,0,1\n" * 0 + "".join(f"{i},0,0,1\n" for i in range(5)) + "5,0,nan,1\n",
-     "line 7: non-finite"),
-    ("x,y,z,r\n" + "".join(f"{i},0,0,1\n" for i in range(5)) + "5,0,0,-1\n", "line 7: radius must be > 0"),
-    ("x,y,z,r\n" + "".join(f"{i},0,0,1\n" for i in range(5)) + "2,0,0,1\n", "line 7: duplicate centre"),
-    ("x,y,z,r\n" + "".join(f"{i},0,0,1\n" for i in range(5)) + "5,0,abc,1\n", "line 7: not a number"),
-    ("x,y,z,r\n" + "".join(f"{i},0,0,1\n" for i in range(5)) + "5,0,1\n", "line 7: expected 4 values"),
+     "row 7: non-finite"),
+    ("x,y,z,r\n" + "".join(f"{i},0,0,1\n" for i in range(5)) + "5,0,0,-1\n", "row 7: radius must be > 0"),
+    ("x,y,z,r\n" + "".join(f"{i},0,0,1\n" for i in range(5)) + "2,0,0,1\n", "row 7: duplicate centre"),
+    ("x,y,z,r\n" + "".join(f"{i},0,0,1\n" for i in range(5)) + "5,0,abc,1\n", "row 7: not a number"),
+    ("x,y,z,r\n" + "".join(f"{i},0,0,1\n" for i in range(5)) + "5,0,1\n", "row 7: expected 4 values"),
     ("x,y,z,r\n0,0,0,1\n1,0,0,1\n", "too few spheres"),
     ("a,b,c\n1,2,3\n", "lacks column"),
 ])
@@ -166,7 +166,7 @@ def test_grain_id_on_spheres_apart_is_refused_naming_it(tmp_path):
     p.write_text("x,y,z,r,grain_id\n" + "\n".join(
         f"{c[i, 0]},{c[i, 1]},{c[i, 2]},{r[i]},{g[i]}" for i in range(10)) + "\n")
     with pytest.raises(ValueError, match=r"grain_id 4 is on spheres that do not overlap into one "
-                                         r"body \(line 6 and line 9 are apart\)"):
+                                         r"body \(row 6 and row 9 are apart\)"):
         read_packing(p)
     p.write_text(p.read_text().replace(",4\n", ",4.5\n", 1))
     with pytest.raises(ValueError, match="grain_id must be a whole number"):

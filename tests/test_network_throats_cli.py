@@ -32,7 +32,7 @@ def test_writes_lengths_that_read_back_bit_for_bit(bed, tmp_path):
     (["{bed}", "--out", "{tmp}/t.csv", "--units", "inch"], "invalid choice: 'inch'"),
     (["{bed}"], "required: --out"),
     (["{tmp}/missing.csv", "--out", "{tmp}/t.csv"], "missing.csv"),
-    (["{nan}", "--out", "{tmp}/t.csv"], "line 3: non-finite"),      # header = line 1
+    (["{nan}", "--out", "{tmp}/t.csv"], "row 3: non-finite"),      # header = row 1
     (["{bed}", "--out", "{tmp}/t.csv", "--margin", "-1"], "--margin"),
     (["{bed}", "--out", "{tmp}/t.csv", "--sample", "0", "1", "0", "1", "0", "1"], "bed"),
 ])

@@ -2,7 +2,8 @@
 
 A packing is a table of sphere centres (N, 3) and radii (N,), in metres: a file in mm or cm
 is read with ``units``. Every reader validates at the door and names the
-offending line (1-based, as an editor shows it) in its ``ValueError``.
+offending row in its ``ValueError``, counted as a spreadsheet does (the file line, header = row 1;
+the 1-based array index of a ``.npz``).
 """
 
 from __future__ import annotations
@@ -31,12 +32,12 @@ def _parse_rows(rows, ncols, first_line, source):
     out = np.empty((len(rows), ncols))
     for k, fields in enumerate(rows):  # parsing is I/O-bound; the loop runs once per line
         if len(fields) != ncols:
-            raise ValueError(f"{source}: line {first_line[k]}: expected {ncols} values, "
+            raise ValueError(f"{source}: row {first_line[k]}: expected {ncols} values, "
                              f"got {len(fields)}: {','.join(fields)!r}")
         try:
             out[k] = [float(f) for f in fields]
         except ValueError as e:
-            raise ValueError(f"{source}: line {first_line[k]}: not a number in "
+            raise ValueError(f"{source}: row {first_line[k]}: not a number in "
                              f"{','.join(fields)!r}") from e
     return out
 
@@ -75,7 +76,7 @@ def _read_csv(path: Path) -> Packing:
         rname = [c for c in _RADIUS_NAMES + _DIAMETER_NAMES if c in names]
         missing = [c for c in ("x", "y", "z") if c not in names] + ([] if rname else ["r"])
         if missing:
-            raise ValueError(f"{src}: line {head_no}: header {head!r} lacks column(s) "
+            raise ValueError(f"{src}: row {head_no}: header {head!r} lacks column(s) "
                              f"{missing}; expected x, y, z and r (or radius, or diameter)")
         cols = [names.index(c) for c in ("x", "y", "z")] + [names.index(rname[0])]
         if "grain_id" in names:
@@ -89,7 +90,7 @@ def _read_csv(path: Path) -> Packing:
         body = lines
     ncols = len(names)
     if ncols < 4:
-        raise ValueError(f"{src}: line {head_no}: expected at least 4 columns (x y z r), got "
+        raise ValueError(f"{src}: row {head_no}: expected at least 4 columns (x y z r), got "
                          f"{ncols}: {head!r}")
     fast = None
     try:
@@ -107,7 +108,7 @@ def _read_csv(path: Path) -> Packing:
         grain = data[:, 4]
         bad = np.flatnonzero(~np.isfinite(grain) | (np.mod(grain, 1) != 0))
         if bad.size:
-            raise ValueError(f"{src}: line {lineno[bad[0]]}: grain_id must be a whole number, "
+            raise ValueError(f"{src}: row {lineno[bad[0]]}: grain_id must be a whole number, "
                              f"got {grain[bad[0]]!r}")
         check_grains(data[:, :3], data[:, 3] * scale, grain, lineno, src)
     return Packing(data[:, :3], data[:, 3] * scale, source=src, grain_id=grain)
@@ -133,11 +134,11 @@ def _read_npz(path: Path) -> Packing:
     if c.ndim != 2 or c.shape[1] != 3 or c.shape[0] != r.shape[0]:
         raise ValueError(f"{src}: centers {c.shape} and radii {r.shape} must be (N, 3) and (N,)")
     rows = np.arange(1, len(r) + 1)
-    validate_spheres(c, r, rows, f"{src} (row)")
+    validate_spheres(c, r, rows, src)
     if grain is not None:
         if grain.shape != r.shape:
             raise ValueError(f"{src}: grain_id {grain.shape} must be ({r.size},)")
-        check_grains(c, r, grain, rows, f"{src} (row)")
+        check_grains(c, r, grain, rows, src)
     return Packing(c, r, source=src, grain_id=grain)
 
 
@@ -157,17 +158,17 @@ def _read_dump(path: Path) -> Packing:
             try:
                 n = int(text[j + 1].split()[0])
             except (IndexError, ValueError) as e:
-                raise ValueError(f"{src}: line {j + 2}: bad atom count") from e
+                raise ValueError(f"{src}: row {j + 2}: bad atom count") from e
             break
     xyz = []
     for names in (("x", "xu", "xs"), ("y", "yu", "ys"), ("z", "zu", "zs")):
         hit = [c for c in names if c in cols]
         if not hit:
-            raise ValueError(f"{src}: line {s + 1}: ATOMS columns {cols} lack {names[0]}")
+            raise ValueError(f"{src}: row {s + 1}: ATOMS columns {cols} lack {names[0]}")
         xyz.append(cols.index(hit[0]))
     rname = [c for c in ("radius", "r", "diameter") if c in cols]
     if not rname:
-        raise ValueError(f"{src}: line {s + 1}: ATOMS columns {cols} lack 'radius' (or 'diameter')")
+        raise ValueError(f"{src}: row {s + 1}: ATOMS columns {cols} lack 'radius' (or 'diameter')")
     rcol = cols.index(rname[0])
     body = []
     for j in range(s + 1, len(text)):
@@ -176,12 +177,12 @@ def _read_dump(path: Path) -> Packing:
         if text[j].strip():
             body.append((j + 1, text[j].split()))
     if n is not None and len(body) != n:
-        raise ValueError(f"{src}: line {s + 1}: header says {n} atoms, found {len(body)} rows")
+        raise ValueError(f"{src}: row {s + 1}: header says {n} atoms, found {len(body)} rows")
     data = _parse_rows([f for _, f in body], len(cols), [i for i, _ in body], src)
     c = data[:, xyz]
     r = data[:, rcol] * (0.5 if rname[0] == "diameter" else 1.0)
     if any(cols[k].endswith("s") for k in xyz):
-        raise ValueError(f"{src}: line {s + 1}: scaled coordinates (xs ys zs) are not supported; "
+        raise ValueError(f"{src}: row {s + 1}: scaled coordinates (xs ys zs) are not supported; "
                          "dump x y z or xu yu zu")
     lineno = np.array([i for i, _ in body])
     validate_spheres(c, r, lineno, src)
@@ -249,6 +250,8 @@ def read_packing(path: str | os.PathLike, *, units: str = "m") -> Packing:
 
 #: Length units a packing file may be written in, with their factor to metres.
 UNITS = {"m": 1.0, "cm": 1e-2, "mm": 1e-3}
+#: Container kinds of a companion JSON, with the names of their ``size_m`` values (m).
+CONTAINER_KINDS = {"box": ("length_x", "width_y"), "cylinder": ("diameter",)}
 #: Formats :func:`read_packing` reads, for error messages.
 FORMATS = ("delimited text x,y,z,r (comma, semicolon, spaces or tabs; YADE export.text)",
            ".npz with centers and radii", "LAMMPS/LIGGGHTS dump custom")
@@ -264,7 +267,15 @@ def read_container(path: str | os.PathLike) -> dict | None:
     -------
     dict or None
         ``{"kind": ..., "size_m": [...], "center_xy": [x, y] (if known)}``; None when there is
-        no companion JSON or it has no usable ``container`` entry (logged).
+        no companion JSON, it is not a JSON object, or it has no ``container`` entry (logged:
+        a JSON of the same stem may be another tool's output).
+
+    Raises
+    ------
+    ValueError
+        A ``container`` entry whose kind is not one of :data:`CONTAINER_KINDS`, or whose
+        ``size_m`` is not the kind's positive, finite sizes (a box: length_x, width_y; a
+        cylinder: diameter); the message names the file.
     """
     import json
 
@@ -273,12 +284,25 @@ def read_container(path: str | os.PathLike) -> dict | None:
         return None
     try:
         meta = json.loads(p.read_text())
-        cont = dict(meta["container"])
-        kind = str(cont["kind"]).lower()
-        size = [float(v) for v in np.atleast_1d(cont["size_m"])]
-    except (ValueError, KeyError, TypeError) as e:
-        log.warning("companion JSON %s has no usable 'container' entry (%s): ignored", p, e)
+    except (ValueError, UnicodeDecodeError) as e:
+        log.warning("companion JSON %s is not readable JSON (%s): ignored", p, e)
         return None
+    if not isinstance(meta, dict) or meta.get("container") is None:
+        log.warning("companion JSON %s has no 'container' entry: ignored", p)
+        return None
+    cont = meta["container"]
+    kind = str(cont.get("kind")).lower() if isinstance(cont, dict) else None
+    if kind not in CONTAINER_KINDS:
+        raise ValueError(f"{p}: container kind {kind!r} is not known; the kinds read are "
+                         f"{', '.join(CONTAINER_KINDS)} (or remove the 'container' entry)")
+    try:
+        size = [float(v) for v in np.atleast_1d(cont["size_m"])]
+    except (KeyError, TypeError, ValueError) as e:
+        raise ValueError(f"{p}: container 'size_m' is missing or not numbers ({e})") from e
+    need = CONTAINER_KINDS[kind]
+    if len(size) != len(need) or not all(np.isfinite(v) and v > 0 for v in size):
+        raise ValueError(f"{p}: a {kind} container needs size_m = [{', '.join(need)}] (m, > 0), "
+                         f"got {size}")
     out = {"kind": kind, "size_m": size, "source": str(p)}
     centre = cont.get("center_xy") or (meta.get("interior_region") or {}).get("center_xy")
     if centre is not None:

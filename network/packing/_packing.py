@@ -158,7 +158,7 @@ class Packing:
 def validate_spheres(centers, radii, lines, source, *, check_duplicates=True):
     """Check finite values, positive radii, distinct centres and enough spheres.
 
-    ``lines[i]`` is the 1-based file line (or array row) that sphere i came from.
+    ``lines[i]`` is the row sphere i came from, counted as a spreadsheet does: the file line (header = row 1) of a text file, the 1-based array index of a .npz.
     """
     n = len(radii)
     if n < MIN_SPHERES:
@@ -166,12 +166,12 @@ def validate_spheres(centers, radii, lines, source, *, check_duplicates=True):
     bad = ~np.isfinite(centers).all(axis=1) | ~np.isfinite(radii)
     if bad.any():
         i = int(np.flatnonzero(bad)[0])
-        raise ValueError(f"{source}: line {lines[i]}: non-finite value (NaN or inf) "
+        raise ValueError(f"{source}: row {lines[i]}: non-finite value (NaN or inf) "
                          f"in x,y,z,r = {centers[i].tolist() + [float(radii[i])]}")
     bad = radii <= 0
     if bad.any():
         i = int(np.flatnonzero(bad)[0])
-        raise ValueError(f"{source}: line {lines[i]}: radius must be > 0, got {radii[i]!r}")
+        raise ValueError(f"{source}: row {lines[i]}: radius must be > 0, got {radii[i]!r}")
     if check_duplicates:
         order = np.lexsort(centers.T[::-1])
         s = centers[order]
@@ -179,8 +179,8 @@ def validate_spheres(centers, radii, lines, source, *, check_duplicates=True):
         if dup.any():
             k = int(np.flatnonzero(dup)[0])
             a, b = sorted((int(order[k]), int(order[k + 1])))
-            raise ValueError(f"{source}: line {lines[b]}: duplicate centre {centers[b].tolist()} "
-                             f"(same as line {lines[a]})")
+            raise ValueError(f"{source}: row {lines[b]}: duplicate centre {centers[b].tolist()} "
+                             f"(same as row {lines[a]})")
 
 
 def check_grains(centers, radii, grain_id, lines, source) -> None:
@@ -211,7 +211,7 @@ def check_grains(centers, radii, grain_id, lines, source) -> None:
         rows = np.flatnonzero(g == gid)
         far = rows[comp[rows] != comp[rows[0]]][0]
         raise ValueError(f"{source}: grain_id {gid} is on spheres that do not overlap into one "
-                         f"body (line {lines[rows[0]]} and line {lines[far]} are apart): two "
+                         f"body (row {lines[rows[0]]} and row {lines[far]} are apart): two "
                          f"grains with one id?")
 
 
