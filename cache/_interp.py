@@ -220,29 +220,52 @@ class GridTable:
             hh = np.append(h, h[-1]) ** 2
             kd *= 0.5 * hh.reshape([-1 if k == d else 1 for k in range(5)])
             self._k.append(np.ascontiguousarray(kd.ravel()))
+        # the per-cell error estimate is built on first use (:attr:`cell_error`): a lookup that
+        # needs only which cells serve (``errors=False``) skips it (0.1-0.2 s on g1)
+        self._estimate = bool(estimate)
+        self._log_q = v
+        self.cell_ok = _cell_all(good)
+        self._cell_error = None
+        self._flat_values = np.ascontiguousarray(self.values.ravel())
+
+    @property
+    def cell_error(self):
+        """Relative error estimate per cell, stored at its lower node (inf: never served)."""
+        if self._cell_error is None:
+            self._build_error()
+        return self._cell_error
+
+    @property
+    def estimated(self):
+        """Cells whose estimate comes from the coarse sub-grid (else the curvature size)."""
+        if self._cell_error is None:
+            self._build_error()
+        return self._estimated
+
+    def _build_error(self):
+        shape = self.spec.shape
         # fallback estimate where the coarse sub-grid cannot judge a cell: the largest size of
         # the curvature correction, sum_d |k_d| / 4 (what plain multilinear would miss)
         k_size = np.zeros(shape)
         for d in range(5):
             if self._k[d] is not None:
                 k_size += np.abs(self._k[d].reshape(shape)) / 4
-        self.estimated = np.zeros(shape, dtype=bool)
-        if estimate:
-            dnode = self._coarse_difference(v)
+        self._estimated = np.zeros(shape, dtype=bool)
+        if self._estimate:
+            dnode = self._coarse_difference(self._log_q)
             # third order when the coarse sub-grid has its curvature terms in every direction
             # (>= 3 nodes); else it is partly multilinear and its error shrinks only as h^2
             cs = self.coarse_spec().shape
             third = self.curvature and all(c >= 3 for c, f in zip(cs, shape) if f > 1)
             order = 3.0 if third else 2.0
-            e_cell = safety * _cell_max(np.where(np.isfinite(dnode), dnode, np.inf)) / 2**order
-            self.estimated = np.isfinite(e_cell)
-            e_cell = np.where(self.estimated, e_cell, k_size) + _cell_max(fe)
+            e_cell = (self.safety * _cell_max(np.where(np.isfinite(dnode), dnode, np.inf))
+                      / 2**order)
+            self._estimated = np.isfinite(e_cell)
+            e_cell = np.where(self._estimated, e_cell, k_size) + _cell_max(self.fe_error)
         else:
-            e_cell = k_size + _cell_max(fe)
-        e_cell[~_cell_all(good)] = np.inf
-        self.cell_error = e_cell
-        self._flat_values = np.ascontiguousarray(self.values.ravel())
-        self._flat_error = np.ascontiguousarray(e_cell.ravel())
+            e_cell = k_size + _cell_max(self.fe_error)
+        e_cell[~self.cell_ok] = np.inf
+        self._cell_error = e_cell
 
     @property
     def coverage(self):
@@ -265,11 +288,13 @@ class GridTable:
         ic[~np.isfinite(ec)] = np.nan
         return np.abs(v.ravel() - ic).reshape(v.shape)
 
-    def __call__(self, x, _log=False, chunk=16384):
+    def __call__(self, x, _log=False, chunk=16384, *, errors=True):
         """Interpolate at points ``x`` (N, 5): returns ``(qstar (N,), rel_error (N,))``.
 
         Points outside the grid box get ``rel_error = inf`` (value from the clamped cell).
         Work is done in chunks of ``chunk`` points so that temporaries stay in cache.
+        ``errors=False``: ``rel_error`` is NaN (not estimated) where the table serves the
+        point and inf where it does not, without building the per-cell estimate.
         """
         x = np.asarray(x, dtype=float)
         n = len(x)
@@ -277,7 +302,7 @@ class GridTable:
         err = np.empty(n)
         for lo in range(0, n, chunk):
             hi = min(lo + chunk, n)
-            v[lo:hi], err[lo:hi] = self._eval(x[lo:hi])
+            v[lo:hi], err[lo:hi] = self._eval(x[lo:hi], errors)
         if _log:
             return v, err
         # only clamped extrapolation outside the grid (rel_error = inf, never served) can
@@ -298,9 +323,9 @@ class GridTable:
         self._f32 = {"views": [vals[o:] for o in offsets], "dims": dims,
                      "k": [None if (k is None or not self.curvature) else k.astype(np.float32)
                            for k in self._k],
-                     "err": self._flat_error.astype(np.float32)}
+                     "ok": self.cell_ok.ravel(), "err": None}
 
-    def _eval(self, x):
+    def _eval(self, x, errors=True):
         self._prepare()
         f = self._f32
         n = len(x)
@@ -341,6 +366,10 @@ class GridTable:
             k = f["k"][d]
             if k is not None:
                 v -= t[d] * (1.0 - t[d]) * k.take(base)
+        if not errors:
+            return v, np.where(f["ok"].take(base) & ~outside, np.nan, np.inf)
+        if f["err"] is None:
+            f["err"] = np.ascontiguousarray(self.cell_error.ravel()).astype(np.float32)
         err = f["err"].take(base).astype(np.float64)
         err[outside] = np.inf
         return v, err
@@ -348,14 +377,19 @@ class GridTable:
 
 def _second_difference(v, a, axis):
     """Second derivative of v along ``axis`` on the non-uniform nodes ``a`` (edges copied)."""
-    v = np.moveaxis(v, axis, 0)
+    def cut(sl):
+        return tuple(sl if k == axis else slice(None) for k in range(v.ndim))
+
+    shape = [-1 if k == axis else 1 for k in range(v.ndim)]
+    hm = (a[1:-1] - a[:-2]).reshape(shape)
+    hp = (a[2:] - a[1:-1]).reshape(shape)
     out = np.empty_like(v)
-    hm = (a[1:-1] - a[:-2]).reshape([-1] + [1] * (v.ndim - 1))
-    hp = (a[2:] - a[1:-1]).reshape([-1] + [1] * (v.ndim - 1))
-    out[1:-1] = 2 * ((v[2:] - v[1:-1]) / hp - (v[1:-1] - v[:-2]) / hm) / (hp + hm)
-    out[0] = out[1]
-    out[-1] = out[-2]
-    return np.moveaxis(out, 0, axis)
+    mid = v[cut(slice(1, -1))]
+    out[cut(slice(1, -1))] = 2 * ((v[cut(slice(2, None))] - mid) / hp
+                                  - (mid - v[cut(slice(None, -2))]) / hm) / (hp + hm)
+    out[cut(0)] = out[cut(1)]
+    out[cut(-1)] = out[cut(-2)]
+    return out
 
 
 def _cell_reduce(a, pair, last=None):
@@ -393,26 +427,33 @@ def _cell_all(mask):
 
 
 def _fill_nan(v, max_sweeps=50):
-    """Replace NaN nodes by the mean of finite axis neighbours, sweep by sweep (keeps lookups finite)."""
+    """Replace NaN nodes by the mean of finite axis neighbours, sweep by sweep (keeps lookups finite).
+
+    Each sweep reads the values left by the previous one (Jacobi order) and touches only the
+    NaN nodes (3 % of g1's): 0.35 s -> 0.01 s on g1, same bits as whole-array sweeps.
+    """
     v = v.copy()
+    flat = v.reshape(-1)
+    strides = [int(np.prod(v.shape[d + 1:])) for d in range(v.ndim)]
     for _ in range(max_sweeps):
-        bad = ~np.isfinite(v)
-        if not bad.any():
+        bad = np.flatnonzero(~np.isfinite(flat))
+        if not bad.size:
             break
-        acc = np.zeros_like(v)
-        cnt = np.zeros_like(v)
+        coord = np.unravel_index(bad, v.shape)
+        acc = np.zeros(bad.size)
+        cnt = np.zeros(bad.size)
         for d in range(v.ndim):
             if v.shape[d] == 1:
                 continue
             for shift in (1, -1):
-                nb = np.roll(v, shift, axis=d)
-                edge = [slice(None)] * v.ndim
-                edge[d] = 0 if shift == 1 else -1
-                nb[tuple(edge)] = np.nan
+                inside = (coord[d] - shift >= 0) & (coord[d] - shift < v.shape[d])
+                nb = np.where(inside, flat[np.where(inside, bad - shift * strides[d], 0)], np.nan)
                 ok = np.isfinite(nb)
                 acc[ok] += nb[ok]
                 cnt[ok] += 1
-        fill = bad & (cnt > 0)
-        v[fill] = acc[fill] / cnt[fill]
+        fill = cnt > 0
+        if not fill.any():
+            break
+        flat[bad[fill]] = acc[fill] / cnt[fill]
     v[~np.isfinite(v)] = 0.0
     return v
