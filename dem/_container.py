@@ -125,7 +125,14 @@ class Container:
 
     @classmethod
     def from_dict(cls, d):
-        return cls(d["kind"], tuple(d["size_m"]), d["fill_height_m"])
+        """The container of a packing's JSON summary; ValueError when an entry is missing or
+        not a number, or the kind is not 'box' or 'cylinder' (checked by the constructor)."""
+        try:
+            return cls(str(d["kind"]).lower(), tuple(float(v) for v in np.atleast_1d(d["size_m"])),
+                       float(d["fill_height_m"]))
+        except (KeyError, TypeError, ValueError) as e:
+            raise ValueError(f"the summary's container {d!r} is not a box or cylinder with size_m and "
+                             f"fill_height_m (m): {e}") from e
 
 
 #: The thesis's bins: Appendix A (rectangular, 0.25 × 0.02 m, filled to 0.25 m) and

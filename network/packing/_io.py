@@ -67,7 +67,7 @@ def _read_csv(path: Path) -> Packing:
     lines = [(i + 1, ln.strip()) for i, ln in enumerate(text)]
     lines = [(i, ln) for i, ln in lines if ln and not ln.startswith("#")]
     if not lines:
-        raise ValueError(f"{src}: empty file (no data line)")
+        raise ValueError(f"{src}: empty file (no data row)")
     head_no, head = lines[0]
     delim = _delimiter(head)
     names = [h.lower() for h in _split(head, delim)]
@@ -84,7 +84,7 @@ def _read_csv(path: Path) -> Packing:
         scale = 0.5 if rname[0] in _DIAMETER_NAMES else 1.0
         body = lines[1:]
         if not body:
-            raise ValueError(f"{src}: no data line after the header")
+            raise ValueError(f"{src}: no data row after the header")
     else:  # no header: x, y, z, r in that order
         cols = [0, 1, 2, 3]
         body = lines
