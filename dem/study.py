@@ -237,7 +237,8 @@ def run_study(args, container, amplitudes) -> int:
     (out / "study.json").write_text(json.dumps(study, indent=1))
     plots = plot_study(study, out)
     _print_table(study)
-    print(f"-> {out / 'study.json'}" + (f", {', '.join(p.name for p in plots)}" if plots else " (no matplotlib: no plots)"))
+    made = f", {', '.join(p.name for p in plots)}" if plots else " (no matplotlib: no plots; pip install '.[plot]')"
+    print(f"-> {out / 'study.json'}{made}")
     return 0
 
 

@@ -23,3 +23,18 @@ def test_bad_input_exits_2(tmp_path, capsys):
     assert code == 2
     assert "box needs 2 size value(s)" in capsys.readouterr().err
     assert not (tmp_path / "b.csv").exists()
+
+
+def test_ctrl_c_exits_1_with_one_line_and_writes_nothing(tmp_path, capsys, monkeypatch):
+    """Ctrl-C during the packing: one ``interrupted:`` line, exit 1, no packing (it is written
+    whole at the end) and no traceback (issue 13)."""
+    def interrupted(*args, **kwargs):
+        raise KeyboardInterrupt
+
+    monkeypatch.setattr(pack, "pack_bed", interrupted)
+    out = tmp_path / "b.csv"
+    code = pack.main(["--scene", "box", "--size", "0.03", "0.03", "--height", "0.03",
+                      "--out", str(out), "--quiet"])
+    err = capsys.readouterr().err.strip().splitlines()
+    assert code == 1 and len(err) == 1 and err[0].startswith("interrupted: "), err
+    assert not list(tmp_path.iterdir())
