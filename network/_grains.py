@@ -19,7 +19,8 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
-__all__ = ["D272Constants", "D272", "GRAIN_ALIASES", "d272_constants", "grains_with_d272"]
+__all__ = ["D272Constants", "D272", "GRAIN_ALIASES", "d272_constants", "grains_with_d272",
+           "BedProperties", "BED"]
 
 
 @dataclass(frozen=True)
@@ -86,3 +87,54 @@ def d272_constants(name: str) -> tuple[float, float]:
         raise ValueError(f"no sourced ASABE D272 constants for {key} (docs/grain-library.md); "
                          f"grains with constants: {', '.join(grains_with_d272())}")
     return float(c.a_pa_s2_m3), float(c.b_s_m)
+
+
+@dataclass(frozen=True)
+class BedProperties:
+    r"""The kernel density and the measured loose-fill bulk porosity the report needs.
+
+    Copies of ``dem.grains`` (network may not import dem; ``tests/test_grain_library.py``
+    checks that the two agree, value and source). ``None``: no source found (see dem.grains).
+    Bulk density of a bed: :math:`\rho_b = \rho_p (1 - \varepsilon)`, kg/m^3.
+    """
+
+    particle_density_kg_m3: float | None
+    particle_density_source: str
+    #: measured loose-fill bulk porosity (low, high)
+    bulk_porosity: tuple[float, float] | None
+    bulk_porosity_source: str
+
+    @property
+    def loose_fill_porosity(self) -> float | None:
+        """The middle of the measured range (the report's default porosity), or None.
+
+        >>> BED["soybean"].loose_fill_porosity
+        0.40985
+        """
+        if self.bulk_porosity is None:
+            return None
+        return round(0.5 * (self.bulk_porosity[0] + self.bulk_porosity[1]), 10)
+
+
+_WANDKAR = "Wandkar, Ukey & Pawar 2012, Determination of physical properties of soybean"
+_W03 = "Moisture-dependent physical properties of wheat, Int. Agrophys. 2003"
+_RAMAJ = "Ramaj, Schock, Karaj & Mueller 2022, Influence of self-compaction"
+_DARFOUR = "Darfour, Ayeh, Odoi, Mills & Odoi 2022, Physical characteristics of maize"
+_SORGHUM = "Effect of moisture content on physical and aerodynamic properties of sorghum"
+_NONE = "not found (dem.grains)"
+
+BED: dict[str, BedProperties] = {
+    "soybean": BedProperties(1285.0, "thesis Table 3.1 (seed/thesis.txt; PFC parameters "
+                             "reported by Liu et al. 2008a; density and porosity from Milani",
+                             (0.4007, 0.419), _WANDKAR + " (40.07-41.9 % over 7.37-15.80 % d.b.)"),
+    "wheat": BedProperties(1240.0, _W03 + " (dry end of 1240-847.2 kg/m^3)", (0.391, 0.413),
+                           _RAMAJ + " (in-bin, 1 h after filling, at 3.4 m and 1.0 m)"),
+    "shelled_corn": BedProperties(1250.0, _DARFOUR, (0.4032, 0.4324), _DARFOUR),
+    "barley": BedProperties(1099.65, "barley varieties Sahra and Valfajr vs moisture 10.12-42.17 "
+                            "% w.b., J. Agric. Sci. Technol. (Gorgan Univ.) (Sahra, 10.12 % w.b.)",
+                            (0.385, 0.4834), "low: Ozturk & Esen 2008, Physical and mechanical "
+                            "properties of barley; high: Sahra, J. Agric. Sci. Technol."),
+    "rough_rice": BedProperties(None, _NONE, None, _NONE),
+    "canola": BedProperties(None, _NONE, None, _NONE),
+    "sorghum": BedProperties(1257.33, _SORGHUM, (0.3515, 0.3675), _SORGHUM),
+}

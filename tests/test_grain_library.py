@@ -114,3 +114,20 @@ def test_d272_soybean_agrees_with_the_empirical_module():
 
     assert (ASABE_SOYBEAN_A, ASABE_SOYBEAN_B) == (D272["soybean"].a_pa_s2_m3,
                                                   D272["soybean"].b_s_m)
+
+
+@pytest.mark.parametrize("name", sorted(GRAINS))
+def test_network_bed_properties_agree_with_dem_grains(name):
+    """network/_grains.py carries the kernel density and loose-fill porosity the report needs
+    (network may not import dem): the same values as dem.grains, read from the same source."""
+    from network._grains import BED
+    b, g = BED[name], GRAINS[name]
+    assert b.particle_density_kg_m3 == g.particle_density_kg_m3.value
+    assert b.bulk_porosity == g.bulk_porosity.value
+    for mine, theirs in ((b.particle_density_source, g.particle_density_kg_m3.source),
+                         (b.bulk_porosity_source, g.bulk_porosity.source)):
+        assert mine.split(" (")[0][:40] in theirs, (name, mine, theirs)
+    if b.bulk_porosity is not None:
+        lo, hi = b.bulk_porosity
+        assert b.loose_fill_porosity == pytest.approx(0.5 * (lo + hi), abs=1e-12)
+    assert set(BED) == set(D272) == set(GRAINS)
