@@ -45,7 +45,7 @@ from .airpaths import (bed_depth, branched_table, face_graph, plot_paths, pore_p
 from .conductance import POLICIES
 from .flow import DEFAULT_DEPTH_M, asabe_d272_gradient, ergun_gradient, solve_network
 from .packing import UNITS, Packing, random_packing
-from .pores import Region, axis_index, tessellate, tie_groups
+from .pores import Region, axis_index, default_region, region_porosity, tessellate, tie_groups
 
 _ALL = ("widest", "narrowest", "maximin", "shortest")
 #: Thesis values (Tables 4.1-4.5) printed beside ours (pressures: over 0.25 m of soybeans).
@@ -348,10 +348,12 @@ def _branched(args, x, r, paths, dup):
 def _table_4_5(args, x, r, branched):
     """Pressure drops over --depth (Pa): measured (thesis, only at its 0.25 m), branched model
     (ours, mean of the MFx3 average-width paths, each drop / its L0 x depth), ASABE D272 and
-    Ergun at the bed's porosity (thesis 4.2.2)."""
+    Ergun (thesis 4.2.2) with the porosity and Sauter diameter that ``network.solve`` uses: the
+    exact porosity of the default interior sample (1.5 mean diameters inside the bed's faces),
+    so both commands print one Ergun value for one bed."""
     depth, velocities = args.depth, args.velocity
-    lo, hi = (x - r[:, None]).min(axis=0), (x + r[:, None]).max(axis=0)
-    porosity = 1.0 - float(np.sum(4.0 / 3.0 * np.pi * r**3) / np.prod(hi - lo))
+    pk = Packing(x, r)
+    porosity, _ = region_porosity(pk, default_region(pk, axis=args.axis), axis_index(args.axis))
     us = [f"{u:g}" for u in velocities]
     out = {}
     if any(_thesis_point(args, u) for u in us):
@@ -360,7 +362,7 @@ def _table_4_5(args, x, r, branched):
                                                for b in branched]) * depth) for u in us}
     out["ASABE D272"] = {f"{u:g}": float(asabe_d272_gradient(u) * depth) for u in velocities}
     out[f"Ergun (porosity {porosity:.3f})"] = {
-        f"{u:g}": float(ergun_gradient(u, porosity=porosity, diameter_m=2 * r.mean(),
+        f"{u:g}": float(ergun_gradient(u, porosity=porosity, diameter_m=pk.sauter_diameter,
                                        viscosity_pa_s=args.viscosity) * depth)
         for u in velocities}
     return out
