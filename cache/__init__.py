@@ -11,7 +11,8 @@ signature(radii, sides)
     (N, 5) scale/permutation-invariant key parameters ``[r1*, r2*, l12*, l13*, l23*]``.
 lookup_qstar(radii, sides, *, db=None, policy='table+fe', rtol=1e-3, workers=1, progress=False)
     :class:`Lookup` of (N,) ``qstar``, ``error_estimate``, ``source`` plus ``stats``.
-    Policies: ``'table-only'``, ``'table+fe'``, ``'fe-only'``, ``'shape-factor'``.
+    Policies: ``'table-only'``, ``'table+fe'``, ``'fe-only'``, ``'shape-factor'``; sources
+    of a row: ``SOURCES``.
 precompute_throats(store, radii, sides, *, rtol, workers, retry_failed, ...)
     Solve and store what a table lacks, one transaction per batch.
 precompute_grid(store, spec, *, rtol, ...)
@@ -38,12 +39,12 @@ meshes or solves itself: it calls ``throats``.
 from ._build import PrecomputeSummary, precompute_grid, precompute_throats
 from ._dask import DaskConnectError, dask_executor
 from ._interp import CALIBRATED_SAFETY, ERROR_SAFETY, GRIDS, GridSpec, GridTable, grid_coordinates
-from ._lookup import (POLICIES, Lookup, default_db_path, export_grid, load_grid_table,
+from ._lookup import (POLICIES, SOURCES, Lookup, default_db_path, export_grid, load_grid_table,
                       lookup_qstar, shipped_grid_path)
 from ._signature import QUANTUM, shape_keys, signature
 from ._store import CacheFileError, ThroatStore, open_store
 
-__all__ = ["signature", "shape_keys", "QUANTUM", "lookup_qstar", "Lookup", "POLICIES",
+__all__ = ["signature", "shape_keys", "QUANTUM", "lookup_qstar", "Lookup", "POLICIES", "SOURCES",
            "default_db_path", "precompute_throats", "precompute_grid", "PrecomputeSummary", "open_store",
            "ThroatStore", "CacheFileError", "GridSpec", "GridTable", "GRIDS",
            "grid_coordinates", "load_grid_table", "export_grid", "shipped_grid_path",

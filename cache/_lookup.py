@@ -34,16 +34,19 @@ import throats
 
 from . import _build
 from ._build import precompute_throats, resolve_solver
-from ._interp import GridSpec, GridTable, grid_coordinates
+from ._interp import GridSpec, GridTable
 from ._signature import as_throats, match_keys, shape_keys, signature
 from ._store import open_store
 
 logger = logging.getLogger(__name__)
 
-__all__ = ["Lookup", "lookup_qstar", "default_db_path", "load_grid_table", "POLICIES",
+__all__ = ["Lookup", "lookup_qstar", "default_db_path", "load_grid_table", "POLICIES", "SOURCES",
            "export_grid", "grid_from_store", "shipped_grid_path"]
 
 POLICIES = ("table-only", "table+fe", "fe-only", "shape-factor")
+#: where a row's Q* came from (:attr:`Lookup.source`), in the order of their internal codes
+SOURCES = ("exact", "interp", "fe", "shape-factor", "closed", "failed")
+EXACT, INTERP, FE, SHAPE_FACTOR, CLOSED, FAILED = range(len(SOURCES))
 _DATA = Path(__file__).resolve().parent / "data"
 
 
@@ -189,16 +192,23 @@ def _shipped_table(name, solver_version):
 
 
 def _quick_valid(r, s):
-    """Cheap row checks of the hot path (finite, positive, strict triangle inequality)."""
-    ok = np.isfinite(r).all(1) & np.isfinite(s).all(1) & (r > 0).all(1) & (s > 0).all(1)
+    """Cheap row checks of the hot path (finite, positive, strict triangle inequality).
+
+    Column by column (a reduction over a length-3 axis costs more than the three columns):
+    ``0 < x < inf`` is False for NaN, inf and non-positive values.
+    """
     l12, l13, l23 = s[:, 0], s[:, 1], s[:, 2]
     with np.errstate(invalid="ignore"):
-        ok &= (l12 < l13 + l23) & (l13 < l12 + l23) & (l23 < l12 + l13)
+        ok = (l12 < l13 + l23) & (l13 < l12 + l23) & (l23 < l12 + l13)
+        for a in (r, s):
+            for c in range(3):
+                ok &= (a[:, c] > 0) & (a[:, c] < np.inf)
     return ok
 
 
 def lookup_qstar(radii, sides, *, db=None, policy="table+fe", rtol=1e-3, workers=1,
-                 progress=False, grid=None, solver=None, solver_version=None, table=None):
+                 progress=False, grid=None, solver=None, solver_version=None, table=None,
+                 estimate=True):
     r"""Q* of N throats from the cache, by the given policy (see module notes).
 
     Parameters
@@ -222,6 +232,10 @@ def lookup_qstar(radii, sides, *, db=None, policy="table+fe", rtol=1e-3, workers
         Injected FE solver (protocol of ``throats.solve_fem``); default ``throats.solve_fem``.
     table : GridTable, optional
         Use this interpolation table instead of loading one (benchmarks, tests).
+    estimate : bool, keyword-only, default True
+        False: interpolated rows of ``'table-only'`` get ``error_estimate`` NaN (not
+        estimated) and the table's per-cell estimate is never built (callers that only use
+        Q*, as the network's conduit sections); the rows served are the same.
 
     Returns
     -------
@@ -242,7 +256,7 @@ def lookup_qstar(radii, sides, *, db=None, policy="table+fe", rtol=1e-3, workers
     n = len(r)
     q = np.full(n, np.nan)
     err = np.full(n, np.nan)
-    src = np.full(n, "failed", dtype="<U12")
+    src = np.full(n, FAILED, dtype=np.int8)
     msg = np.full(n, "", dtype=object)
     stats = {"n": n, "policy": policy, "rtol": rtol, "n_fe": 0}
 
@@ -251,7 +265,7 @@ def lookup_qstar(radii, sides, *, db=None, policy="table+fe", rtol=1e-3, workers
     if policy == "shape-factor":
         sf = throats.shape_factor_qstar
         q[pending] = sf(r[pending], s[pending])
-        src[pending] = "shape-factor"
+        src[pending] = SHAPE_FACTOR
     else:
         if solver is not None or policy != "table-only":
             solver, solver_version = resolve_solver(solver, solver_version)
@@ -267,11 +281,15 @@ def lookup_qstar(radii, sides, *, db=None, policy="table+fe", rtol=1e-3, workers
                 logger.warning("no grid table for solver %s: every row needs exact hits or FE",
                                solver_version)
             else:
-                x = grid_coordinates(r[pending], s[pending])
-                qi, ei = table(x)
-                q[pending], err[pending] = qi, ei
-                src[pending] = "interp"
-                good = (ei <= rtol) if policy == "table+fe" else np.isfinite(ei)
+                errors = estimate or policy == "table+fe"
+                if len(pending) == n:        # every row (the usual case): no gathered copies
+                    q, err = table.at_throats(r, s, errors=errors)
+                else:
+                    q[pending], err[pending] = table.at_throats(r[pending], s[pending],
+                                                                errors=errors)
+                src[pending] = INTERP
+                ei = err[pending]
+                good = (ei <= rtol) if policy == "table+fe" else ~np.isinf(ei)
                 pending = pending[~good]
         # rows the table did not settle: exact hits, then FE or shape factor
         if len(pending):
@@ -282,13 +300,14 @@ def lookup_qstar(radii, sides, *, db=None, policy="table+fe", rtol=1e-3, workers
     if len(bad):
         _, m = throats.validate_throats(r[bad], s[bad])
         msg[bad] = [mm or "invalid throat" for mm in m]
-        q[bad], err[bad], src[bad] = np.nan, np.nan, "failed"
-    for name in ("exact", "interp", "fe", "shape-factor", "closed", "failed"):
-        stats[f"n_{name.replace('-', '_')}"] = int(np.sum(src == name))
+        q[bad], err[bad], src[bad] = np.nan, np.nan, FAILED
+    counts = np.bincount(src, minlength=len(SOURCES))
+    for name, count in zip(SOURCES, counts):
+        stats[f"n_{name.replace('-', '_')}"] = int(count)
     n_valid = max(n - stats["n_failed"], 1)
     stats["hit_rate"] = (stats["n_exact"] + stats["n_interp"]) / n_valid
     stats["seconds"] = time.perf_counter() - t0
-    return Lookup(q, err, src.astype(str), stats, msg)
+    return Lookup(q, err, np.asarray(SOURCES)[src], stats, msg)
 
 
 def _stored_first(r, s, rows, q, err, src, msg, *, db, rtol, solver_version):
@@ -304,7 +323,7 @@ def _stored_first(r, s, rows, q, err, src, msg, *, db, rtol, solver_version):
             return rows
         found = _exact(store, shape_keys(signature(r[rows], s[rows])), rtol, solver_version)
     hit = found["found"]
-    _assign_exact(rows[hit], found, hit, q, err, src, msg, "exact")
+    _assign_exact(rows[hit], found, hit, q, err, src, msg, EXACT)
     return rows[~hit]
 
 
@@ -314,7 +333,7 @@ def _settle(r, s, rows, q, err, src, msg, stats, *, db, policy, rtol, workers, p
     ok, m = throats.validate_throats(r[rows], s[rows])
     bad = rows[~ok]
     msg[bad] = m[~ok]
-    q[bad], err[bad], src[bad] = np.nan, np.nan, "failed"
+    q[bad], err[bad], src[bad] = np.nan, np.nan, FAILED
     rows = rows[ok]
     if not len(rows):
         return
@@ -327,7 +346,7 @@ def _settle(r, s, rows, q, err, src, msg, stats, *, db, policy, rtol, workers, p
     with open_store(path, create=policy != "table-only") as store:
         found = _exact(store, keys, rtol, solver_version)
         hit = found["found"]
-        _assign_exact(rows[hit], found, hit, q, err, src, msg, "exact")
+        _assign_exact(rows[hit], found, hit, q, err, src, msg, EXACT)
         miss, mkeys = rows[~hit], keys[~hit]
         if not len(miss):
             return
@@ -342,9 +361,9 @@ def _settle(r, s, rows, q, err, src, msg, stats, *, db, policy, rtol, workers, p
         stats["fe_seconds"] = stats.get("fe_seconds", 0.0) + summ.seconds
         found = _exact(store, mkeys, rtol, solver_version, statuses=None)
         hit = found["found"]
-        _assign_exact(miss[hit], found, hit, q, err, src, msg, "fe")
+        _assign_exact(miss[hit], found, hit, q, err, src, msg, FE)
         lost = miss[~hit]
-        q[lost], err[lost], src[lost] = np.nan, np.nan, "failed"
+        q[lost], err[lost], src[lost] = np.nan, np.nan, FAILED
         msg[lost] = "no stored result after the FE solve"
 
 
@@ -357,7 +376,7 @@ def _assign_exact(dest, rows, sel, q, err, src, msg, label):
     st = rows["status"][sel]
     q[dest] = np.where(st == "closed", 0.0, rows["qstar"][sel])
     err[dest] = np.where(st == "closed", 0.0, rows["error_estimate"][sel])
-    src[dest] = np.where(st == "closed", "closed", np.where(st == "ok", label, "failed"))
+    src[dest] = np.where(st == "closed", CLOSED, np.where(st == "ok", label, FAILED))
     msg[dest] = np.where(st == "ok", "", rows["message"][sel])
 
 
@@ -366,4 +385,4 @@ def _shape_factor_rows(r, s, rows, q, err, src):
         return
     q[rows] = throats.shape_factor_qstar(r[rows], s[rows])
     err[rows] = np.nan
-    src[rows] = "shape-factor"
+    src[rows] = SHAPE_FACTOR

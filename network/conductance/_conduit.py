@@ -118,6 +118,15 @@ def _section_radii(radii, h):
     return np.sqrt(np.maximum(radii[:, None, :] ** 2 - h[..., None] ** 2, 0.0))
 
 
+def _colmax(a):
+    """Largest entry along the last axis (length 2 or 3): np.max(a, axis=-1), same values,
+    without numpy's slow reduction over a short axis."""
+    out = np.maximum(a[..., 0], a[..., 1])
+    for c in range(2, a.shape[-1]):
+        np.maximum(out, a[..., c], out=out)
+    return out
+
+
 def side_resistance(radii, sides, h_side, y_window, *, n_sections: int = 8,
                     section_q=None):
     r"""Viscosity-free resistance :math:`R_P/\mu` of N conduit halves (unit⁻³).
@@ -166,9 +175,9 @@ def side_resistance(radii, sides, h_side, y_window, *, n_sections: int = 8,
     m = int(n_sections)
     if m < 2:
         raise ValueError(f"n_sections must be >= 2, got {n_sections!r}")
-    rmax = radii.max(axis=1)
+    rmax = _colmax(radii)
     H = np.minimum(np.maximum(hs, 0.0), rmax[:, None])           # (N, k)
-    Hmax = H.max(axis=1)
+    Hmax = _colmax(H) if H.shape[1] > 1 else H[:, 0]
     # one set of nodes serves every side of a throat (the sections depend on h only),
     # uniform in theta with h = rmax sin(theta): the disks shrink smoothly,
     # rho_k = sqrt(r_k^2 - h^2), and the nodes gather where the sphere walls turn steep
@@ -180,19 +189,20 @@ def side_resistance(radii, sides, h_side, y_window, *, n_sections: int = 8,
     dhdth = rmax[:, None] * np.cos(theta)
     rho = _section_radii(radii, h)                               # (N, m+1, 3)
     flat_rho = rho.reshape(-1, 3)
-    flat_sides = np.repeat(sides, m + 1, axis=0)
     if section_q is None:
-        q = section_estimate(flat_rho, flat_sides).reshape(n, m + 1)
+        q = section_estimate(flat_rho, np.repeat(sides, m + 1, axis=0)).reshape(n, m + 1)
         with np.errstate(divide="ignore", invalid="ignore"):
             y = np.where(np.isinf(q), 0.0, y0[:, None] * q[:, :1] / q)
         y[:, 0] = y0
     else:
         q = np.full(n * (m + 1), np.inf)
         # the window (node 0) is y_window already; sections with no disk left have no wall
-        live = (flat_rho.max(axis=1) > 0) & (np.tile(np.arange(m + 1), n) > 0)
-        live &= np.repeat(Hmax > 0, m + 1)
-        if live.any():
-            q[live] = section_q(flat_rho[live], flat_sides[live])
+        live = _colmax(rho) > 0                                  # (N, m+1)
+        live[:, 0] = False
+        live &= (Hmax > 0)[:, None]
+        idx = np.flatnonzero(live)
+        if idx.size:
+            q[idx] = section_q(flat_rho[idx], sides[idx // (m + 1)])
         q = q.reshape(n, m + 1)
         with np.errstate(divide="ignore", invalid="ignore"):
             y = np.where(np.isinf(q), 0.0, 1.0 / q)
@@ -353,7 +363,8 @@ def conduit_conductance(tessellation, throats_idx=None, *, viscosity_pa_s: float
         q_win, gg, st = _conduit_block(radii[blk], sides[blk], h[blk], mu, section_stats,
                                        throat_qstar, sections=sections, n_sections=n_sections,
                                        qkw=dict(policy=policy, rtol=rtol, db=db,
-                                                workers=workers, progress=progress),
+                                                workers=workers, progress=progress,
+                                                estimate=False),
                                        srtol=srtol)
         qstar[blk] = q_win
         g[blk] = gg
@@ -395,7 +406,7 @@ def _conduit_block(r_n, s_n, h_n, mu, section_stats, throat_qstar, *, sections, 
     """Window Q*, conductance (NaN: zero length) and window lookup stats of one block."""
     qres = throat_qstar(r_n, s_n, **qkw)
     q_win = np.asarray(qres.qstar, dtype=float)
-    rbar = r_n.mean(axis=1)
+    rbar = (r_n[:, 0] + r_n[:, 1] + r_n[:, 2]) / 3.0       # r_n.mean(axis=1), same bits
     with np.errstate(divide="ignore"):
         y0 = np.where(q_win > 0, 1.0 / (q_win * rbar**4), np.inf)
     section_q = None
@@ -404,20 +415,21 @@ def _conduit_block(r_n, s_n, h_n, mu, section_stats, throat_qstar, *, sections, 
             out = np.full(rho.shape[0], np.inf)
             # a vanished disk: keep a small one (2e-2 of the shortest side) so the section
             # is still a valid throat (a pinpoint wall, nearly free flow)
-            rr = np.maximum(rho, 2e-2 * s.min(axis=1, keepdims=True))
-            live = rho.max(axis=1) > 0
-            res = throat_qstar(rr[live], s[live], **dict(qkw, rtol=srtol))
-            rb = rr[live].mean(axis=1)
+            smin = np.minimum(np.minimum(s[:, 0], s[:, 1]), s[:, 2])
+            rr = np.maximum(rho, 2e-2 * smin[:, None])
+            live = _colmax(rho) > 0
+            if not live.all():
+                rr, s = rr[live], s[live]
+            res = throat_qstar(rr, s, **dict(qkw, rtol=srtol))
+            rb = (rr[:, 0] + rr[:, 1] + rr[:, 2]) / 3.0
             qq = np.asarray(res.qstar, dtype=float) * rb**4
-            src = np.asarray(res.source, dtype=str)
-            section_stats["n_sections"] += int(src.size)
-            for kind, count in zip(*np.unique(src, return_counts=True)):
-                section_stats["sources"][str(kind)] = (
-                    section_stats["sources"].get(str(kind), 0) + int(count))
-            if qkw["policy"] != "shape-factor":
+            section_stats["n_sections"] += int(qq.size)
+            for kind, count in res.stats.get("sources", {}).items():
+                section_stats["sources"][kind] = section_stats["sources"].get(kind, 0) + count
+            if qkw["policy"] != "shape-factor" and "shape-factor" in res.stats.get("sources", {}):
                 # outside the table the cache falls back to the shape factor, which is
                 # 2-10 times off for these open sections: continue by ratios instead
-                qq = np.where(src == "shape-factor", np.nan, qq)
+                qq = np.where(np.asarray(res.source) == "shape-factor", np.nan, qq)
             out[live] = qq
             return out
     R = side_resistance(r_n, s_n, h_n, y0, n_sections=n_sections, section_q=section_q)

@@ -16,7 +16,7 @@ import time
 import numpy as np
 
 import throats
-from cache import POLICIES, lookup_qstar
+from cache import POLICIES, SOURCES, lookup_qstar
 
 __all__ = ["POLICIES", "QstarResult", "check_policy", "throat_qstar", "qstar_from_function"]
 
@@ -48,7 +48,7 @@ def check_policy(policy: str) -> str:
 
 def throat_qstar(radii, sides, *, policy: str = "table-only", rtol: float = 1e-3, db=None,
                  workers: int = 1, progress: bool = False,
-                 on_failed: str = "shape-factor") -> QstarResult:
+                 on_failed: str = "shape-factor", estimate: bool = True) -> QstarResult:
     """Dimensionless flow rate Q* (r̄ units) of N throats under a policy.
 
     Parameters
@@ -68,6 +68,9 @@ def throat_qstar(radii, sides, *, policy: str = "table-only", rtol: float = 1e-3
         What to do with throats the policy could not answer (FE failure, ``'failed'`` source):
         use their shape-factor estimate (default; counted in ``stats`` and logged as a
         warning), or raise.
+    estimate : bool
+        False: no error estimate for interpolated rows of 'table-only' (NaN; the table's
+        per-cell estimate is not built), for callers that use Q* only (default True).
 
     Returns
     -------
@@ -91,15 +94,20 @@ def throat_qstar(radii, sides, *, policy: str = "table-only", rtol: float = 1e-3
         return QstarResult(np.zeros(0), np.zeros(0, dtype="<U12"), np.zeros(0),
                            {"policy": policy, "backend": "none", "seconds": 0.0})
     res = lookup_qstar(radii, sides, db=db, policy=policy, rtol=rtol, workers=workers,
-                       progress=progress)
+                       progress=progress, estimate=estimate)
     q = np.asarray(res.qstar, dtype=float)
-    src = np.asarray(res.source).astype(str)
+    src = np.asarray(res.source, dtype=str)
     err = np.asarray(res.error_estimate, dtype=float)
     stats = dict(res.stats or {})
     backend = "cache.lookup_qstar"
+    # rows per source from the lookup's counts (sorting N strings cost 0.1 s per 1e6 rows)
+    sources = {k: stats.get(f"n_{k.replace('-', '_')}", 0) for k in SOURCES}
     bad = ~np.isfinite(q) | (q < 0)
     n_fallback = 0
     if bad.any() and on_failed == "shape-factor":
+        for k, c in zip(*np.unique(src[bad], return_counts=True)):
+            sources[str(k)] -= int(c)
+        sources["shape-factor-fallback"] = int(bad.sum())
         q = q.copy()
         src = src.astype("<U24")
         q[bad] = np.asarray(throats.shape_factor_qstar(radii[bad], sides[bad]), dtype=float)
@@ -115,11 +123,10 @@ def throat_qstar(radii, sides, *, policy: str = "table-only", rtol: float = 1e-3
         raise RuntimeError(f"{int(bad.sum())} of {n} throats have no valid Q* (first: radii "
                            f"{radii[k].tolist()}, sides {sides[k].tolist()}, source {src[k]!r})")
     seconds = time.perf_counter() - t0
-    kinds, counts = np.unique(src, return_counts=True)
     stats.update({"policy": policy, "backend": backend, "seconds": seconds, "rtol": rtol,
                   "n_shape_factor_fallback": n_fallback,
                   "n_throats": int(n),
-                  "sources": {str(k): int(c) for k, c in zip(kinds, counts)}})
+                  "sources": {k: int(c) for k, c in sorted(sources.items()) if c > 0}})
     log.info("Q* of %d throats by %s (%s) in %.2f s: %s", n, policy, backend, seconds,
              stats["sources"])
     return QstarResult(q, src, err, stats)
@@ -133,4 +140,5 @@ def qstar_from_function(qstar_fn, radii, sides) -> QstarResult:
     """
     q = np.asarray(qstar_fn(np.asarray(radii, float), np.asarray(sides, float)), dtype=float)
     return QstarResult(q, np.full(q.size, "qstar_fn"), np.full(q.size, np.nan),
-                       {"policy": "qstar_fn", "n_throats": int(q.size)})
+                       {"policy": "qstar_fn", "n_throats": int(q.size),
+                        "sources": {"qstar_fn": int(q.size)} if q.size else {}})
