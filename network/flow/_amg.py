@@ -41,7 +41,8 @@ class SolveInfo:
     Attributes: ``converged`` (bool), ``iterations`` (int), ``residual`` (final relative residual
     ‖b − Ax‖/‖b‖ of the unscaled system), ``residuals`` (history of the preconditioned CG,
     relative), ``setup_s`` and ``solve_s`` (s; ``setup_s`` is 0 when the hierarchy was reused),
-    ``method`` (str).
+    ``method`` (str); ``amg``: the :class:`AMGSolver` that solved it (None for other solvers),
+    for a caller that solves a nearby system next (the Newton steps of an inertial solve).
     """
 
     converged: bool
@@ -52,6 +53,7 @@ class SolveInfo:
     solve_s: float
     method: str
     assemble_s: float = 0.0
+    amg: "AMGSolver | None" = dataclasses.field(default=None, repr=False, compare=False)
 
 
 class AMGSolver:
@@ -161,7 +163,7 @@ class AMGSolver:
         res = float(np.linalg.norm(b - self.A @ x) / bnorm)
         method = "pyamg-sa-pcg" if self.strength == "symmetric" else "pyamg-sa(evolution)-pcg"
         info = SolveInfo(converged=converged, iterations=len(hist), residual=res,
-                         residuals=hist, setup_s=setup, solve_s=solve_t, method=method)
+                         residuals=hist, setup_s=setup, solve_s=solve_t, method=method, amg=self)
         if not converged:
             log.warning("CG did not converge after %d iterations, residual %.3g",
                         len(hist), hist[-1] if hist else float("nan"))

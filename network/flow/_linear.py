@@ -138,7 +138,8 @@ def apply_pressure_bc(A, b, pores, values):
 
 
 def solve_pressure(A, b, *, tol: float = 1e-10, maxiter: int = 500,
-                   solver: Callable | None = None) -> tuple[np.ndarray, SolveInfo]:
+                   solver: Callable | None = None,
+                   smoother: str = "symmetric") -> tuple[np.ndarray, SolveInfo]:
     r"""Solve the condensed SPD system with AMG-preconditioned CG (or a given solver).
 
     Parameters
@@ -153,12 +154,15 @@ def solve_pressure(A, b, *, tol: float = 1e-10, maxiter: int = 500,
         CG iteration limit (default 500).
     solver : callable, optional
         ``solver(A, b) -> x`` used instead of pyamg, e.g. ``scipy.sparse.linalg.spsolve``.
+    smoother : {'symmetric', 'forward-backward'}, optional
+        Gauss-Seidel sweeps of the V-cycle (:class:`AMGSolver`; default 'symmetric').
 
     Returns
     -------
     x : (n,) ndarray
     info : SolveInfo
-        Non-convergence is reported here and logged as a warning, never raised.
+        Non-convergence is reported here and logged as a warning, never raised; ``info.amg``
+        holds the hierarchy for reuse.
 
     Notes
     -----
@@ -192,7 +196,7 @@ def solve_pressure(A, b, *, tol: float = 1e-10, maxiter: int = 500,
                             getattr(solver, "__name__", "custom"))
     if bnorm == 0:
         return np.zeros(n), SolveInfo(True, 0, 0.0, [], 0.0, 0.0, "zero rhs")
-    return AMGSolver(A).solve(b, tol=tol, maxiter=maxiter)
+    return AMGSolver(A, smoother=smoother).solve(b, tol=tol, maxiter=maxiter)
 
 
 def boundary_flows(throat_conns, g, p, inlet, outlet):
@@ -243,8 +247,12 @@ def verify_solution(throat_conns, g, p, inlet, outlet, *, rtol: float = 1e-8):
 
 def solve_fixed_pressure(n_pores, throat_conns, g, inlet, outlet, *, p_in: float = 1.0,
                          p_out: float = 0.0, tol: float = 1e-10, maxiter: int = 500,
-                         solver: Callable | None = None, check_rtol: float = 1e-8):
+                         solver: Callable | None = None, check_rtol: float = 1e-8,
+                         smoother: str = "symmetric"):
     """Assemble, fix inlet/outlet pressures, solve and verify (one call for the pipeline).
+
+    ``smoother`` as :func:`solve_pressure`; the returned ``info.amg`` is the hierarchy of the
+    condensed matrix (free pores in ascending order), reusable by :func:`solve_inertial`.
 
     Returns
     -------
@@ -265,11 +273,13 @@ def solve_fixed_pressure(n_pores, throat_conns, g, inlet, outlet, *, p_in: float
     vals = np.concatenate([np.full(inlet.size, p_in), np.full(outlet.size, p_out)])
     A_ii, b_i, free, p = apply_pressure_bc(A, np.zeros(n_pores), pores, vals)
     t_asm = time.perf_counter() - t0
-    x, info = solve_pressure(A_ii, b_i, tol=tol, maxiter=maxiter, solver=solver)
+    x, info = solve_pressure(A_ii, b_i, tol=tol, maxiter=maxiter, solver=solver,
+                             smoother=smoother)
     p[free] = x
     check = verify_solution(throat_conns, g, p, inlet, outlet, rtol=check_rtol)
     if not check["ok"] and solver is None:
-        x, info2 = solve_pressure(A_ii, b_i, tol=tol * 1e-2, maxiter=maxiter * 2)
+        x, info2 = solve_pressure(A_ii, b_i, tol=tol * 1e-2, maxiter=maxiter * 2,
+                                  smoother=smoother)
         p[free] = x
         info = dataclasses.replace(info2, iterations=info.iterations + info2.iterations,
                                    setup_s=info.setup_s + info2.setup_s,
