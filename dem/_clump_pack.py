@@ -3,10 +3,19 @@ r"""Packing multi-sphere grains (issue 15 items 1 and 3) with :class:`dem.clumps
 Procedure (the 'sediment' idea of :mod:`dem._procedures` for grains): N grains from the target
 porosity, :math:`N = \lfloor(1-φ)V/V_g\rfloor`; their bounding spheres placed by random
 sequential addition in the whole box under a lid at (1 + ``lid_headroom``) × the fill height, at
-scale 1/m₀, each with a random orientation (uniform on SO(3)); the whole templates grow to scale 1
-without friction, settle frictionless, then the material's friction is restored, the lid removed
-and the bed settled to ``tol`` (or ``max_steps``). Porosity: the union of all spheres, by QMC in
-an interior box (walls and surface one grain length away), with its standard error.
+scale 1/m₀ (m₀ = ``initial_multiplier``, default the larger of 1.4 and the scale at which the
+bounding spheres fill 20 % of that box: elongated grains' bounding spheres are 5 × their
+volume), each with a random orientation (uniform on SO(3)); the whole templates grow to scale 1
+and settle with the grain-grain friction ``deposition_friction`` (walls frictionless; 0, the
+default, gives the densest bed, friction while the grains grow and fall loosens it: the
+procedure's porosity lever, :func:`pack_grains_to_porosity`), then the material's friction is
+restored, the lid removed and the bed settled to ``tol`` (or ``max_steps``).
+
+Porosity: the union of all spheres by QMC (:func:`union_porosity_in_box`), with its standard
+error, in two boxes: ``porosity_interior_union`` keeps one grain length from the walls and the
+surface; ``porosity_network_region`` is the box ``network`` samples by default (the spheres'
+bounding box shrunk by 1.5 volume-equivalent grain diameters on every side,
+``network.pores.default_region``), the one :func:`pack_grains_to_porosity` aims at.
 
 Output: :func:`write_grain_packing` writes ``x,y,z,r,grain_id`` (one row per sphere, what
 ``network`` reads), ``<stem>.grains.csv`` (one row per grain: id, centre, quaternion w,x,y,z,
@@ -31,7 +40,29 @@ from ._material import SOYBEAN
 from ._rigid import random_quaternions
 from .clumps import ClumpSimulation
 
-__all__ = ["pack_grains", "write_grain_packing", "union_porosity_in_box"]
+__all__ = ["pack_grains", "pack_grains_to_porosity", "procedure_lever", "write_grain_packing",
+           "union_porosity_in_box", "network_region", "DEPOSITION_FRICTION_RANGE"]
+
+#: deposition friction searched by :func:`pack_grains_to_porosity`: frictionless (densest) to 1.0
+DEPOSITION_FRICTION_RANGE = (0.0, 1.0)
+
+#: margin of network's default sample region, in volume-equivalent grain diameters
+NETWORK_MARGIN_DIAMETERS = 1.5
+
+
+def network_region(centers, radii, grain_volume_m3):
+    r"""The box ``network`` samples by default: the spheres' bounding box, :math:`[\min(x-r),
+    \max(x+r)]` per axis, shrunk by 1.5 d_v on every side, :math:`d_v = (6V_g/\pi)^{1/3}` (m).
+
+    >>> lo, hi = network_region(np.array([[0.0, 0, 0], [0.1, 0.1, 0.1]]), np.array([0.01, 0.01]),
+    ...                         np.pi / 6 * 0.01**3)
+    >>> lo.round(4).tolist(), hi.round(4).tolist()
+    ([0.005, 0.005, 0.005], [0.095, 0.095, 0.095])
+    """
+    m = NETWORK_MARGIN_DIAMETERS * (6.0 * grain_volume_m3 / np.pi) ** (1 / 3)
+    lo = (centers - radii[:, None]).min(axis=0) + m
+    hi = (centers + radii[:, None]).max(axis=0) - m
+    return lo, hi
 
 
 def union_porosity_in_box(centers, radii, lo, hi, *, log2_points=14, replicates=4, seed=7):
@@ -49,26 +80,34 @@ def union_porosity_in_box(centers, radii, lo, hi, *, log2_points=14, replicates=
 
 
 def pack_grains(container, template, *, material=SOYBEAN, porosity=0.408, n_grains=None, rng=None,
-                initial_multiplier=1.4, mass_scale=100.0, lid_headroom=0.3, grow_steps=3000, sediment_steps=3000,
-                tol=2e-3, max_steps=40000, check_every=200, progress=None):
+                initial_multiplier=None, deposition_friction=0.0, mass_scale=100.0, lid_headroom=0.3,
+                grow_steps=3000, sediment_steps=3000, tol=2e-3, max_steps=40000, check_every=200,
+                progress=None):
     """Settled packing of grains of one template in ``container`` (procedure: module notes).
 
+    ``deposition_friction`` is the grain-grain friction coefficient while the grains grow and
+    fall (>= 0; walls frictionless then); the material's friction holds afterwards.
     Returns (sphere centres (N, 3), radii (N,), grain_id (N,), grain table dict, summary dict).
     """
+    if not (np.isfinite(deposition_friction) and deposition_friction >= 0):
+        raise ValueError(f"deposition friction must be finite and >= 0, got {deposition_friction!r}")
     t0 = time.perf_counter()
     rng = np.random.default_rng(rng)
     n = int((1 - porosity) * container.volume_m3 / template.volume_m3) if n_grains is None else int(n_grains)
     if n < 1:
         raise ValueError(f"no grain of {template.volume_m3:.3g} m^3 fits the container")
     lid = container.fill_height_m * (1 + lid_headroom)
-    rb = template.bounding_radius_m / initial_multiplier
     gen_box = replace(container, fill_height_m=lid)
+    if initial_multiplier is None:
+        v_bound = n * 4 / 3 * np.pi * template.bounding_radius_m**3
+        initial_multiplier = max(1.4, float((v_bound / (0.2 * gen_box.volume_m3)) ** (1 / 3)))
+    rb = template.bounding_radius_m / initial_multiplier
     x, _ = generate_spheres(gen_box, n, rb, rb, rng)
     q = random_quaternions(n, rng)
     s0 = np.full(n, 1 / initial_multiplier)
-    frictionless = replace(material, friction=0.0, wall_friction=0.0)
+    deposition = replace(material, friction=float(deposition_friction), wall_friction=0.0)
     sim = ClumpSimulation([template], np.zeros(n, int), x, q, s0, container.walls(lid=True, lid_height_m=lid),
-                          frictionless, mass_scale=mass_scale)
+                          deposition, mass_scale=mass_scale)
     stages = {"grow": sim.run(max_steps=grow_steps, grow_from=s0, grow_to=np.ones(n), check_every=check_every,
                               callback=progress)}
     stages["sediment"] = sim.run(max_steps=sediment_steps, check_every=check_every, callback=progress)
@@ -86,18 +125,107 @@ def pack_grains(container, template, *, material=SOYBEAN, porosity=0.408, n_grai
         h = container.size_m[0] / 2 / np.sqrt(2) - margin
         lo, hi = np.array([-h, -h, margin]), np.array([h, h, top - margin])
     phi, phi_err = (union_porosity_in_box(xs, r, lo, hi) if np.all(hi > lo) else (float("nan"), float("nan")))
+    net_lo, net_hi = network_region(xs, r, template.volume_m3)
+    phi_net, phi_net_err = (union_porosity_in_box(xs, r, net_lo, net_hi) if np.all(net_hi > net_lo)
+                            else (float("nan"), float("nan")))
     wall = time.perf_counter() - t0
     steps = sum(s["steps"] for s in stages.values())
     summary = {"n_grains": n, "n_spheres": len(r), "template": template.name, "template_source": template.source,
                "spheres_per_grain": template.n, "grain_volume_m3": template.volume_m3,
                "porosity_interior_union": phi, "porosity_interior_error": phi_err,
-               "interior_box_m": [lo.tolist(), hi.tolist()], "bed_top_m": top, "stages": stages,
+               "interior_box_m": [lo.tolist(), hi.tolist()], "porosity_network_region": phi_net,
+               "porosity_network_region_error": phi_net_err,
+               "network_region_m": [net_lo.tolist(), net_hi.tolist()],
+               "deposition_friction": float(deposition_friction),
+               "initial_multiplier": float(initial_multiplier), "bed_top_m": top, "stages": stages,
                "steps": steps, "dt_s": sim.dt, "mass_scale": mass_scale, "wall_time_s": wall,
                "material": {k: getattr(material, k) for k in material.__dataclass_fields__},
                "engine": "dem.clumps (numpy; separate from the compiled sphere step)"}
     grains = {"centers": sim.X.copy(), "quaternions": sim.q.copy(), "volume_m3": sim.volume_m3.copy(),
               "template": [template.name] * n}
     return xs, r, sim.gid.copy(), grains, summary
+
+
+def procedure_lever(lam, *, headroom=0.3, friction_max=DEPOSITION_FRICTION_RANGE[1]):
+    r"""(lid_headroom, deposition_friction) of the procedure lever λ in [-1, 1].
+
+    λ in [-1, 0]: frictionless growth under a lid at (1 + 0.3(1 + λ)) × the fill height: at
+    λ = -1 the grains grow in the closed box of the requested global porosity (thesis Appendix A
+    style, the densest); λ in [0, 1]: free fall from 1.3 × the fill height with deposition
+    friction λ μ_max (looser as λ grows).
+
+    >>> procedure_lever(-1.0), procedure_lever(-0.5), procedure_lever(0.5)
+    ((0.0, 0.0), (0.15, 0.0), (0.3, 0.5))
+    """
+    lam = float(np.clip(lam, -1.0, 1.0))
+    if lam < 0:
+        return round(headroom * (1 + lam), 12), 0.0
+    return headroom, round(lam * friction_max, 12)
+
+
+def pack_grains_to_porosity(container, template, *, porosity, porosity_tol=0.005, max_packings=6,
+                            **kwargs):
+    r"""A packing whose porosity in network's region (``porosity_network_region``) is within
+    ``porosity_tol`` of ``porosity``, reached by the packing procedure's lever λ (:func:`procedure_lever`).
+
+    The two ends λ = -1 and +1 are packed first (same seed, same grain count
+    :math:`N = \lfloor(1-φ)V/V_g\rfloor` from the requested φ): they bound the porosities this
+    procedure reaches. A request more than ``porosity_tol`` outside them is a ValueError naming the
+    reachable range. Inside, regula falsi on φ(λ) (monotone up to the packing noise) packs until
+    a bed lands within ``porosity_tol`` or ``max_packings`` beds are spent (then RuntimeError with the
+    closest). Returns what :func:`pack_grains` returns; the summary gains ``porosity_search``:
+    target, tol, reachable range, every (λ, φ) tried.
+    """
+    if not (np.isfinite(porosity) and 0 < porosity < 1):
+        raise ValueError(f"porosity must be in (0, 1), got {porosity!r}")
+    tol = porosity_tol
+    if not (np.isfinite(tol) and tol > 0):
+        raise ValueError(f"porosity tolerance must be > 0, got {tol!r}")
+    tried, best = [], None
+
+    def pack(lam):
+        head, mu = procedure_lever(lam)
+        out = pack_grains(container, template, porosity=porosity, deposition_friction=mu,
+                          lid_headroom=head, **kwargs)
+        e = out[4]["porosity_network_region"]
+        tried.append({"lever": float(lam), "lid_headroom": head, "deposition_friction": mu,
+                      "porosity": e, "porosity_error": out[4]["porosity_network_region_error"],
+                      "wall_time_s": out[4]["wall_time_s"]})
+        out[4]["procedure_lever"] = float(lam)
+        return out, e
+
+    (lo, e_lo), (hi, e_hi) = pack(-1.0), pack(1.0)
+    reach = (min(e_lo, e_hi), max(e_lo, e_hi))
+    if not (reach[0] - tol <= porosity <= reach[1] + tol):
+        raise ValueError(f"porosity {porosity:g} is outside what this procedure reaches for "
+                         f"{template.name} in this container: {reach[0]:.4f}-{reach[1]:.4f} "
+                         "(lever -1: closed-box growth, +1: deposition friction 1; network's "
+                         "sample region)")
+    a, b = (-1.0, e_lo), (1.0, e_hi)
+    best = min((lo, hi), key=lambda o: abs(o[4]["porosity_network_region"] - porosity))
+    while abs(best[4]["porosity_network_region"] - porosity) > tol and len(tried) < max_packings:
+        if b[1] == a[1]:
+            break
+        lam = a[0] + (porosity - a[1]) * (b[0] - a[0]) / (b[1] - a[1])
+        w = 0.05 * abs(b[0] - a[0])
+        lam = float(np.clip(lam, min(a[0], b[0]) + w, max(a[0], b[0]) - w))
+        out, e = pack(lam)
+        if abs(e - porosity) < abs(best[4]["porosity_network_region"] - porosity):
+            best = out
+        if (e - porosity) * (a[1] - porosity) > 0:
+            a = (lam, e)
+        else:
+            b = (lam, e)
+    best[4]["porosity_search"] = {
+        "target": float(porosity), "tol": float(tol), "reachable": list(reach), "tried": tried,
+        "lever": "lambda in [-1, 0]: lid headroom 0.3 (1 + lambda), frictionless growth; "
+                 "[0, 1]: deposition friction lambda (porosity in network's sample region)"}
+    got = best[4]["porosity_network_region"]
+    if abs(got - porosity) > tol:
+        steps = [(round(t["lever"], 3), round(t["porosity"], 4)) for t in tried]
+        raise RuntimeError(f"no packing within {tol:g} of porosity {porosity:g} after "
+                           f"{len(tried)} packings (closest {got:.4f}; lever, porosity: {steps})")
+    return best
 
 
 def write_grain_packing(path, centers, radii, grain_id, grains, summary=None):

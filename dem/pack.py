@@ -6,6 +6,7 @@
     python -m dem.pack --scene box --size 0.1 0.05 --height 0.1 --out box.csv
     python -m dem.pack --scene cylinder --size 0.08 --height 0.1 --out cyl_small.csv
     python -m dem.pack --scene box --grain soybean --out bed.csv     # multi-sphere grains
+    python -m dem.pack --scene box --grain wheat --porosity 0.402 --out bed.csv   # search, 3-6 packings
     python -m dem.pack --scene box --grain my_kernel.csv --template-units mm --out bed.csv
 
 With ``--grain`` (a library name or a template CSV x,y,z,r) the grains are rigid multi-sphere
@@ -29,7 +30,7 @@ from ._cli import EXIT_FAILED, progress_printer, resolve_container, run_main
 from ._container import SCENE_DEFAULTS, SCENES, default_measure_spheres
 from ._material import Material
 from ._io import summary_path, write_packing
-from ._clump_pack import grains_path, pack_grains, write_grain_packing
+from ._clump_pack import grains_path, pack_grains, pack_grains_to_porosity, write_grain_packing
 from ._procedures import PROCEDURES, pack_bed
 from .grains import grain
 from .templates import resolve_template
@@ -43,7 +44,15 @@ def _parser():
     p.add_argument("--seed", type=int, default=1, help="random seed of the insertion (same seed, same packing; default 1)")
     p.add_argument("--size", type=float, nargs="+", help="box: length_x width_y; cylinder: diameter (m)")
     p.add_argument("--height", type=float, help="fill height (m) for box/cylinder")
-    p.add_argument("--porosity", type=float, default=0.408, help="target porosity (Table 3.1: 0.408)")
+    p.add_argument("--porosity", type=float, default=None,
+                   help="target porosity (spheres: default 0.408, Table 3.1). With --grain: reached within "
+                        "--porosity-tol in network's sample region by searching the procedure's lever (closed-box "
+                        "growth .. deposition friction, 3-6 packings), or exit 2 with the reachable range; without it one packing at "
+                        "--deposition-friction, grain count from the grain's measured loose-fill porosity")
+    p.add_argument("--porosity-tol", type=float, default=0.005, help="--grain --porosity: tolerance (default 0.005)")
+    p.add_argument("--deposition-friction", type=float, default=None,
+                   help="--grain: grain-grain friction while the grains grow and fall (default 0: the densest "
+                        "bed; friction then loosens it); the material's friction holds afterwards")
     p.add_argument("--n-particles", type=int, help="default: thesis Eq. 3.10")
     p.add_argument("--mass-scale", type=float, default=100.0, help="density scaling during packing (1 = none)")
     p.add_argument("--packing-friction", type=float, default=None,
@@ -115,17 +124,44 @@ def _pack_grains(args) -> int:
     container = resolve_container(args.scene, size_m=size, height_m=height)
     material, used = _grain_material(args, template.name)
     pr = progress_printer(quiet=args.quiet)
-    xs, r, gid, grains, s = pack_grains(container, template, material=material, porosity=args.porosity,
-                                        n_grains=args.n_grains, rng=args.seed, mass_scale=args.mass_scale,
-                                        tol=args.tol, max_steps=min(args.max_steps, 60000),
-                                        progress=lambda sim, f: pr("grains", _Progress(sim), None))
+    kw = dict(material=material, n_grains=args.n_grains, rng=args.seed, mass_scale=args.mass_scale,
+              tol=args.tol, max_steps=min(args.max_steps, 60000),
+              progress=lambda sim, f: pr("grains", _Progress(sim), None))
+    if args.porosity is not None and args.deposition_friction is None:
+        try:
+            xs, r, gid, grains, s = pack_grains_to_porosity(container, template, porosity=args.porosity,
+                                                            porosity_tol=args.porosity_tol, **kw)
+        except RuntimeError as e:
+            print(f"error: {e}", file=sys.stderr)
+            return EXIT_FAILED
+    else:
+        xs, r, gid, grains, s = pack_grains(container, template, porosity=_grain_porosity(args, template.name),
+                                            deposition_friction=args.deposition_friction or 0.0, **kw)
     s.update(scene=args.scene, seed=args.seed, container=container.to_dict(), material_from_library=used)
     write_grain_packing(args.out, xs, r, gid, grains, s)
     print(f"{s['n_grains']} grains of {template.n} spheres ({s['n_spheres']} spheres) -> {args.out} "
           f"(+ {grains_path(args.out).name}, {summary_path(args.out).name})")
-    print(f"porosity (union of spheres, interior box): {s['porosity_interior_union']:.4f} "
-          f"+- {s['porosity_interior_error']:.4f}; {s['steps']} steps, wall {s['wall_time_s']:.1f} s")
+    print(f"porosity (union of spheres): network's sample region {s['porosity_network_region']:.4f} +- "
+          f"{s['porosity_network_region_error']:.4f}, interior box {s['porosity_interior_union']:.4f} "
+          f"+- {s['porosity_interior_error']:.4f}; deposition friction {s['deposition_friction']:.3f}; "
+          f"{s['steps']} steps, wall {s['wall_time_s']:.1f} s")
+    if "porosity_search" in s:
+        ps = s["porosity_search"]
+        print(f"porosity search: reachable {ps['reachable'][0]:.4f}-{ps['reachable'][1]:.4f}; tried "
+              + ", ".join(f"lever {t['lever']:+.3f} -> {t['porosity']:.4f}" for t in ps["tried"]))
     return 0
+
+
+def _grain_porosity(args, name):
+    """The porosity that sets the grain count of one packing: --porosity, else the middle of the
+    grain's measured loose-fill range, else 0.408 (thesis Table 3.1)."""
+    if args.porosity is not None:
+        return args.porosity
+    try:
+        rng = grain(name).bulk_porosity.value
+    except ValueError:
+        rng = None
+    return 0.408 if rng is None else 0.5 * (rng[0] + rng[1])
 
 
 class _Progress:
@@ -169,7 +205,8 @@ def _pack(args) -> int:
         r = args.measure_radius or default_measure_spheres(container)[1]
         measure = (np.array(args.measure, dtype=float), r)
     opts = _procedure_options(args)
-    res = pack_bed(container, material=material, porosity=args.porosity, n_particles=args.n_particles,
+    porosity = 0.408 if args.porosity is None else args.porosity
+    res = pack_bed(container, material=material, porosity=porosity, n_particles=args.n_particles,
                    rng=args.seed, mass_scale=args.mass_scale, packing_friction=args.packing_friction,
                    open_top=not args.keep_lid, tol=args.tol, max_steps=args.max_steps,
                    dt_safety=args.dt_safety, measure_spheres=measure,
