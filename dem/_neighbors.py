@@ -188,12 +188,16 @@ class VerletList:
         ``by_second[second_start[p]:second_start[p + 1]]`` are the pairs with p as second
         member, ascending.
     n_builds : int
+    groups : (N,) int64 or None
+        Pairs whose two members have the same group (the spheres of one rigid grain) are left
+        out of the list: they are never contacts.
     """
 
-    def __init__(self, skin):
+    def __init__(self, skin, *, groups=None):
         if not skin > 0:
             raise ValueError(f"skin must be positive, got {skin}")
         self.skin = float(skin)
+        self.groups = None if groups is None else np.asarray(groups, dtype=np.int64)
         self.pairs = np.empty((0, 2), dtype=np.int64)
         self.keys = np.empty(0, dtype=np.int64)
         self.first_start = self.second_start = self.by_second = np.zeros(1, dtype=np.int64)
@@ -211,6 +215,8 @@ class VerletList:
         """Rebuild; returns the old keys so callers can remap pair history."""
         old = self.keys
         self.pairs = build_pairs(centers, radii, self.skin)
+        if self.groups is not None:
+            self.pairs = self.pairs[self.groups[self.pairs[:, 0]] != self.groups[self.pairs[:, 1]]]
         n = len(radii)
         i, j = self.pairs[:, 0], self.pairs[:, 1]
         self.keys = i * n + j
