@@ -2,15 +2,17 @@
 
 Examples
 --------
-    python -m network.report --grain soybean                      # the bundled soybean scene
+    python -m network.report --grain wheat --depth 3 --diameter 6   # bundled wheat bed
     python -m network.report --grain soybean --depth 3 --diameter 6 --fan fan.csv --html r.html
-    python -m network.report --grain wheat --packing bed.csv --particle-density 1240 --json r.json
+    python -m network.report --grain wheat --porosity 0.41 --packing bed.csv --json r.json
 
 The inertial resistance curve (vertical z and horizontal x) of a packing, with ASABE D272 and
 Ergun beside it and the fits of :func:`network.flow.fit_curve`; the porosity band (d ln(ΔP/L)/dε
 computed by packing and solving neighbouring porosities, :mod:`network._report_band`); the
 system curve of a bin and, with ``--fan``, its operating point (:mod:`network._report_system`).
-The porosity reported is the packing's own (interior Monte-Carlo porosity of the sample).
+The porosity reported is the grain's measured loose-fill porosity, ``--porosity``, or the
+packing's own, moved along the band's slope (:mod:`network._report_porosity`); figures go to
+``report_<grain>/`` unless ``--plot-dir``/``--no-figures`` say otherwise.
 Exit 0 done, 1 a solve failed, 2 bad input: one ``error:`` line (docs/cli.md, docs/report.md).
 """
 
@@ -26,18 +28,22 @@ import numpy as np
 from ._cli import (CliError, CliParser, add_air, add_sample, bad_input, check_common,
                    check_outputs, check_plot, computing, load_packing, progress_log, run,
                    sample_box_m)
-from ._grains import D272, GRAIN_ALIASES, grains_with_d272
+from ._grains import BED, D272, GRAIN_ALIASES, grains_with_d272
 from ._report_band import BAND_OFFSETS, band_gradients, pack_band, slope_at
+from ._report_porosity import (bundled_grains, bundled_packing, check_reachable, packing_meta,
+                               reachable_range, requested_porosity, shift_factor)
 from ._report_html import write_figures, write_html
 from ._report_system import (AIRFLOW_UNITS, bulk_density, curve_range, dense_system, floor_area,
                              operating_point, read_fan, system_rows, velocity_from_airflow)
 from .curve import DEFAULT_VELOCITIES, parse_velocities
-from .flow import DEFAULT_DEPTH_M, asabe_d272_gradient, ergun_gradient, solve_network
+from .flow import DEFAULT_DEPTH_M, asabe_d272_gradient, ergun_gradient, fit_curve, solve_network
 from .packing import UNITS, read_container
 from .pores import sample_region
 
 #: soybean kernel density, kg/m^3: thesis Table 3.1 (DESIGN.md), also dem.grains' soybean entry
-SOYBEAN_PARTICLE_DENSITY = 1285.0
+SOYBEAN_PARTICLE_DENSITY = BED["soybean"].particle_density_kg_m3
+#: below this porosity difference the packing's own porosity is the report's (no move)
+SAME_POROSITY = 5e-4
 KEYS = ["velocity_m_s", "reynolds_particle", "pressure_gradient_pa_per_m",
         "apparent_permeability_m2", "converged"]
 
@@ -52,19 +58,22 @@ def build_parser() -> CliParser:
                     help=f"crop: {', '.join(D272)} (D272 constants sourced for "
                          f"{', '.join(grains_with_d272())})")
     ap.add_argument("--packing", default=None, metavar="FILE",
-                    help="packing of that grain (any format the readers take); default for "
-                         "soybean: the bundled scene; other grains need one (dem.pack)")
+                    help="packing of that grain (any format the readers take); default: the "
+                         f"bundled one ({', '.join(bundled_grains())}); others: dem.pack")
     ap.add_argument("--units", default="m", type=str.lower, choices=list(UNITS),
                     help="length unit of the packing file")
     add_sample(ap, cylinder=False)
     add_air(ap)
     ap.add_argument("--velocities", default=DEFAULT_VELOCITIES,
                     help="superficial velocities, m/s: a,b,c or start:stop:n (log-spaced)")
+    ap.add_argument("--porosity", type=float, default=None,
+                    help="porosity the report is for (default: the grain's measured loose-fill "
+                         "porosity, middle of its range); reached by moving along the band's "
+                         "computed slope from the packing's own, within the range a packing of "
+                         "the grain reaches")
     ap.add_argument("--particle-density", type=float, default=None,
                     help="kernel (true) density, kg/m^3, for the bulk density rho_p (1 - "
-                         "porosity); default for soybean 1285 (thesis Table 3.1, dem.grains); "
-                         "other grains: give it (python -c \"import dem; print(dem.grain('wheat')"
-                         ".particle_density_kg_m3)\")")
+                         "porosity); default: the grain library's (network/_grains.py BED)")
     ap.add_argument("--depth", type=float, default=DEFAULT_DEPTH_M, help="bed depth, m, > 0")
     area = ap.add_mutually_exclusive_group()
     area.add_argument("--diameter", type=float, default=None, help="round bin diameter, m")
@@ -82,7 +91,9 @@ def build_parser() -> CliParser:
     ap.add_argument("--html", default=None, metavar="OUT.html",
                     help="self-contained HTML report with embedded plots (needs matplotlib)")
     ap.add_argument("--plot-dir", default=None, metavar="DIR",
-                    help="also write the plots as PNG files into this folder")
+                    help="write the plots as PNG files into this existing folder (default: "
+                         "report_<grain>/ in the current folder, made if missing)")
+    ap.add_argument("--no-figures", action="store_true", help="write no PNG files")
     ap.add_argument("--quiet", "-q", action="store_true", help="no stage progress on stderr")
     return ap
 
@@ -103,18 +114,25 @@ def _check(args) -> dict:
         v = getattr(args, opt)
         if v is not None and not (np.isfinite(v) and v > 0):
             raise ValueError(f"--{opt.replace('_', '-')} must be finite and > 0, got {v!r}")
-    rho_p = args.particle_density
+    rho_p, bed = args.particle_density, BED[key]
+    rho_src = "--particle-density"
     if rho_p is None:
-        if key != "soybean":
-            raise ValueError(f"--particle-density is needed for {key} (the soybean default "
-                             "1285 kg/m^3 does not apply); dem.grains has sourced values: "
-                             f"python -c \"import dem; print(dem.grain('{key}')"
-                             ".particle_density_kg_m3)\"")
-        rho_p = SOYBEAN_PARTICLE_DENSITY
-    if args.packing is None and key != "soybean":
-        raise ValueError(f"no bundled packing for {key}: pack one with python -m dem.pack "
-                         f"--scene box --grain {key} --out bed.csv (about 1.5 min), then add "
-                         "--packing bed.csv")
+        if bed.particle_density_kg_m3 is None:
+            raise ValueError(f"no sourced kernel density for {key} (docs/grain-library.md): "
+                             "give --particle-density (kg/m^3)")
+        rho_p, rho_src = bed.particle_density_kg_m3, bed.particle_density_source
+    if args.packing is None:
+        if bundled_packing(key) is None:
+            raise ValueError(f"no bundled packing for {key} (bundled: "
+                             f"{', '.join(bundled_grains())}): pack one with python -m dem.pack "
+                             f"--scene box --grain {key} --porosity P --out bed.csv, then add "
+                             "--packing bed.csv")
+        args.packing = str(bundled_packing(key))
+    target, why = requested_porosity(key, args.porosity)
+    meta = packing_meta(args.packing)
+    reach = reachable_range(meta)
+    if target is not None:
+        check_reachable(target, meta.get("porosity_network_region"), reach, key)
     airflow = None
     if args.airflow is not None:
         value, unit = args.airflow
@@ -136,8 +154,17 @@ def _check(args) -> dict:
         raise ValueError(f"--plot-dir {args.plot_dir}: not an existing folder")
     if args.html or args.plot_dir:
         check_plot("--html/--plot-dir")
-    return {"grain": key, "particle_density": rho_p, "airflow": airflow, "fan": fan,
-            "velocities": parse_velocities(args.velocities)}
+    plot_dir = args.plot_dir
+    if plot_dir is None and not args.no_figures:
+        plot_dir = f"report_{key}"
+        if Path(plot_dir).exists() and not Path(plot_dir).is_dir():
+            raise ValueError(f"{plot_dir} exists and is not a folder: give --plot-dir or "
+                             "--no-figures")
+        check_plot("the figures (or give --no-figures)")
+    return {"grain": key, "particle_density": rho_p, "particle_density_source": rho_src,
+            "airflow": airflow, "fan": fan, "velocities": parse_velocities(args.velocities),
+            "porosity": target, "porosity_source": why, "reachable": reach,
+            "plot_dir": plot_dir}
 
 
 def _solve(args, packing, container, box, margin, axis, us, porosity=None):
@@ -147,6 +174,16 @@ def _solve(args, packing, container, box, margin, axis, us, porosity=None):
                          velocity_m_s=us[0], depth_m=args.depth, inertia=True,
                          density_kg_m3=args.density, curve_velocities_m_s=us[1:],
                          inertial_law=args.inertial_law, porosity=porosity)
+
+
+def _fits(args, pts, porosity, d32):
+    """fit_curve over the converged points (as reported, at the report's porosity)."""
+    ok = [p for p in pts if p["converged"]]
+    if not ok:
+        return {}
+    return fit_curve([p["velocity_m_s"] for p in ok], [p["pressure_gradient_pa_per_m"] for p in ok],
+                     viscosity_pa_s=args.viscosity, density_kg_m3=args.density,
+                     porosity=porosity, diameter_m=d32)
 
 
 def _points(res):
@@ -160,7 +197,19 @@ def build_report(args, opts, path, packing) -> dict:
     container = None if box else read_container(path)
     us = list(opts["velocities"])
     rz = _solve(args, packing, container, box, margin, "z", us)
-    e, d32 = rz.porosity, rz.sauter_diameter_m
+    e_p, d32 = rz.porosity, rz.sauter_diameter_m
+    e, why = opts["porosity"], opts["porosity_source"]
+    if e is None:
+        e = e_p
+    try:
+        check_reachable(e, e_p, opts["reachable"], opts["grain"])
+    except ValueError as exc:
+        raise CliError(str(exc), 2) from None
+    move = abs(e - e_p) > SAME_POROSITY
+    if move and args.no_band:
+        why = (f"the packing's own: --no-band gives no computed slope to move it to {e:.4f} "
+               f"({why})")
+        e, move = e_p, False
     rho_b = bulk_density(opts["particle_density"], e)
     u_air = None
     if opts["airflow"]:
@@ -175,13 +224,23 @@ def build_report(args, opts, path, packing) -> dict:
     band = None
     if not args.no_band:
         ub = sorted(us)
-        band = pack_band(packing, e, velocities_m_s=[ub[0], float(np.sqrt(ub[0] * ub[-1])),
+        band = pack_band(packing, e_p, velocities_m_s=[ub[0], float(np.sqrt(ub[0] * ub[-1])),
                                                      ub[-1]],
                          seeds=(args.seed, args.seed + 1), viscosity_pa_s=args.viscosity,
                          density_kg_m3=args.density, inertial_law=args.inertial_law)
     c = D272[opts["grain"]]
     for p, px in zip(pts, pts_x):
         u = p["velocity_m_s"]
+        f, sig = 1.0, 0.0
+        if move:
+            f, sig = shift_factor(slope_at(u, band["velocities_m_s"], band["slopes"]),
+                                  slope_at(u, band["velocities_m_s"], band["slope_stderrs"]),
+                                  e - e_p)
+        p["pressure_gradient_packing_pa_per_m"] = p["pressure_gradient_pa_per_m"]
+        p["pressure_gradient_pa_per_m"] *= f
+        p["apparent_permeability_m2"] = args.viscosity * u / p["pressure_gradient_pa_per_m"]
+        px["pressure_gradient_pa_per_m"] *= f
+        p["porosity_shift_factor"], p["porosity_shift_ln_stderr"] = f, sig
         p["d272_pressure_gradient_pa_per_m"] = (
             None if c.a_pa_s2_m3 is None else
             float(asabe_d272_gradient(u, a=c.a_pa_s2_m3, b=c.b_s_m)))
@@ -201,20 +260,22 @@ def build_report(args, opts, path, packing) -> dict:
     sg = [p["pressure_gradient_pa_per_m"] for p in ok]
     system = system_rows(su, sg, depth_m=args.depth, area_m2=area, bulk_density_kg_m3=rho_b)
     out = {"grain": opts["grain"], "packing": str(path), "n_spheres": packing.n,
-           "n_grains": packing.n_grains, "porosity": e, "porosity_std": rz.porosity_std,
-           "porosity_source": "packing: the interior Monte-Carlo porosity of the packing's own "
-                              "sample (the grain's measured loose-fill porosity and --porosity "
-                              "are not implemented yet)",
+           "n_grains": packing.n_grains, "porosity": e, "porosity_source": why,
+           "porosity_packing": e_p, "porosity_packing_std": rz.porosity_std,
+           "porosity_reachable": opts["reachable"],
+           "porosity_move": ("none: the packing's own porosity" if not move else
+                             f"along the band's computed slope from the packing's {e_p:.4f} to "
+                             f"{e:.4f} (g exp(S de); not packed anew)"),
            "sauter_diameter_m": d32, "viscosity_pa_s": args.viscosity,
            "air_density_kg_m3": args.density, "particle_density_kg_m3": opts["particle_density"],
-           "particle_density_source": ("thesis Table 3.1 (soybean default)"
-                                       if args.particle_density is None else "--particle-density"),
+           "particle_density_source": opts["particle_density_source"],
            "bulk_density_kg_m3": rho_b,
            "d272": {"a_pa_s2_m3": c.a_pa_s2_m3, "b_s_m": c.b_s_m, "source": c.source,
                     "note": c.note},
            "permeability_stokes_m2": {"z": rz.permeability_m2, "x": rx.permeability_m2},
            "horizontal_to_vertical_stokes": rz.permeability_m2 / rx.permeability_m2,
-           "fits": rz.curve_fits(), "fits_horizontal": rx.curve_fits(),
+           "permeability_stokes_note": "as solved, at the packing's own porosity",
+           "fits": _fits(args, pts, e, d32), "fits_horizontal": _fits(args, pts_x, e, d32),
            "points": pts, "band": band,
            "bin": {"depth_m": args.depth, "diameter_m": args.diameter, "floor_area_m2": area,
                    "grain_mass_t": rho_b * area * args.depth / 1000.0},
@@ -247,14 +308,23 @@ def _g(v, fmt="10.4g"):
 
 def print_report(r) -> None:
     """The text report on stdout."""
-    print(f"grain {r['grain']}: packing {r['packing']} ({r['n_spheres']} spheres), porosity "
-          f"{r['porosity']:.4f} (std error {r['porosity_std']:.1e}; {r['porosity_source']})")
+    print(f"grain {r['grain']}: packing {r['packing']} ({r['n_grains']} grains, {r['n_spheres']} "
+          f"spheres), own porosity {r['porosity_packing']:.4f} (std error "
+          f"{r['porosity_packing_std']:.1e})")
+    print(f"porosity of this report {r['porosity']:.4f}: {r['porosity_source']}; moved "
+          f"{r['porosity_move']}")
+    f = [p["porosity_shift_ln_stderr"] for p in r["points"]]
+    if r["porosity"] != r["porosity_packing"]:
+        print(f"  the move multiplies dP/L by {min(p['porosity_shift_factor'] for p in r['points']):.4f}"
+              f"-{max(p['porosity_shift_factor'] for p in r['points']):.4f}, uncertain by "
+              f"+-{100 * max(f):.1f} % (|de| x the slope's standard error)")
     print(f"d32 {r['sauter_diameter_m'] * 1e3:.3f} mm, kernel density "
           f"{r['particle_density_kg_m3']:g} kg/m^3 ({r['particle_density_source']}), bulk "
           f"density {r['bulk_density_kg_m3']:.1f} kg/m^3")
     k = r["permeability_stokes_m2"]
-    print(f"Stokes k: vertical {k['z']:.4e} m^2, horizontal {k['x']:.4e} m^2 (horizontal/"
-          f"vertical resistance {r['horizontal_to_vertical_stokes']:.3f})")
+    print(f"Stokes k at the packing's own porosity: vertical {k['z']:.4e} m^2, horizontal "
+          f"{k['x']:.4e} m^2 (horizontal/vertical resistance "
+          f"{r['horizontal_to_vertical_stokes']:.3f})")
     if r["d272"]["a_pa_s2_m3"] is None:
         print(f"D272: no sourced constants for {r['grain']} (column '-')")
     print(f"{'U m/s':>8} {'Re_p':>6} {'dP/L z':>10} {'dP/L x':>10} {'D272':>10} {'Ergun':>10} "
@@ -321,7 +391,10 @@ def _main(args) -> int:
             with open(args.json_out, "w") as f:
                 json.dump(rep, f, indent=2)
             print(f"wrote {args.json_out}")
-        figs = write_figures(rep, args.plot_dir) if (args.html or args.plot_dir) else {}
+        plot_dir = opts["plot_dir"]
+        if plot_dir is not None:
+            Path(plot_dir).mkdir(exist_ok=True)
+        figs = write_figures(rep, plot_dir) if (args.html or plot_dir) else {}
         for name in figs.get("files", []):
             print(f"wrote {name}")
         if args.html:

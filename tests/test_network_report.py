@@ -84,13 +84,37 @@ def test_bad_input_exits_2(tmp_path, capsys):
     fan.write_text("airflow_m3_s,static_pressure_pa\n0,500\n-0.1,20\n")
     assert main(["--fan", str(fan), "--floor-area", "1", "-q"]) == 2
     assert "row 3" in capsys.readouterr().err
-    assert main(["--grain", "wheat", "--particle-density", "1240", "-q"]) == 2
-    assert "python -m dem.pack --scene box --grain wheat" in capsys.readouterr().err
-    assert main(["--grain", "wheat", "-q"]) == 2
-    assert "--particle-density" in capsys.readouterr().err
+    # canola: no sourced kernel density (dem.grains / network._grains.BED)
+    assert main(["--grain", "canola", "-q"]) == 2
+    assert "no sourced kernel density for canola" in capsys.readouterr().err
+    assert main(["--grain", "canola", "--particle-density", "1100", "-q"]) == 2
+    assert "no bundled packing for canola" in capsys.readouterr().err
+    for bad in ("1.5", "-0.1", "nan"):
+        assert main(["--porosity", bad, "-q"]) == 2
+        assert "--porosity must be in (0, 1)" in capsys.readouterr().err
+    assert not list(tmp_path.glob("report_*"))
 
 
-def test_end_to_end_bundled_scene(tmp_path, capsys):
+def test_porosity_outside_the_reachable_range_exits_2(tmp_path, capsys, monkeypatch):
+    """The bundled soybean scene has no recorded reachable range: the report moves along the
+    band at most 0.02 from its own porosity (0.3990), so 0.45 is refused after the solve, before
+    anything is written, naming the range."""
+    monkeypatch.chdir(tmp_path)
+    out = tmp_path / "r.json"
+    assert main(["--porosity", "0.45", "--velocities", "0.01,0.1", "--no-band", "-q",
+                 "--json", str(out)]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1, err
+    assert "porosity 0.45 is outside the range a packing of soybean reaches: 0.3790-0.4190" \
+        in err[0], err
+    assert not out.exists() and not list(tmp_path.glob("report_*"))
+
+
+def test_end_to_end_bundled_scene(tmp_path, capsys, monkeypatch):
+    """Default porosity: soybean's measured loose-fill 0.40985 (middle of 0.4007-0.419, Wandkar
+    2012), reached from the scene's own 0.3990 along the computed band slope (about -12.3,
+    docs/report.md): dP/L x exp(-12.3 x 0.0109) = x 0.875; figures in report_soybean/."""
+    monkeypatch.chdir(tmp_path)
     fan = tmp_path / "fan.csv"
     fan.write_text("airflow_m3_s,static_pressure_pa\n0,600\n0.05,500\n0.1,350\n0.15,100\n")
     out = tmp_path / "r.json"
@@ -101,8 +125,19 @@ def test_end_to_end_bundled_scene(tmp_path, capsys):
     for key in ("grain", "porosity", "porosity_source", "fits", "points", "band",
                 "system_curve", "operating_point"):
         assert key in r
-    assert r["grain"] == "soybean" and r["porosity"] == pytest.approx(0.399, abs=0.002)
-    assert "packing" in r["porosity_source"]
+    assert r["grain"] == "soybean" and r["porosity"] == pytest.approx(0.40985, abs=1e-9)
+    assert "loose-fill" in r["porosity_source"] and "Wandkar" in r["porosity_source"]
+    assert r["porosity_packing"] == pytest.approx(0.399, abs=0.002)
+    assert "band's computed slope" in r["porosity_move"]
+    for p in r["points"]:
+        f = p["porosity_shift_factor"]
+        assert f == pytest.approx(np.exp(p["band_slope"] * (r["porosity"] - r["porosity_packing"])))
+        assert 0.84 < f < 0.91
+        assert p["pressure_gradient_pa_per_m"] == pytest.approx(
+            f * p["pressure_gradient_packing_pa_per_m"], rel=1e-12)
+        assert 0 < p["porosity_shift_ln_stderr"] < 0.02
+    assert sorted(x.name for x in (tmp_path / "report_soybean").iterdir()) == [
+        "report_band.png", "report_curve.png", "report_system.png"]
     for k in ("permeability_m2", "forchheimer_beta_per_m", "d272_a", "d272_b", "ergun_A"):
         assert k in r["fits"]
     assert len(r["points"]) == 3

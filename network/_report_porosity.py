@@ -1,0 +1,115 @@
+r"""The porosity of ``network.report``: which one, why, and how the prediction gets there.
+
+A report is for one porosity ε (issue 16 item 3), chosen in this order and named in
+``porosity_source``: the user's ``--porosity``; else the grain's measured loose-fill bulk
+porosity (the middle of the range in :data:`network._grains.BED`, the condition D272's data were
+taken in); else, for a grain without one, the packing's own. The network is solved on a packing
+of porosity :math:`\varepsilon_p` (its interior Monte-Carlo porosity); the prediction is moved to ε
+along the porosity band's computed slope S(U) (:mod:`network._report_band`), not by packing anew:
+
+.. math:: g(U; \varepsilon) = g(U; \varepsilon_p)\,\exp\!\big(S(U)\,(\varepsilon - \varepsilon_p)\big),
+   \qquad \sigma_{\ln g} = |\varepsilon - \varepsilon_p|\,\sigma_S
+
+(g in Pa/m; σ_S the slope's standard error). The porosities a packing of the grain can reach
+are those its companion JSON records (``porosity_search.reachable`` of ``dem.pack --porosity``,
+the densest and loosest bed of the deposition-friction lever); a packing without that record
+accepts ε within ``MAX_SHIFT`` of its own (the band's span).
+"""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+import numpy as np
+
+from ._grains import BED
+
+__all__ = ["DATA_DIR", "MAX_SHIFT", "bundled_packing", "bundled_grains", "packing_meta",
+           "requested_porosity", "reachable_range", "check_reachable", "shift_factor"]
+
+DATA_DIR = Path(__file__).resolve().parent / "data"
+#: largest move along the band without a recorded reachable range (the band's span), porosity
+MAX_SHIFT = 0.02
+
+
+def bundled_packing(grain: str) -> Path | None:
+    """``network/data/<grain>_default.csv`` or ``.npz`` if shipped, else None."""
+    for ext in (".csv", ".npz"):
+        p = DATA_DIR / f"{grain}_default{ext}"
+        if p.is_file():
+            return p
+    return None
+
+
+def bundled_grains() -> list[str]:
+    """The grains with a bundled packing."""
+    return [g for g in BED if bundled_packing(g) is not None]
+
+
+def packing_meta(path) -> dict:
+    """The companion JSON of a packing (same stem, ``.json``) as a dict; {} if none or not JSON."""
+    p = Path(path).with_suffix(".json")
+    try:
+        meta = json.loads(p.read_text())
+    except (OSError, ValueError):
+        return {}
+    return meta if isinstance(meta, dict) else {}
+
+
+def requested_porosity(grain: str, porosity: float | None) -> tuple[float | None, str]:
+    """(ε or None, why): ``--porosity``, else the grain's measured loose-fill porosity, else None
+    (the packing's own, known only after the solve).
+
+    >>> requested_porosity("wheat", None)[0], requested_porosity("canola", None)[0]
+    (0.402, None)
+    """
+    if porosity is not None:
+        if not (np.isfinite(porosity) and 0 < porosity < 1):
+            raise ValueError(f"--porosity must be in (0, 1), got {porosity!r}")
+        return float(porosity), "--porosity (the user's)"
+    bed = BED[grain]
+    if bed.loose_fill_porosity is not None:
+        lo, hi = bed.bulk_porosity
+        return bed.loose_fill_porosity, (f"the grain's measured loose-fill bulk porosity, middle of "
+                                         f"{lo:g}-{hi:g} ({bed.bulk_porosity_source})")
+    return None, f"the packing's own (no measured loose-fill porosity for {grain})"
+
+
+def reachable_range(meta: dict) -> tuple[float, float] | None:
+    """(low, high) porosity that ``dem.pack --porosity`` reached for this grain, from the JSON."""
+    r = meta.get("porosity_search", {}).get("reachable") if isinstance(meta, dict) else None
+    if r is None or len(r) != 2:
+        return None
+    return float(min(r)), float(max(r))
+
+
+def check_reachable(porosity: float, own: float | None, reach, grain: str) -> None:
+    """ValueError unless ``porosity`` lies in ``reach`` (or, without one, within MAX_SHIFT of
+    the packing's ``own`` porosity), naming the reachable range.
+
+    >>> check_reachable(0.45, None, (0.37, 0.43), "wheat")
+    Traceback (most recent call last):
+    ...
+    ValueError: porosity 0.45 is outside the range a packing of wheat reaches: 0.3700-0.4300 (dem.pack --porosity, deposition friction 0-1)
+    """
+    if reach is not None:
+        lo, hi = reach
+        how = "dem.pack --porosity, deposition friction 0-1"
+    elif own is not None:
+        lo, hi = own - MAX_SHIFT, own + MAX_SHIFT
+        how = f"the packing's own {own:.4f} +- {MAX_SHIFT} along the band; no recorded range"
+    else:
+        return
+    if not lo - 1e-12 <= porosity <= hi + 1e-12:
+        raise ValueError(f"porosity {porosity:g} is outside the range a packing of {grain} "
+                         f"reaches: {lo:.4f}-{hi:.4f} ({how})")
+
+
+def shift_factor(slope: float, slope_stderr: float, d_porosity: float) -> tuple[float, float]:
+    r"""(exp(S Δε), σ of its logarithm |Δε| σ_S): the factor that moves g to ε_p + Δε.
+
+    >>> f, s = shift_factor(-12.0, 1.0, 0.01); round(f, 6), round(s, 6)
+    (0.88692, 0.01)
+    """
+    return float(np.exp(slope * d_porosity)), float(abs(d_porosity) * slope_stderr)
