@@ -5,16 +5,17 @@ thesis model (:func:`thesis_conductance`); both give a :class:`ConductanceResult
 """
 
 from ._conduit import SECTION_MODES, conduit_conductance, section_estimate, side_resistance
-from ._inertial import (contraction_coefficient, expansion_coefficient,
-                        inertial_coefficients)
+from ._inertial import (ONSET_SLOPE, contraction_coefficient, expansion_coefficient,
+                        inertial_coefficients, onset_scales, turning_cosines)
 from ._models import MODELS, check_model, throat_conductance
 from ._qstar import POLICIES, QstarResult, check_policy, qstar_from_function, throat_qstar
 from ._result import ConductanceResult
 from ._table import default_table, has_grid, table_totals
 from ._thesis import thesis_conductance
 
-__all__ = ["MODELS", "POLICIES", "SECTION_MODES", "ConductanceResult", "QstarResult",
-           "check_model", "check_policy", "conduit_conductance", "contraction_coefficient",
-           "default_table", "expansion_coefficient", "has_grid", "inertial_coefficients",
-           "qstar_from_function", "section_estimate", "side_resistance", "table_totals",
-           "thesis_conductance", "throat_conductance", "throat_qstar"]
+__all__ = ["MODELS", "ONSET_SLOPE", "POLICIES", "SECTION_MODES", "ConductanceResult",
+           "QstarResult", "check_model", "check_policy", "conduit_conductance",
+           "contraction_coefficient", "default_table", "expansion_coefficient", "has_grid",
+           "inertial_coefficients", "onset_scales", "qstar_from_function", "section_estimate",
+           "side_resistance", "table_totals", "thesis_conductance", "throat_conductance",
+           "throat_qstar", "turning_cosines"]

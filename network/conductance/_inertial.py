@@ -29,10 +29,16 @@ import numpy as np
 
 import throats
 
-from .._air import RHO_AIR_KG_M3, check_density
+from .._air import MU_AIR_PA_S, RHO_AIR_KG_M3, check_density, check_viscosity
 
-__all__ = ["PROFILES", "contraction_coefficient", "expansion_coefficient",
-           "inertial_coefficients"]
+__all__ = ["ONSET_SLOPE", "PROFILES", "contraction_coefficient", "expansion_coefficient",
+           "inertial_coefficients", "onset_scales",
+           "turning_cosines"]
+
+#: Low-Re slope of a single sphere-ring constriction's excess loss coefficient,
+#: :math:`dk/dRe_w = c_1 h/a`: axisymmetric Navier-Stokes of six constrictions
+#: (``docs/inertial-flow.md``); not fitted to bed data.
+ONSET_SLOPE = 0.0235
 
 
 def contraction_coefficient(sigma):
@@ -51,13 +57,15 @@ def contraction_coefficient(sigma):
 PROFILES = {"uniform": (1.0, 1.0), "laminar": (2.0, 4.0 / 3.0)}
 
 
-def expansion_coefficient(sigma, *, profile: str = "uniform"):
+def expansion_coefficient(sigma, *, profile: str = "uniform", cos_theta=1.0):
     r"""Loss coefficient of a sudden expansion from area ratio :math:`\sigma = A_1/A_2`.
 
     Momentum and energy balances between the expansion plane and the reattached flow, with
     profile coefficients :math:`(\alpha, \beta)` on both sides (:data:`PROFILES`):
     :math:`K_e = \alpha - 2\beta\sigma + (2\beta - \alpha)\sigma^2` (per
-    :math:`\rho V_1^2/2`); Borda-Carnot :math:`(1-\sigma)^2` for a flat profile.
+    :math:`\rho V_1^2/2`); Borda-Carnot :math:`(1-\sigma)^2` for a flat profile. A jet at angle
+    :math:`\theta` to the downstream flow recovers only its momentum component along it:
+    :math:`K_e = \alpha - 2\beta\sigma\cos\theta + (2\beta - \alpha)\sigma^2`.
 
     >>> float(expansion_coefficient(0.25)), float(expansion_coefficient(0.0, profile="laminar"))
     (0.5625, 2.0)
@@ -66,11 +74,13 @@ def expansion_coefficient(sigma, *, profile: str = "uniform"):
         raise ValueError(f"profile must be one of {sorted(PROFILES)}, got {profile!r}")
     a, b = PROFILES[profile]
     s = np.clip(np.asarray(sigma, dtype=float), 0.0, 1.0)
-    return a - 2.0 * b * s + (2.0 * b - a) * s**2
+    c = np.clip(np.asarray(cos_theta, dtype=float), -1.0, 1.0)
+    return a - 2.0 * b * s * c + (2.0 * b - a) * s**2
 
 
 def inertial_coefficients(tessellation, throats_idx, h_m, *, internal=None,
-                          density_kg_m3: float = RHO_AIR_KG_M3, profile: str = "uniform"):
+                          density_kg_m3: float = RHO_AIR_KG_M3, profile: str = "uniform",
+                          cos_theta=None, contraction: str = "sharp"):
     r"""Inertial coefficients K of M conduits for both flow directions, Pa s² m⁻⁶.
 
     Parameters
@@ -86,6 +96,13 @@ def inertial_coefficients(tessellation, throats_idx, h_m, *, internal=None,
         ρ (default 1.20 kg/m³).
     profile : {'uniform', 'laminar'}, keyword-only
         Velocity profile of the expansion loss (:func:`expansion_coefficient`).
+    contraction : {'sharp', 'smooth'}, keyword-only
+        'sharp': :func:`contraction_coefficient` (vena contracta); 'smooth': no contraction
+        loss (a sphere-rounded window: single-constriction Navier-Stokes,
+        ``docs/inertial-flow.md``).
+    cos_theta : (M, 2) array_like, optional
+        Turning cosine of each flow direction in the body it expands into
+        (:func:`turning_cosines`, same column order); None: 1 (straight expansion).
 
     Returns
     -------
@@ -94,6 +111,22 @@ def inertial_coefficients(tessellation, throats_idx, h_m, *, internal=None,
         reverse; 0 for closed windows and internal throats.
     """
     rho = check_density(density_kg_m3)
+    a_w, sigma, _ = _window_and_ratios(tessellation, throats_idx, h_m)
+    ct = np.ones((sigma.shape[0], 2)) if cos_theta is None else np.asarray(cos_theta, float)
+    if contraction not in ("sharp", "smooth"):
+        raise ValueError(f"contraction must be 'sharp' or 'smooth', got {contraction!r}")
+    kc = contraction_coefficient(sigma) if contraction == "sharp" else np.zeros_like(sigma)
+    ke = expansion_coefficient(sigma[:, ::-1], profile=profile, cos_theta=ct)[:, ::-1]
+    with np.errstate(divide="ignore"):
+        scale = np.where(a_w > 0, rho / (2.0 * a_w**2), 0.0)
+    K = np.column_stack([kc[:, 0] + ke[:, 1], kc[:, 1] + ke[:, 0]]) * scale[:, None]
+    if internal is not None:
+        K[np.asarray(internal, dtype=bool)] = 0.0
+    return K
+
+
+def _window_and_ratios(tessellation, throats_idx, h_m):
+    """Open window area (M,), area ratios sigma (M, 2) per side, mean sphere radius (M,)."""
     idx = np.asarray(throats_idx, dtype=np.int64)
     h = np.asarray(h_m, dtype=float)
     if h.shape != (idx.size, 2):
@@ -108,10 +141,63 @@ def inertial_coefficients(tessellation, throats_idx, h_m, *, internal=None,
         a_b = np.asarray(throats.open_area(np.maximum(rk, point), sides), dtype=float)
         with np.errstate(divide="ignore", invalid="ignore"):
             sigma[:, side] = np.where(a_b > 0, a_w / a_b, 1.0)
-    kc, ke = contraction_coefficient(sigma), expansion_coefficient(sigma, profile=profile)
-    with np.errstate(divide="ignore"):
-        scale = np.where(a_w > 0, rho / (2.0 * a_w**2), 0.0)
-    K = np.column_stack([kc[:, 0] + ke[:, 1], kc[:, 1] + ke[:, 0]]) * scale[:, None]
-    if internal is not None:
-        K[np.asarray(internal, dtype=bool)] = 0.0
-    return K
+    return a_w, sigma, radii.mean(axis=1)
+
+
+def onset_scales(tessellation, throats_idx, h_m, K, *,
+                 density_kg_m3: float = RHO_AIR_KG_M3, viscosity_pa_s: float = MU_AIR_PA_S):
+    r"""Onset scale c of M conduits for both flow directions, s/m³: :math:`c|q| = Re_w/Re_c`.
+
+    A single sphere-ring constriction (axisymmetric Navier-Stokes, ``docs/inertial-flow.md``)
+    loses :math:`k(Re_w)\,\rho u_w^2/2` over its Stokes drop with
+    :math:`k = k_\infty\,t/\sqrt{1+t^2}`, :math:`t = Re_w/Re_c`,
+    :math:`Re_c = k_\infty/(c_1 h/a)`: the low-Re slope :math:`dk/dRe_w = c_1 h/a`
+    (:data:`ONSET_SLOPE`, h the window-to-body height, a the sphere radius) and the
+    asymptote :math:`k_\infty`. Here :math:`k_\infty = 2A_w^2 K/\rho` is the conduit's own
+    loss coefficient (``K`` from :func:`inertial_coefficients`, same columns),
+    :math:`Re_w = \rho (|q|/A_w) D_w/\mu`, :math:`D_w = 2\sqrt{A_w/\pi}`, h of the side the
+    flow expands into, a the mean radius of the window's spheres. 0 where K = 0.
+
+    Returns
+    -------
+    c : (M, 2) ndarray
+    """
+    rho = check_density(density_kg_m3)
+    mu = check_viscosity(viscosity_pa_s)
+    a_w, _, a = _window_and_ratios(tessellation, throats_idx, h_m)
+    K = np.asarray(K, dtype=float)
+    if K.shape != (a_w.size, 2):
+        raise ValueError(f"K must have shape ({a_w.size}, 2), got {K.shape}")
+    h = np.abs(np.asarray(h_m, dtype=float))[:, ::-1]        # flow 0 -> 1 expands into side 1
+    with np.errstate(divide="ignore", invalid="ignore"):
+        re_per_q = 2.0 * rho / (mu * np.sqrt(np.pi * a_w))
+        k_inf = 2.0 * a_w[:, None] ** 2 * K / rho
+        c = re_per_q[:, None] * ONSET_SLOPE * h / (a[:, None] * k_inf)
+    return np.where(np.isfinite(c) & (K > 0), c, 0.0)
+
+
+def turning_cosines(centers_m, throat_vertices, pore_xyz_m, conns, flow_m3_s, axis: int):
+    r"""Cosine between each conduit's jet and the mean outflow of the body it enters, (M, 2).
+
+    The jet leaves the window along the face normal :math:`d` (oriented from ``conns[:, 0]``
+    to ``conns[:, 1]``); body Q sends its flow on along
+    :math:`M_Q = \sum_{out} |q_g| o_g / \sum_{out} |q_g|` (outflow directions :math:`o_g`,
+    weighted by ``flow_m3_s``, e.g. the Stokes flows); a body without outflow (outlet)
+    takes the flow axis. Column 0: :math:`d\cdot M_{Q_1}` (flow 0 → 1), column 1:
+    :math:`-d\cdot M_{Q_0}`.
+    """
+    x = np.asarray(centers_m, dtype=float)[np.asarray(throat_vertices, dtype=np.int64)]
+    n = np.cross(x[:, 1] - x[:, 0], x[:, 2] - x[:, 0])
+    c = np.asarray(conns, dtype=np.int64)
+    xyz = np.asarray(pore_xyz_m, dtype=float)
+    n *= np.sign(np.einsum("ij,ij->i", n, xyz[c[:, 1]] - xyz[c[:, 0]]))[:, None]
+    n /= np.maximum(np.linalg.norm(n, axis=1, keepdims=True), 1e-300)
+    q = np.asarray(flow_m3_s, dtype=float)
+    up = np.where(q > 0, c[:, 0], c[:, 1])
+    npores = xyz.shape[0]
+    tot = np.bincount(up, np.abs(q), npores)
+    M = np.stack([np.bincount(up, q * n[:, k], npores) for k in range(3)], axis=1)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        M = np.where(tot[:, None] > 0, M / tot[:, None], np.eye(3)[int(axis)])
+    return np.clip(np.column_stack([np.einsum("ij,ij->i", n, M[c[:, 1]]),
+                                    -np.einsum("ij,ij->i", n, M[c[:, 0]])]), -1.0, 1.0)

@@ -65,14 +65,17 @@ class InertialPoint:
     throat_flow_m3_s: np.ndarray = dataclasses.field(repr=False)
 
 
-def conduit_flow(dp, g, K, *, crossover: float | None = None):
+def conduit_flow(dp, g, K, *, crossover: float | None = None, onset_scale=None):
     r"""Signed conduit flows q and slopes w = dq/dΔp for pressure drops ``dp`` (module formula).
 
     ``K`` is (Nt, 2) (direction-dependent) or (Nt,). K = 0 gives q = g Δp exactly. With
     ``crossover`` :math:`X_c` the inertial loss has a weak-inertia onset,
     :math:`\Delta p = q/g + K q|q|\,X/(X_c + X)`, :math:`X = Kg|q|` (the ratio of the
     high-Re loss to the viscous one; ``docs/inertial-flow.md``); q is found by Newton from
-    an upper bound, monotone onto the root.
+    an upper bound, monotone onto the root. With ``onset_scale`` c (per conduit, s/m³; exclusive
+    with ``crossover``) the onset follows the window Reynolds number instead:
+    :math:`\Delta p = q/g + K q|q|\,t/\sqrt{1+t^2}`, :math:`t = c|q| = Re_w/Re_c`
+    (:func:`network.conductance.onset_scales`), solved the same way.
 
     >>> q, w = conduit_flow(np.array([1.5, -1.5]), np.array([1.0, 1.0]), np.array([0.5, 0.5]))
     >>> q.tolist(), w.tolist()
@@ -83,6 +86,12 @@ def conduit_flow(dp, g, K, *, crossover: float | None = None):
     a = np.abs(dp)
     inv_g = 1.0 / g
     q = 2.0 * a / (inv_g + np.sqrt(inv_g**2 + 4.0 * k * a))
+    if onset_scale is not None:
+        if crossover is not None:
+            raise ValueError("give crossover or onset_scale, not both")
+        c = np.asarray(onset_scale, dtype=float)
+        c = np.where(dp >= 0, c[:, 0], c[:, 1]) if c.ndim == 2 else c
+        return _throat_onset_flow(dp, a, g, inv_g, k, c)
     if crossover is None:
         w = 1.0 / (inv_g + 2.0 * k * q)
         return np.sign(dp) * q, w
@@ -108,9 +117,34 @@ def conduit_flow(dp, g, K, *, crossover: float | None = None):
     return np.sign(dp) * q, w
 
 
+def _throat_onset_flow(dp, a, g, inv_g, k, c):
+    r"""|Δp| = q/g + k q² φ(cq), φ(t) = t/√(1+t²): Newton from an upper bound
+    (φ(t) >= 1 - 1/t bounds q by the root of k q² + (1/g - k/c) q = |Δp|, and by g|Δp|);
+    the residual is convex and increasing in q (d²/dt² t³/√(1+t²) >= 0), so the iterates
+    descend onto the root."""
+    with np.errstate(divide="ignore", invalid="ignore"):
+        b = inv_g - np.where(c > 0, k / c, 0.0)
+        disc = np.sqrt(b * b + 4.0 * k * a)
+        up = np.where(b > 0, 2.0 * a / (b + disc), (disc - b) / (2.0 * k))
+    live = (k > 0) & (c > 0)
+    q = np.where(live, np.minimum(g * a, np.nan_to_num(up, nan=np.inf, posinf=np.inf)), g * a)
+    for _ in range(60):
+        t = c * q
+        s2 = 1.0 + t * t
+        f = q * inv_g + k * q * q * t / np.sqrt(s2) - a
+        df = inv_g + k * q * t * (3.0 + 2.0 * t * t) / s2**1.5
+        step = np.where(live, f / df, 0.0)
+        q = np.maximum(q - step, 0.0)
+        if np.all(np.abs(step) <= 1e-14 * q):
+            break
+    t = c * q
+    w = 1.0 / (inv_g + k * q * t * (3.0 + 2.0 * t * t) / (1.0 + t * t) ** 1.5)
+    return np.sign(dp) * q, w
+
+
 def solve_inertial(n_pores, conns, g, K, inlet, outlet, flows_m3_s, *, tol: float = 1e-10,
                    maxiter: int = 30, amg: AMGSolver | None = None,
-                   crossover: float | None = None) -> list[InertialPoint]:
+                   crossover: float | None = None, onset_scale=None) -> list[InertialPoint]:
     """Solve the nonlinear network at every total flow (ascending), reusing one hierarchy.
 
     Parameters
@@ -133,6 +167,8 @@ def solve_inertial(n_pores, conns, g, K, inlet, outlet, flows_m3_s, *, tol: floa
         Hierarchy of the condensed Stokes matrix (built here when not given).
     crossover : float, optional
         :math:`X_c` of the weak-inertia onset (:func:`conduit_flow`); None: purely quadratic.
+    onset_scale : (Nt, 2) or (Nt,) array_like, optional, s/m³
+        Window-Reynolds onset of :func:`conduit_flow` instead (exclusive with ``crossover``).
 
     Returns
     -------
@@ -148,6 +184,10 @@ def solve_inertial(n_pores, conns, g, K, inlet, outlet, flows_m3_s, *, tol: floa
         raise ValueError("conductances must be finite and > 0 (prune closed throats first)")
     if np.any(K < 0) or np.any(~np.isfinite(K)):
         raise ValueError("inertial coefficients must be finite and >= 0")
+    c_on = None if onset_scale is None else np.asarray(onset_scale, dtype=float)
+    if c_on is not None and (c_on.shape[0] != g.size or np.any(c_on < 0)
+                             or np.any(~np.isfinite(c_on))):
+        raise ValueError(f"onset_scale must have {g.size} rows, finite and >= 0")
     inlet = np.asarray(inlet, dtype=np.int64)
     outlet = np.asarray(outlet, dtype=np.int64)
     is_in = np.zeros(n_pores, bool)
@@ -167,7 +207,7 @@ def solve_inertial(n_pores, conns, g, K, inlet, outlet, flows_m3_s, *, tol: floa
     i, j = c[:, 0], c[:, 1]
 
     def residual(p, Q):
-        q, w = conduit_flow(p[i] - p[j], g, K, crossover=crossover)
+        q, w = conduit_flow(p[i] - p[j], g, K, crossover=crossover, onset_scale=c_on)
         net = np.bincount(i, q, n_pores) - np.bincount(j, q, n_pores)
         return np.append(net[free], net[inlet].sum() - Q), q, w
 

@@ -8,9 +8,9 @@ viscosity 1 and density 1 with the superficial velocities :math:`U = Re/d`, so t
 k the sample's Stokes permeability) beside the laws'
 :math:`F(\phi, Re)/F(\phi, 0)` (:mod:`._drag_laws`).
 
-``crossover`` selects the weak-inertia onset of :func:`network.flow.conduit_flow` and
-``profile`` the expansion loss of :func:`network.conductance.inertial_coefficients` (None and
-'uniform': the purely quadratic law that ``network.solve`` uses).
+The cases pass their keyword law options (``crossover``, ``profile``, ``contraction``,
+``turning``, ``onset``) to :func:`solve_sample_curve`; none given: the flat-profile quadratic
+law; :data:`DERIVED_LAW`: the law derived from single-constriction Navier-Stokes.
 
 * :func:`random_inertial_case`: periodic random packing (:func:`network.random_packing`),
   copied 3 x 3 x 3, the middle two periods as the sample, as
@@ -33,14 +33,20 @@ from pathlib import Path
 import numpy as np
 from scipy.spatial import cKDTree
 
-from ..conductance import inertial_coefficients, throat_conductance
+from ..conductance import (inertial_coefficients, onset_scales, throat_conductance,
+                           turning_cosines)
 from ..flow import AMGSolver, darcy_permeability, solve_fixed_pressure, solve_inertial
 from ..packing import Packing, lattice_packing, periodic_copies, random_packing, read_packing
 from ..pores import Region, merge_pores, prune_disconnected, select_sample, tessellate
 from ._drag_laws import DRAG_LAWS, drag_ratio
 
-__all__ = ["FINNEY_PATH", "InertialCase", "finney_inertial_case", "lattice_inertial_case",
-           "random_inertial_case", "solve_sample_curve"]
+__all__ = ["DERIVED_LAW", "FINNEY_PATH", "InertialCase", "finney_inertial_case",
+           "lattice_inertial_case", "random_inertial_case", "solve_sample_curve"]
+
+#: Conduit law from single-constriction Navier-Stokes + the turning momentum balance
+#: (``docs/inertial-flow.md``): keyword options of :func:`solve_sample_curve` and the cases.
+DERIVED_LAW = {"profile": "uniform", "contraction": "smooth", "turning": True,
+               "onset": "throat"}
 
 #: Finney's packing, central subset (radius 1, lengths in sphere radii).
 FINNEY_PATH = Path("/work/shared/data/finney/finney_subset_4021.csv")
@@ -80,12 +86,21 @@ class InertialCase:
 
 def solve_sample_curve(packing, region, velocities_m_s, *, axis=0, policy="table-only",
                        db=None, viscosity_pa_s=1.0, density_kg_m3=1.0, crossover=None,
-                       profile="uniform"):
+                       profile="uniform", onset=None, turning=False,
+                       contraction="sharp"):
     """The inertial pipeline of :func:`network.solve_network` (conduit model, bodies merged;
-    one AMG hierarchy, built for the Stokes solve and reused by every Newton step),
-    with the onset ``crossover`` of :func:`network.flow.solve_inertial` and the expansion
-    ``profile`` of :func:`network.conductance.inertial_coefficients` selectable:
-    ``(permeability_m2, length_m, points, seconds)``, ``seconds`` a dict by stage."""
+    one AMG hierarchy, built for the Stokes solve and reused by every Newton step):
+    ``(permeability_m2, length_m, points, seconds)``, ``seconds`` a dict by stage.
+
+    The conduit law is selectable: ``crossover`` (X_c onset of
+    :func:`network.flow.solve_inertial`) or ``onset="throat"`` (window-Reynolds onset,
+    :func:`network.conductance.onset_scales`); the expansion ``profile``, ``contraction``
+    ('sharp' | 'smooth') and ``turning`` (expansion against each body's Stokes outflow
+    direction, :func:`network.conductance.turning_cosines`) of
+    :func:`network.conductance.inertial_coefficients`. :data:`DERIVED_LAW` is the law
+    derived from single-constriction Navier-Stokes (``docs/inertial-flow.md``)."""
+    if onset not in (None, "throat"):
+        raise ValueError(f"onset must be None or 'throat', got {onset!r}")
     t = {}
     t0 = time.perf_counter()
     tess = tessellate(packing)
@@ -97,10 +112,10 @@ def solve_sample_curve(packing, region, velocities_m_s, *, axis=0, policy="table
                               viscosity_pa_s=viscosity_pa_s, merge=merge)
     before = sample.throats
     sample, g = prune_disconnected(sample, tess, cres.g)
+    keep = np.searchsorted(before, sample.throats)
     K = inertial_coefficients(tess, before, cres.h_m, internal=cres.internal,
-                              density_kg_m3=density_kg_m3,
-                              profile=profile)[np.searchsorted(before,
-                                                                           sample.throats)]
+                              density_kg_m3=density_kg_m3, profile=profile,
+                              contraction=contraction)[keep]
     t["conductance"] = time.perf_counter() - t0
     t0 = time.perf_counter()
     held = {}
@@ -115,30 +130,41 @@ def solve_sample_curve(packing, region, velocities_m_s, *, axis=0, policy="table
                            viscosity_pa_s=viscosity_pa_s)
     t["stokes"] = time.perf_counter() - t0
     t0 = time.perf_counter()
+    if turning:         # expansion into each body against its Stokes outflow direction
+        cos = turning_cosines(packing.centers, tess.throat_vertices[sample.throats],
+                              sample.pore_xyz, sample.conns, check["throat_flow"], axis)
+        K = inertial_coefficients(tess, sample.throats, cres.h_m[keep],
+                                  internal=np.asarray(cres.internal)[keep],
+                                  density_kg_m3=density_kg_m3, profile=profile, cos_theta=cos,
+                                  contraction=contraction)
+    c_on = None
+    if onset == "throat":
+        c_on = onset_scales(tess, sample.throats, cres.h_m[keep], K,
+                            density_kg_m3=density_kg_m3, viscosity_pa_s=viscosity_pa_s)
     pts = solve_inertial(sample.n_pores, sample.conns, g, K, sample.inlet, sample.outlet,
                          np.asarray(velocities_m_s, dtype=float) * sample.area_m2,
-                         crossover=crossover, amg=held.get("amg"))
+                         crossover=crossover, onset_scale=c_on, amg=held.get("amg"))
     t["inertial"] = time.perf_counter() - t0
     return k, sample.length_m, pts, t
 
 
 def _run(name, packing, region, diameter, solid_fraction, reynolds, *, axis, policy, db,
-         laws, crossover, profile):
+         laws, law):
     re = np.asarray(reynolds, dtype=float)
     if re.ndim != 1 or not re.size or np.any(~np.isfinite(re)) or np.any(re <= 0):
         raise ValueError(f"reynolds must be a non-empty list of values > 0, got {reynolds!r}")
     t0 = time.perf_counter()
     us = re / diameter                      # mu = rho = 1: Re = U d
     k, length, pts, _ = solve_sample_curve(packing, region, us, axis=axis, policy=policy,
-                                           db=db, crossover=crossover, profile=profile)
+                                           db=db, **law)
     grad = np.array([p.dp_pa for p in pts]) / length
     k_ratio = grad * k / us                 # (dP/L) / (mu U / k)
     law_ratio = {}
-    for law in laws:
-        if law == "hill_koch_ladd" and solid_fraction < 0.4:
+    for name_ in laws:
+        if name_ == "hill_koch_ladd" and solid_fraction < 0.4:
             continue
-        law_ratio[law] = np.asarray(drag_ratio(law, solid_fraction, re), dtype=float)
-    error = {law: k_ratio / r - 1.0 for law, r in law_ratio.items()}
+        law_ratio[name_] = np.asarray(drag_ratio(name_, solid_fraction, re), dtype=float)
+    error = {name_: k_ratio / r - 1.0 for name_, r in law_ratio.items()}
     return InertialCase(name, float(solid_fraction), re, k_ratio, law_ratio, error,
                         np.array([p.iterations for p in pts]),
                         bool(all(p.converged for p in pts)), float(k / diameter**2),
@@ -147,8 +173,7 @@ def _run(name, packing, region, diameter, solid_fraction, reynolds, *, axis, pol
 
 def random_inertial_case(solid_fraction: float, reynolds, *, n_spheres: int = 800, rng=1,
                          copies: int = 3, axis: int = 0, policy: str = "table-only",
-                         db=None, laws=tuple(DRAG_LAWS), crossover=None,
-                         profile="uniform") -> InertialCase:
+                         db=None, laws=tuple(DRAG_LAWS), **law) -> InertialCase:
     """Periodic random packing of unit spheres at ``solid_fraction`` (<= 0.64), copied
     ``copies``³ times; sample = all but half a period at every face (module notes)."""
     phi = float(solid_fraction)
@@ -161,13 +186,12 @@ def random_inertial_case(solid_fraction: float, reynolds, *, n_spheres: int = 80
     region = Region(np.full(3, 0.5 * side), np.full(3, (copies - 0.5) * side))
     return _run(f"random phi={phi:.3f} n={n_spheres} seed={rng}", packing, region, 1.0, phi,
                 reynolds, axis=axis, policy=policy, db=db, laws=laws,
-                crossover=crossover, profile=profile)
+                law=law)
 
 
 def finney_inertial_case(reynolds, *, half_side: float = 8.0, axis: int = 0,
                          policy: str = "table-only", db=None, path=FINNEY_PATH,
-                         laws=tuple(DRAG_LAWS), crossover=None,
-                         profile="uniform") -> InertialCase:
+                         laws=tuple(DRAG_LAWS), **law) -> InertialCase:
     """A cube of half-side ``half_side`` (sphere radii) at the centroid of Finney's packing;
     the law is evaluated at the cube's solid fraction (sphere volume counted by quadrature
     of 200 000 seeded points)."""
@@ -178,7 +202,7 @@ def finney_inertial_case(reynolds, *, half_side: float = 8.0, axis: int = 0,
     phi = _box_solid_fraction(packing, region)
     return _run(f"finney cube {2 * h:g} r, phi={phi:.3f}", packing, region,
                 float(2 * packing.radii.mean()), phi, reynolds, axis=axis, policy=policy,
-                db=db, laws=laws, crossover=crossover, profile=profile)
+                db=db, laws=laws, law=law)
 
 
 def _box_solid_fraction(packing: Packing, region: Region, n_points: int = 200_000) -> float:
@@ -190,8 +214,7 @@ def _box_solid_fraction(packing: Packing, region: Region, n_points: int = 200_00
 
 def lattice_inertial_case(kind: str, solid_fraction: float, reynolds, *, n_cells: int = 7,
                           axis: int = 0, policy: str = "table-only", db=None,
-                          offset: float = 0.137, crossover=None,
-                          profile="uniform") -> InertialCase:
+                          offset: float = 0.137, **law) -> InertialCase:
     """Simple-cubic / BCC / FCC array, lattice constant 1, sample box as
     :func:`lattice_sample_permeability`; ``law_ratio`` holds the random-packing laws for
     information only (an ordered array is not a random bed)."""
@@ -199,4 +222,4 @@ def lattice_inertial_case(kind: str, solid_fraction: float, reynolds, *, n_cells
     region = Region(np.full(3, 1.0 + offset), np.full(3, n_cells - 2 + offset))
     return _run(f"{kind} phi={float(solid_fraction):.3f}", Packing(c, r), region,
                 float(2 * r[0]), float(solid_fraction), reynolds, axis=axis, policy=policy,
-                db=db, laws=("beetstra",), crossover=crossover, profile=profile)
+                db=db, laws=("beetstra",), law=law)
