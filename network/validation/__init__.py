@@ -13,9 +13,10 @@ from ._references import (STOKES_CELL_BCC, STOKES_CELL_FCC, ZICK_HOMSY_SC, beets
                           sangani_acrivos_sc_drag, zick_homsy_sc_drag)
 
 __all__ = ["DERIVED_LAW", "DRAG_LAWS", "ESTIMATORS", "FINNEY_PATH", "InertialCase",
-           "STOKES_CELL_BCC", "STOKES_CELL_FCC", "ZICK_HOMSY_SC", "beetstra_drag", "beetstra_permeability",
-           "beetstra_stokes_drag", "computed_lattice_permeability", "drag_ratio",
-           "drag_to_permeability", "ergun_viscous_permeability", "finney_inertial_case",
+           "STOKES_CELL_BCC", "STOKES_CELL_FCC", "ZICK_HOMSY_SC", "beetstra_drag",
+           "beetstra_permeability", "beetstra_stokes_drag", "computed_lattice_permeability",
+           "drag_ratio", "drag_to_permeability", "ergun_viscous_permeability",
+           "finney_inertial_case",
            "hill_koch_ladd_drag", "kozeny_carman_permeability", "lattice_inertial_case",
            "lattice_permeability", "lattice_sample_permeability", "periodic_permeability",
            "random_inertial_case", "random_sample_permeability", "sangani_acrivos_sc_drag",
