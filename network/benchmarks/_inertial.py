@@ -6,7 +6,7 @@ solid_fraction=0.60)``, as the scaling part makes it; the sample is the default 
 tessellation, conductances, the Stokes solve and the Newton curve each timed, with Newton
 iterations per velocity and the 1-minute load average. :func:`inertial_validation` runs the
 drag-law cases of :mod:`network.validation` (Finney's packing and periodic random packings)
-for the default quadratic law and the laminar-profile + onset law (:data:`INERTIAL_LAWS`),
+for the conduit laws of :data:`INERTIAL_LAWS` (quadratic, onset, derived),
 and :func:`inertial_lines` prints both. Measurements: ``docs/inertial-flow.md``.
 """
 
@@ -19,7 +19,8 @@ import numpy as np
 
 from ..packing import random_packing
 from ..pores import default_region
-from ..validation import finney_inertial_case, random_inertial_case, solve_sample_curve
+from ..validation import (DERIVED_LAW, finney_inertial_case, random_inertial_case,
+                          solve_sample_curve)
 
 __all__ = ["INERTIAL_LAWS", "INERTIAL_REYNOLDS", "inertial_lines", "inertial_speed",
            "inertial_validation"]
@@ -33,8 +34,9 @@ def _load() -> float:
 
 
 def inertial_speed(n_spheres: int = 20_000, *, seed: int = 1, n_points: int = 12,
-                   policy: str = "table-only", db=None) -> dict:
-    """Stage times (s) of a ``n_points`` curve 0.005-0.3 m/s on the benchmark packing."""
+                   policy: str = "table-only", db=None, law: str = "onset") -> dict:
+    """Stage times (s) of a ``n_points`` curve 0.005-0.3 m/s on the benchmark packing, with
+    the conduit ``law`` of :data:`INERTIAL_LAWS` (default 'onset', ``network.solve``'s)."""
     t0 = time.perf_counter()
     pk = random_packing(int(n_spheres), rng=seed, periodic=True, solid_fraction=0.60)
     gen = time.perf_counter() - t0
@@ -42,9 +44,10 @@ def inertial_speed(n_spheres: int = 20_000, *, seed: int = 1, n_points: int = 12
     us = np.geomspace(0.005, 0.3, int(n_points))
     load0 = _load()
     k, _, pts, t = solve_sample_curve(pk, region, us, axis=2, policy=policy, db=db,
-                                      viscosity_pa_s=1.932e-5, density_kg_m3=1.2)
+                                      viscosity_pa_s=1.932e-5, density_kg_m3=1.2,
+                                      **INERTIAL_LAWS[law])
     stokes = t["tessellate"] + t["conductance"] + t["stokes"]
-    return {"n_spheres": int(n_spheres), "generate_s": gen,
+    return {"n_spheres": int(n_spheres), "law": law, "generate_s": gen,
             **{f"{k2}_s": v for k2, v in t.items()},
             "stokes_pipeline_s": stokes, "curve_total_s": stokes + t["inertial"],
             "curve_over_stokes": (stokes + t["inertial"]) / stokes,
@@ -54,8 +57,11 @@ def inertial_speed(n_spheres: int = 20_000, *, seed: int = 1, n_points: int = 12
             "load_before": load0, "load_after": _load()}
 
 
-#: Laws of the validation table: name -> (profile, crossover) (``docs/inertial-flow.md``).
-INERTIAL_LAWS = {"quadratic": ("uniform", None), "onset": ("laminar", 1.0)}
+#: Laws of the validation table: name -> keyword options of the validation cases
+#: (``docs/inertial-flow.md``): 'quadratic' flat-profile K q|q|; 'onset' laminar profile +
+#: X_c = 1 (``network.solve``'s default); 'derived' the single-constriction Navier-Stokes law.
+INERTIAL_LAWS = {"quadratic": {}, "onset": {"profile": "laminar", "crossover": 1.0},
+                 "derived": DERIVED_LAW}
 
 
 def inertial_validation(*, reynolds=INERTIAL_REYNOLDS, solid_fractions=(0.55, 0.60, 0.64),
@@ -65,8 +71,7 @@ def inertial_validation(*, reynolds=INERTIAL_REYNOLDS, solid_fractions=(0.55, 0.
     packing and the random packings, per conduit law of :data:`INERTIAL_LAWS`."""
     rows = []
     for law in laws:
-        profile, crossover = INERTIAL_LAWS[law]
-        kw = dict(policy=policy, db=db, crossover=crossover, profile=profile)
+        kw = dict(policy=policy, db=db, **INERTIAL_LAWS[law])
         cases = [finney_inertial_case(reynolds, **kw)]
         cases += [random_inertial_case(phi, reynolds, n_spheres=n_spheres, rng=seed, **kw)
                   for phi in solid_fractions]
@@ -78,8 +83,9 @@ def inertial_lines(speed: dict | None, rows: list[dict]) -> list[str]:
     """The printed table of part 4."""
     out = []
     if speed:
-        out.append(f"inertial curve, {speed['n_spheres']} spheres: tessellate "
-                   f"{speed['tessellate_s']:.2f} s, conductance {speed['conductance_s']:.2f} s, "
+        out.append(f"inertial curve ({speed.get('law', 'onset')} law), {speed['n_spheres']} "
+                   f"spheres: tessellate {speed['tessellate_s']:.2f} s, conductance "
+                   f"{speed['conductance_s']:.2f} s, "
                    f"Stokes solve {speed['stokes_s']:.2f} s, Newton {speed['inertial_s']:.2f} s: "
                    f"curve {speed['curve_over_stokes']:.2f}x the Stokes pipeline; Newton "
                    f"iterations {speed['newton_iterations']}, load {speed['load_before']:.1f}"
