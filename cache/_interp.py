@@ -190,10 +190,14 @@ class GridTable:
         Apply the curvature correction (False: plain multilinear).
     estimate : bool, keyword-only, default True
         Compute the per-cell error estimate from the coarse sub-grid (needs odd node counts).
+    derived : dict, keyword-only, optional
+        :meth:`derived` of a table built from the same ``spec``, ``qstar`` and ``curvature``
+        by this code (a saved copy, :func:`cache.load_grid_table`): taken instead of
+        recomputing the filled values, curvature coefficients and served cells.
     """
 
     def __init__(self, spec, qstar, fe_error=None, *, safety=None, curvature=True,
-                 estimate=True):
+                 estimate=True, derived=None):
         if safety is None:
             safety = CALIBRATED_SAFETY.get(spec.name, ERROR_SAFETY) if curvature else ERROR_SAFETY
         self.spec = spec
@@ -205,7 +209,7 @@ class GridTable:
         self.node_ok = good
         with np.errstate(divide="ignore", invalid="ignore"):
             v = np.where(good, np.log(np.where(good, q, 1.0)), np.nan)
-        self.values = fill_nan(v)
+        self.values = fill_nan(v) if derived is None else derived["values"].reshape(shape)
         fe = np.zeros(shape) if fe_error is None else np.asarray(fe_error, float).reshape(shape)
         fe = np.where(np.isfinite(fe), np.abs(fe), 0.0)
         self.fe_error = fe
@@ -216,8 +220,8 @@ class GridTable:
         # per-cell curvature coefficients k_d = H_d^2 * mean(v''_d) / 2, stored at the lower node
         self._k = []
         for d in range(5):
-            if shape[d] < 3:
-                self._k.append(None)
+            if shape[d] < 3 or derived is not None:
+                self._k.append(None if shape[d] < 3 else derived[f"k{d}"])
                 continue
             h = np.diff(self._axes[d])
             d2 = second_difference(self.values, self._axes[d], d)
@@ -229,9 +233,15 @@ class GridTable:
         # needs only which cells serve (``errors=False``) skips it (0.1-0.2 s on g1)
         self._estimate = bool(estimate)
         self._log_q = v
-        self.cell_ok = cell_all(good)
+        self.cell_ok = cell_all(good) if derived is None else derived["cell_ok"].reshape(shape)
         self._cell_error = None
         self._flat_values = np.ascontiguousarray(self.values.ravel())
+
+    def derived(self):
+        """The arrays a lookup needs that cost a whole-grid pass to make (``derived=``)."""
+        out = {"values": self.values, "cell_ok": self.cell_ok}
+        out.update({f"k{d}": k for d, k in enumerate(self._k) if k is not None})
+        return out
 
     @property
     def cell_error(self):

@@ -34,6 +34,7 @@ import throats
 
 from . import _build
 from ._build import precompute_throats, resolve_solver
+from ._derived import derived_path, load_derived, save_derived
 from ._interp import GridSpec, GridTable
 from ._signature import as_throats, match_keys, shape_keys, signature
 from ._store import open_store
@@ -184,8 +185,18 @@ def _shipped_table(name, solver_version):
                            path, z["solver_version"], solver_version, name)
             _TABLES[key] = None
         else:
-            table = GridTable(GridSpec.from_dict(json.loads(str(z["spec"]))), z["qstar"],
-                              z["fe_error"])
+            spec = GridSpec.from_dict(json.loads(str(z["spec"])))
+            # the whole-grid passes of GridTable (0.1-0.2 s) are done once per table and code
+            # version, then read back from a memory map (docs/scale.md)
+            saved = derived_path(path, default_db_path().parent)
+            rows = load_derived(saved, spec.shape)
+            if rows is None:
+                table = GridTable(spec, z["qstar"], z["fe_error"])
+                if saved is not None:
+                    save_derived(saved, dict(table.derived(), qstar=z["qstar"],
+                                             fe_error=z["fe_error"]))
+            else:
+                table = GridTable(spec, rows["qstar"], rows["fe_error"], derived=rows)
             table.n_missing = 0
             _TABLES[key] = table
     return _TABLES[key]

@@ -1,0 +1,47 @@
+"""The shipped table's derived arrays, saved once and memory-mapped afterwards (cache._derived).
+
+A table rebuilt from the saved arrays must answer every lookup with the same bits as one
+computed from the table file, error estimates included; a broken or foreign file is ignored.
+"""
+
+import json
+
+import numpy as np
+
+from cache import GridSpec, GridTable, shipped_grid_path
+from cache._derived import ROWS, derived_path, load_derived, save_derived
+
+
+def _shipped():
+    z = np.load(shipped_grid_path("g1"))
+    return GridSpec.from_dict(json.loads(str(z["spec"]))), z["qstar"], z["fe_error"]
+
+
+def test_saved_arrays_rebuild_the_same_table(tmp_path):
+    spec, q, fe = _shipped()
+    fresh = GridTable(spec, q, fe)
+    saved = derived_path(shipped_grid_path("g1"), tmp_path)
+    save_derived(saved, dict(fresh.derived(), qstar=q, fe_error=fe))
+    rows = load_derived(saved, spec.shape)
+    assert set(rows) == set(ROWS) and rows["cell_ok"].dtype == bool
+    again = GridTable(spec, rows["qstar"], rows["fe_error"], derived=rows)
+    rng = np.random.default_rng(7)
+    x = rng.uniform([-0.3, -0.3, -0.3, -0.3, -0.3], [2.3, 2.3, 2.3, 0.3, 0.3], (20_000, 5))
+    for errors in (True, False):
+        (q1, e1), (q2, e2) = fresh(x, errors=errors), again(x, errors=errors)
+        np.testing.assert_array_equal(q1, q2)
+        np.testing.assert_array_equal(e1, e2)
+    np.testing.assert_array_equal(fresh.cell_error, again.cell_error)
+    # one copy per table file: a newer one replaces it
+    assert [p.name for p in tmp_path.iterdir()] == [saved.name]
+
+
+def test_broken_or_foreign_files_are_not_used(tmp_path):
+    spec, _, _ = _shipped()
+    junk = tmp_path / "junk.npy"
+    junk.write_bytes(b"not an array")
+    assert load_derived(junk, spec.shape) is None
+    np.save(junk, np.zeros((len(ROWS), 10)))               # another grid's size
+    assert load_derived(junk, spec.shape) is None
+    assert load_derived(tmp_path / "absent.npy", spec.shape) is None
+    assert derived_path(tmp_path / "absent.npz", tmp_path) is None
