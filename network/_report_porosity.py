@@ -34,9 +34,11 @@ MAX_SHIFT = 0.02
 
 
 def bundled_packing(grain: str) -> Path | None:
-    """``network/data/<grain>_default.csv`` or ``.npz`` if shipped, else None."""
-    for ext in (".csv", ".npz"):
-        p = DATA_DIR / f"{grain}_default{ext}"
+    """The shipped packing of a grain, else None: ``network/data/<grain>_grains.csv`` (rigid
+    multi-sphere grains made by ``dem.pack --grain``, network/data/README.md), else
+    ``<grain>_default.csv`` (spheres)."""
+    for name in (f"{grain}_grains.csv", f"{grain}_default.csv"):
+        p = DATA_DIR / name
         if p.is_file():
             return p
     return None
@@ -77,25 +79,33 @@ def requested_porosity(grain: str, porosity: float | None) -> tuple[float | None
 
 
 def reachable_range(meta: dict) -> tuple[float, float] | None:
-    """(low, high) porosity that ``dem.pack --porosity`` reached for this grain, from the JSON."""
-    r = meta.get("porosity_search", {}).get("reachable") if isinstance(meta, dict) else None
+    """(low, high) porosity ``dem.pack --porosity`` reaches for this grain, from the JSON: the
+    porosities of its densest and loosest packing, widened by its tolerance (a request that far
+    outside still lands within the tolerance).
+
+    >>> reachable_range({"porosity_search": {"reachable": [0.35, 0.41], "tol": 0.005}})
+    (0.345, 0.415)
+    """
+    s = meta.get("porosity_search", {}) if isinstance(meta, dict) else {}
+    r = s.get("reachable")
     if r is None or len(r) != 2:
         return None
-    return float(min(r)), float(max(r))
+    tol = float(s.get("tol", 0.0))
+    return round(float(min(r)) - tol, 12), round(float(max(r)) + tol, 12)
 
 
 def check_reachable(porosity: float, own: float | None, reach, grain: str) -> None:
     """ValueError unless ``porosity`` lies in ``reach`` (or, without one, within MAX_SHIFT of
     the packing's ``own`` porosity), naming the reachable range.
 
-    >>> check_reachable(0.45, None, (0.37, 0.43), "wheat")
+    >>> check_reachable(0.45, None, (0.37, 0.43), "wheat")  # doctest: +ELLIPSIS
     Traceback (most recent call last):
     ...
-    ValueError: porosity 0.45 is outside the range a packing of wheat reaches: 0.3700-0.4300 (dem.pack --porosity, deposition friction 0-1)
+    ValueError: porosity 0.45 is outside the range a packing of wheat reaches: 0.3700-0.4300 (...)
     """
     if reach is not None:
         lo, hi = reach
-        how = "dem.pack --porosity, deposition friction 0-1"
+        how = "dem.pack --porosity: its densest and loosest packing +- its tolerance"
     elif own is not None:
         lo, hi = own - MAX_SHIFT, own + MAX_SHIFT
         how = f"the packing's own {own:.4f} +- {MAX_SHIFT} along the band; no recorded range"
