@@ -3,11 +3,18 @@
     python -m dem.bench                       # N = 1000 ... 50000, writes dem_bench.json
     python -m dem.bench --n 20000 --repeat 3
     python -m dem.bench --mass-scale-study    # small packing made with S = 1, 10, 100
+    python -m dem.bench --grains 500 2000 5000   # the grain engine (soybean templates)
+    python -m dem.bench --grain-pack 5000        # + wall time of dem.pack for 5000 soybeans
 
 Scene for the rate: N spheres of radius 3.25 mm on a simple cubic lattice 6.5 mm apart
 (overlap 1e-4 r, six contacts each, close to the 4–6 true contacts of a settled bed),
 with gravity, box walls and the Verlet list, density scaling 100: the inner loop of
-``dem.pack``. The JSON records the load average, platform, CPU count and a timestamp.
+``dem.pack``. Grain rows (``--grains G``): G soybean templates (6 spheres) aligned on a
+lattice of their length, width and thickness (overlap 1e-4 of each), the same walls, gravity and
+scaling, timed in sphere-steps/s of :class:`dem.ClumpSimulation`. ``--grain-pack G`` times
+``python -m dem.pack --scene box --grain soybean`` for G grains in a cube (as a subprocess,
+numba compilation excluded by a warm-up run). The JSON records the load average, platform, CPU
+count and a timestamp.
 """
 
 from __future__ import annotations
@@ -24,6 +31,8 @@ import numpy as np
 from ._container import Container, make_simulation
 from ._procedures import pack_bed
 from ._perf import tune_malloc
+from .clumps import ClumpSimulation
+from .templates import library_template
 
 
 def lattice_simulation(n, *, rng=0, mass_scale=100.0, threads=None):
@@ -68,6 +77,70 @@ def rate(n, *, steps=None, repeat=3, threads=None):
     }
 
 
+def grain_lattice_simulation(n_grains, *, grain="soybean", mass_scale=100.0):
+    """G library grains, all aligned with the axes, on a lattice of their extent (L, W, T) shrunk by
+    1e-4 (neighbours along x, y, z touch) in a closed box that fits it: the grain rate scene."""
+    t = library_template(grain)
+    ext = t.extent_m * (1 - 1e-4)
+    nx = max(2, int(round((n_grains / 2) ** (1 / 3))))
+    nz = int(np.ceil(n_grains / (nx * nx)))
+    g = np.stack(np.meshgrid(np.arange(nx), np.arange(nx), np.arange(nz), indexing="ij"), -1).reshape(-1, 3)
+    x = (g[:n_grains] + 0.5) * ext
+    x[:, :2] -= nx * ext[:2] / 2
+    c = Container("box", (nx * t.extent_m[0], nx * t.extent_m[1]), nz * t.extent_m[2])
+    q = np.tile([1.0, 0.0, 0.0, 0.0], (len(x), 1))
+    return ClumpSimulation([t], np.zeros(len(x), int), x, q, np.ones(len(x)), c.walls(lid=True),
+                           mass_scale=mass_scale)
+
+
+def grain_rate(n_grains, *, steps=None, repeat=3):
+    """Sphere-steps per second of the grain engine on :func:`grain_lattice_simulation`."""
+    sim = grain_lattice_simulation(n_grains)
+    n = len(sim.radii)
+    for _ in range(5):
+        sim.step()
+    steps = steps or max(10, int(1e6 / n))
+    times, cpu = [], []
+    for _ in range(repeat):
+        t, c = time.perf_counter(), time.process_time()
+        for _ in range(steps):
+            sim.step()
+        times.append(time.perf_counter() - t)
+        cpu.append(time.process_time() - c)
+    times = np.array(times)
+    return {"grains": int(sim.n_grains), "n": int(n), "steps": steps, "contacts": int(len(sim.contact_fn)),
+            "wall_contacts": int(len(sim.last_wall_fn)), "seconds": times.tolist(), "cpu_seconds": cpu,
+            "rate_best": float(n * steps / times.min()), "rate_median": float(n * steps / np.median(times)),
+            "rate_per_cpu_s_best": float(n * steps / min(cpu)), "ms_per_step_best": float(1e3 * times.min() / steps),
+            "loadavg": os.getloadavg()}
+
+
+def grain_pack_time(n_grains, *, seed=1, porosity=0.40985, out_dir=None):
+    """Wall time of ``python -m dem.pack --scene box --grain soybean --n-grains G`` in a cube holding
+    G soybeans at ``porosity`` (side (G V_g / (1 - porosity))^(1/3)), run as a subprocess after a
+    one-grain-count warm-up that loads numba's cache. Returns the command, times, load, summary."""
+    import subprocess
+    import tempfile
+    side = float((n_grains * library_template("soybean").volume_m3 / (1 - porosity)) ** (1 / 3))
+    out_dir = out_dir or tempfile.mkdtemp(prefix="grain_pack_")
+    cmd = [sys.executable, "-m", "dem.pack", "--scene", "box", "--grain", "soybean", "--size", f"{side:.4f}",
+           f"{side:.4f}", "--height", f"{side:.4f}", "--n-grains", str(n_grains), "--seed", str(seed),
+           "--quiet", "--out", os.path.join(out_dir, "bed.csv")]
+    warm = cmd[:cmd.index("--n-grains") + 1] + ["20"] + cmd[cmd.index("--n-grains") + 2:-1] + \
+        [os.path.join(out_dir, "warm.csv")]
+    subprocess.run(warm, check=True, capture_output=True)
+    load0, t0, c0 = os.getloadavg(), time.perf_counter(), os.times()
+    done = subprocess.run(cmd, check=True, capture_output=True, text=True)
+    wall, c1 = time.perf_counter() - t0, os.times()
+    with open(os.path.join(out_dir, "bed.json")) as f:
+        summary = json.load(f)
+    return {"grains": n_grains, "side_m": side, "command": " ".join(cmd[1:]), "wall_s": wall,
+            "cpu_s": (c1.children_user - c0.children_user) + (c1.children_system - c0.children_system),
+            "loadavg_before": load0, "loadavg_after": os.getloadavg(), "steps": summary["steps"],
+            "n_spheres": summary["n_spheres"], "pack_wall_time_s": summary["wall_time_s"],
+            "porosity_network_region": summary.get("porosity_network_region"), "stdout": done.stdout[-2000:]}
+
+
 def mass_scale_study(scales=(1.0, 10.0, 100.0), *, seed=1, settle_time_s=0.3, grow_time_s=0.04):
     """Pack the same small box (0.05 x 0.02 x 0.05 m, ~200 spheres) with several density
     scalings S, with the same physical expansion and settling times (S = 1 is the reference)."""
@@ -103,6 +176,10 @@ def main(argv=None) -> int:
                    help="instead of the rates: pack one bed at each --scales mass scale and compare")
     p.add_argument("--scales", type=float, nargs="+", default=[1.0, 10.0, 100.0],
                    help="--mass-scale-study: density scalings (default 1 10 100)")
+    p.add_argument("--grains", type=int, nargs="+", default=None,
+                   help="instead of the sphere rates: grain-engine rates for these soybean grain counts")
+    p.add_argument("--grain-pack", type=int, default=None, metavar="G",
+                   help="also time python -m dem.pack --grain soybean for G grains in a cube (e.g. 5000)")
     p.add_argument("--json", default="dem_bench.json", help="output JSON path (default dem_bench.json)")
     args = p.parse_args(argv)
     meta = {"loadavg_before": os.getloadavg(), "platform": platform.platform(), "cpu_count": os.cpu_count(),
@@ -111,6 +188,23 @@ def main(argv=None) -> int:
     result = {"meta": meta}
     if args.mass_scale_study:
         result["mass_scale_study"] = mass_scale_study(tuple(args.scales))
+    elif args.grains or args.grain_pack:
+        print(f"{'grains':>7} {'spheres':>8} {'contacts':>9} {'ms/step':>8} {'s-steps/s best':>15} {'median':>12} "
+              f"{'per CPU-s':>12} {'load':>5}")
+        rows = []
+        for g in args.grains or []:
+            r = grain_rate(g, steps=args.steps, repeat=args.repeat)
+            rows.append(r)
+            print(f"{r['grains']:7d} {r['n']:8d} {r['contacts']:9d} {r['ms_per_step_best']:8.2f} "
+                  f"{r['rate_best']:15.3e} {r['rate_median']:12.3e} {r['rate_per_cpu_s_best']:12.3e} "
+                  f"{r['loadavg'][0]:5.2f}", flush=True)
+        result["grain_rates"] = rows
+        if args.grain_pack:
+            r = grain_pack_time(args.grain_pack)
+            result["grain_pack"] = r
+            print(f"dem.pack {r['grains']} soybeans ({r['n_spheres']} spheres, {r['side_m']:.3f} m cube): "
+                  f"{r['wall_s']:.1f} s wall, {r['cpu_s']:.1f} s CPU, {r['steps']} steps, load "
+                  f"{r['loadavg_before'][0]:.2f} -> {r['loadavg_after'][0]:.2f}", flush=True)
     else:
         print(f"{'N':>7} {'pairs':>8} {'contacts':>9} {'ms/step':>8} {'p-steps/s best':>15} {'median':>12} "
               f"{'per CPU-s':>12} {'threads':>8}")

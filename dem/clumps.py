@@ -36,7 +36,13 @@ from ._material import SOYBEAN, Material
 from ._neighbors import VerletList
 from ._rigid import quat_to_matrix
 
-__all__ = ["ClumpSimulation"]
+__all__ = ["ClumpSimulation", "GRAIN_SKIN_FRACTION"]
+
+#: Default Verlet skin over the largest sphere radius for grains (spheres: 0.4). A soybean's six
+#: spheres lie within 0.8 mm of its centre (radii 2.8-2.9 mm), so two touching grains list up to
+#: 36 sphere pairs. CPU time of the 253-grain `dem.pack --scene box --grain soybean` bed (21 400
+#: steps, the same bits at every skin): 4.6 s at 0.4, 3.7 s at 0.2 and at 0.1 (load 8.3-8.6).
+GRAIN_SKIN_FRACTION = 0.2
 
 
 class ClumpSimulation(Simulation):
@@ -58,7 +64,9 @@ class ClumpSimulation(Simulation):
         Orientations (w, x, y, z), body to world.
     scales : (G,) array
         Size of each grain relative to its template (growth scales the whole template).
-    walls, material, gravity_m_s2, mass_scale, dt_safety, skin_m, threads : as :class:`dem.Simulation`.
+    walls, material, gravity_m_s2, mass_scale, dt_safety, threads : as :class:`dem.Simulation`.
+    skin_m : float | None
+        Verlet skin, m; default :data:`GRAIN_SKIN_FRACTION` times the largest sphere radius.
     """
 
     def __init__(self, templates, kind, centers, quaternions, scales, walls, material=SOYBEAN, *,
@@ -88,7 +96,7 @@ class ClumpSimulation(Simulation):
         self._arm = np.zeros((len(radii), 3))
         super().__init__(np.zeros((len(radii), 3)), radii, walls, material, gravity_m_s2=gravity_m_s2,
                          mass_scale=mass_scale, dt_safety=dt_safety, threads=threads,
-                         skin_m=skin_m if skin_m is not None else 0.4 * float(radii.max()))
+                         skin_m=skin_m if skin_m is not None else GRAIN_SKIN_FRACTION * float(radii.max()))
         self.verlet = VerletList(self.verlet.skin, groups=self.gid)
         self._poses()
 

@@ -66,3 +66,28 @@ def test_lattice_box_holds_the_lattice():
     box = Container("box", (4 * 0.0065, 4 * 0.0065), 8 * 0.0065)
     assert np.all(np.abs(x[:, :2]) + sim.radii[:, None] <= np.array(box.size_m) / 2 + 1e-6)
     assert np.all((x[:, 2] - sim.radii >= -1e-6) & (x[:, 2] + sim.radii <= box.fill_height_m + 1e-6))
+
+
+def test_grain_lattice_touches_its_neighbours_once_per_bond():
+    # 16 soybeans on a 2 x 2 x 4 lattice of their extent shrunk by 1e-4: 28 grain bonds. The template's
+    # four middle spheres (r = c) touch their partners across a z bond, the tip spheres across an x
+    # bond and the outer row spheres across a y bond: 8 + 8 + 12 * 4 = 64 sphere contacts; the floor
+    # carries the four middle spheres of the 4 bottom grains
+    sim = bench.grain_lattice_simulation(16)
+    sim.step()
+    assert (sim.n_grains, len(sim.radii)) == (16, 96)
+    assert len(sim.contact_fn) == 64 and len(sim.last_wall_fn) == 16
+    assert len(np.unique(np.sort(sim.touching_grains, axis=1), axis=0)) == 28
+    # overlap 1e-4 of the thickness 5.77 mm at kn 2e6 N/m: F_n = 1.15 N
+    assert np.median(sim.contact_fn) == pytest.approx(2e6 * 1e-4 * sim.templates[0].extent_m[2], rel=0.01)
+
+
+def test_grain_rate_row_and_json(tmp_path, capsys):
+    r = bench.grain_rate(16, steps=4, repeat=2)
+    assert (r["grains"], r["n"], r["steps"]) == (16, 96, 4)
+    assert r["rate_best"] == pytest.approx(96 * 4 / min(r["seconds"]), rel=1e-12) and r["rate_best"] >= r["rate_median"]
+    assert len(r["loadavg"]) == 3
+    out = tmp_path / "g.json"
+    assert bench.main(["--grains", "16", "--steps", "3", "--repeat", "1", "--json", str(out)]) == 0
+    assert "s-steps/s best" in capsys.readouterr().out
+    assert [row["grains"] for row in json.loads(out.read_text())["grain_rates"]] == [16]
