@@ -50,7 +50,7 @@ def load_derived(saved, shape):
         return None
     if a.dtype != np.float64 or a.shape != (len(ROWS), int(np.prod(shape))):
         return None
-    out = dict(zip(ROWS, a))
+    out = dict(zip(ROWS, np.asarray(a)))      # plain ndarray views: no memmap wrapping later
     out["cell_ok"] = out["cell_ok"] > 0.5
     return out
 
