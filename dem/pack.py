@@ -46,9 +46,10 @@ def _parser():
     p.add_argument("--height", type=float, help="fill height (m) for box/cylinder")
     p.add_argument("--porosity", type=float, default=None,
                    help="target porosity (spheres: default 0.408, Table 3.1). With --grain: reached within "
-                        "--porosity-tol in network's sample region by searching the procedure's lever (closed-box "
-                        "growth .. deposition friction, 3-6 packings), or exit 2 with the reachable range; without it one packing at "
-                        "--deposition-friction, grain count from the grain's measured loose-fill porosity")
+                        "--porosity-tol in network's sample region by searching the procedure's lever "
+                        "(closed-box growth .. deposition friction, 3-6 packings), or exit 2 with the "
+                        "reachable range; without it one packing at --deposition-friction, grain count "
+                        "from the grain's measured loose-fill porosity")
     p.add_argument("--porosity-tol", type=float, default=0.005, help="--grain --porosity: tolerance (default 0.005)")
     p.add_argument("--deposition-friction", type=float, default=None,
                    help="--grain: grain-grain friction while the grains grow and fall (default 0: the densest "

@@ -7,8 +7,9 @@ taken in); else, for a grain without one, the packing's own. The network is solv
 of porosity :math:`\varepsilon_p` (its interior Monte-Carlo porosity); the prediction is moved to ε
 along the porosity band's computed slope S(U) (:mod:`network._report_band`), not by packing anew:
 
-.. math:: g(U; \varepsilon) = g(U; \varepsilon_p)\,\exp\!\big(S(U)\,(\varepsilon - \varepsilon_p)\big),
-   \qquad \sigma_{\ln g} = |\varepsilon - \varepsilon_p|\,\sigma_S
+.. math:: g(U; \varepsilon) = g(U; \varepsilon_p)\,
+   \exp\!\big(S(U)\,(\varepsilon - \varepsilon_p)\big), \qquad
+   \sigma_{\ln g} = |\varepsilon - \varepsilon_p|\,\sigma_S
 
 (g in Pa/m; σ_S the slope's standard error). The porosities a packing of the grain can reach
 are those its companion JSON records (``porosity_search.reachable`` of ``dem.pack --porosity``,
@@ -73,8 +74,9 @@ def requested_porosity(grain: str, porosity: float | None) -> tuple[float | None
     bed = BED[grain]
     if bed.loose_fill_porosity is not None:
         lo, hi = bed.bulk_porosity
-        return bed.loose_fill_porosity, (f"the grain's measured loose-fill bulk porosity, middle of "
-                                         f"{lo:g}-{hi:g} ({bed.bulk_porosity_source})")
+        why = (f"the grain's measured loose-fill bulk porosity, middle of {lo:g}-{hi:g} "
+               f"({bed.bulk_porosity_source})")
+        return bed.loose_fill_porosity, why
     return None, f"the packing's own (no measured loose-fill porosity for {grain})"
 
 

@@ -315,8 +315,8 @@ def print_report(r) -> None:
           f"{r['porosity_move']}")
     f = [p["porosity_shift_ln_stderr"] for p in r["points"]]
     if r["porosity"] != r["porosity_packing"]:
-        print(f"  the move multiplies dP/L by {min(p['porosity_shift_factor'] for p in r['points']):.4f}"
-              f"-{max(p['porosity_shift_factor'] for p in r['points']):.4f}, uncertain by "
+        sf = [p["porosity_shift_factor"] for p in r["points"]]
+        print(f"  the move multiplies dP/L by {min(sf):.4f}-{max(sf):.4f}, uncertain by "
               f"+-{100 * max(f):.1f} % (|de| x the slope's standard error)")
     print(f"d32 {r['sauter_diameter_m'] * 1e3:.3f} mm, kernel density "
           f"{r['particle_density_kg_m3']:g} kg/m^3 ({r['particle_density_source']}), bulk "
