@@ -9,7 +9,11 @@ cells moved k by < 0.1 %).
 import numpy as np
 import pytest
 
-from network.conductance import ONSET_SLOPE, expansion_coefficient, turning_cosines
+import throats
+from network.conductance import (ONSET_SLOPE, contraction_coefficient, expansion_coefficient,
+                                 inertial_coefficients, onset_scales, turning_cosines)
+from network.packing import Packing
+from network.pores import tessellate
 from network.flow import conduit_flow
 from network.validation import DERIVED_LAW, FINNEY_PATH, finney_inertial_case
 
@@ -97,3 +101,24 @@ def test_finney_derived_law_at_three_reynolds_numbers():
     # values recorded at the commit that added this file (docs/inertial-flow.md)
     np.testing.assert_allclose(case.k_ratio, [1.00265, 1.05216, 1.57470], rtol=2e-3)
     np.testing.assert_allclose(case.error["beetstra"], [0.000, -0.028, -0.075], atol=0.003)
+
+
+def test_smooth_contraction_and_onset_scales_on_two_tetrahedra():
+    # two tetrahedra sharing face 0 (three spheres r 0.3 at unit spacing); h 0.25 each side
+    c = np.array([[0, 0, 0], [1, 0, 0], [0.5, 0.87, 0], [0.5, 0.29, 0.82], [0.5, 0.29, -0.82]])
+    tess = tessellate(Packing(c, np.full(5, 0.3)))
+    assert tess.throat_pores[0].tolist() == [0, 1]
+    h = np.array([[0.25, 0.25]])
+    sharp = inertial_coefficients(tess, [0], h, density_kg_m3=1.2)
+    smooth = inertial_coefficients(tess, [0], h, density_kg_m3=1.2, contraction="smooth")
+    aw = throats.open_area(tess.throat_radii[:1], tess.throat_sides[:1])[0]
+    rk = np.sqrt(0.3**2 - 0.25**2)
+    sigma = aw / throats.open_area(np.full((1, 3), rk), tess.throat_sides[:1])[0]
+    np.testing.assert_allclose(smooth, 1.2 / (2 * aw**2) * (1 - sigma) ** 2, rtol=1e-12)
+    np.testing.assert_allclose(sharp - smooth,
+                               1.2 / (2 * aw**2) * contraction_coefficient(sigma), rtol=1e-12)
+    # c |q| = Re_w / Re_c, Re_w = rho |q| D_w / (mu A_w), Re_c = k_inf a / (c_1 h)
+    cs = onset_scales(tess, [0], h, smooth, density_kg_m3=1.2, viscosity_pa_s=2e-5)
+    re_per_q = 1.2 * 2 * np.sqrt(aw / np.pi) / (2e-5 * aw)
+    re_c = (1 - sigma) ** 2 * 0.3 / (ONSET_SLOPE * 0.25)
+    np.testing.assert_allclose(cs, re_per_q / re_c, rtol=1e-12)
