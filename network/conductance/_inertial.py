@@ -18,9 +18,14 @@ its own kinetic energy and cancel along every path between inlet and outlet bodi
 left out so that every conduit's law is monotone (Newton's Jacobian stays a weighted graph
 Laplacian). ``profile='laminar'`` takes the expansion's momentum and energy balances with the
 Poiseuille-tube profile coefficients (alpha 2, beta 4/3) instead of flat ones; the weak-inertia
-onset is the solver's (:func:`network.flow.conduit_flow`, ``crossover``). No coefficient is
-fitted to bed-scale data. Derivation, measured onset and the validation against the LBM drag
-laws: ``docs/inertial-flow.md``.
+onset is the solver's (:func:`network.flow.conduit_flow`, ``crossover``).
+
+The law derived from single-constriction Navier-Stokes (``network.validation.DERIVED_LAW``)
+uses ``contraction='smooth'`` (no vena contracta at a sphere-rounded window), the expansion
+against the downstream body's outflow direction (``cos_theta`` from :func:`turning_cosines`)
+and the window-Reynolds onset of :func:`onset_scales`. No coefficient is fitted to bed-scale
+data. Derivations, the Navier-Stokes table and the validation against the LBM drag laws:
+``docs/inertial-flow.md``.
 """
 
 from __future__ import annotations
@@ -32,8 +37,7 @@ import throats
 from .._air import MU_AIR_PA_S, RHO_AIR_KG_M3, check_density, check_viscosity
 
 __all__ = ["ONSET_SLOPE", "PROFILES", "contraction_coefficient", "expansion_coefficient",
-           "inertial_coefficients", "onset_scales",
-           "turning_cosines"]
+           "inertial_coefficients", "onset_scales", "turning_cosines"]
 
 #: Low-Re slope of a single sphere-ring constriction's excess loss coefficient,
 #: :math:`dk/dRe_w = c_1 h/a`: axisymmetric Navier-Stokes of six constrictions

@@ -10,7 +10,9 @@ signed flow is the monotone function
 With ``crossover`` :math:`X_c` the inertial term has a weak-inertia onset,
 :math:`K q|q|\,X/(X_c+X)`, :math:`X = Kg|q|`: its excess over the viscous drop starts as
 :math:`X^2/X_c` (Re² per conduit, the minimum-dissipation argument of
-``docs/inertial-flow.md``) and tends to :math:`Kq|q|` at high Re.
+``docs/inertial-flow.md``) and tends to :math:`Kq|q|` at high Re. With ``onset_scale`` c the
+onset follows the window Reynolds number instead, :math:`K q|q|\,t/\sqrt{1+t^2}`,
+:math:`t = c|q|` (single-constriction Navier-Stokes, :func:`network.conductance.onset_scales`).
 
 The unknowns are the free pore pressures and the common inlet pressure P (outlet pores at 0);
 the equations are mass balance in every free pore and a total inlet flow :math:`Q = UA`. The
