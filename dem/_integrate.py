@@ -225,8 +225,13 @@ class Simulation:
     def _evaluate(self, advance):
         if self.verlet.needs_rebuild(self._x, self.radii):
             self._rebuild()
-        mat, dt, vl = self.material, self._dt, self.verlet
         t0 = time.perf_counter()
+        self._step_kernels(advance)
+        self.threads.record(time.perf_counter() - t0)
+
+    def _step_kernels(self, advance):
+        """The compiled passes of one evaluation (:mod:`dem._kernels`), timed for the thread choice."""
+        mat, dt, vl = self.material, self._dt, self.verlet
         if not self._coef_valid:
             pair_damping(self._ms, self._pi, self._pj, mat.damping_ratio, mat.kn_pp, mat.ks_pp, self._cn, self._ct)
             self._coef_valid = True
@@ -238,7 +243,6 @@ class Simulation:
                         self.wall_vz_m_s, self.wall_shear, self._wall_fn, self._wall_touch, mat.kn_pw, mat.ks_pw,
                         mat.damping_ratio, mat.wall_friction, dt, self._inv_m, self._inv_i, self._force,
                         self._torque, advance)
-        self.threads.record(time.perf_counter() - t0)
 
     def forces(self):
         """Net force and torque on every particle, both (3, N) component-first (scaled masses).

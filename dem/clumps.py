@@ -173,11 +173,15 @@ class ClumpSimulation(Simulation):
         super().set_state(state)
 
     # ------------------------------------------------------------------ forces and stepping
-    def _grain_pass(self, advance):
-        self._poses()
-        self._evaluate(False)
+    def _step_kernels(self, advance):
+        """The sphere step's kernels without their update, then the grains' sums and update."""
+        super()._step_kernels(False)
         grain_update(self.X, self.V, self.q, self.L, self._inertia_s, self._start, self._arm, self._force,
                      self._torque, self._weight, self._inv_m_g, self._dt, self._force_g, self._torque_g, advance)
+
+    def _grain_pass(self, advance):
+        self._poses()
+        self._evaluate(advance)
 
     def forces(self):
         """Net force and torque on every grain, (G, 3) each (scaled masses; advances the springs)."""
