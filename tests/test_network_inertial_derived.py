@@ -14,7 +14,7 @@ from network.conductance import (ONSET_SLOPE, contraction_coefficient, expansion
                                  inertial_coefficients, onset_scales, turning_cosines)
 from network.packing import Packing
 from network.pores import tessellate
-from network.flow import conduit_flow
+from network.flow import conduit_flow, solve_inertial
 from network.validation import DERIVED_LAW, FINNEY_PATH, finney_inertial_case
 
 NS_RE = np.array([1, 2, 5, 10, 20, 50, 100, 200], dtype=float)
@@ -71,6 +71,18 @@ def test_throat_onset_conduit_flow():
     assert q[0] ** 2 == pytest.approx(1e8, rel=1e-3)
     with pytest.raises(ValueError, match="not both"):
         conduit_flow(dp, g, K, crossover=1.0, onset_scale=c)
+    conns = np.array([[0, 1], [1, 2]])
+    with pytest.raises(ValueError, match="not both"):
+        solve_inertial(3, conns, np.ones(2), np.ones(2), [0], [2], [1.0], crossover=1.0,
+                       onset_scale=np.ones(2))
+    with pytest.raises(ValueError, match="onset_scale must have 2 rows"):
+        solve_inertial(3, conns, np.ones(2), np.ones(2), [0], [2], [1.0],
+                       onset_scale=np.ones(3))
+    # two conduits in series, 1 m3/s: each drop is 1 + 1 * 1/sqrt(2) (t = 1)
+    pts = solve_inertial(3, conns, np.ones(2), np.ones(2), [0], [2], [1.0],
+                         onset_scale=np.ones(2))
+    assert pts[0].converged
+    assert pts[0].dp_pa == pytest.approx(2 * (1 + 1 / np.sqrt(2)), rel=1e-10)
 
 
 def test_expansion_against_the_outflow_direction():

@@ -187,6 +187,8 @@ def solve_inertial(n_pores, conns, g, K, inlet, outlet, flows_m3_s, *, tol: floa
     if np.any(K < 0) or np.any(~np.isfinite(K)):
         raise ValueError("inertial coefficients must be finite and >= 0")
     c_on = None if onset_scale is None else np.asarray(onset_scale, dtype=float)
+    if c_on is not None and crossover is not None:
+        raise ValueError("give crossover or onset_scale, not both")
     if c_on is not None and (c_on.shape[0] != g.size or np.any(c_on < 0)
                              or np.any(~np.isfinite(c_on))):
         raise ValueError(f"onset_scale must have {g.size} rows, finite and >= 0")
