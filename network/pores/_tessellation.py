@@ -167,16 +167,23 @@ class Tessellation:
         return np.flatnonzero(self.throat_pores[:, 1] >= 0)
 
 
-def _circumcenters(p: np.ndarray) -> np.ndarray:
-    """Circumcentres of tetrahedra given as (N, 4, 3) vertex coordinates (NaN when flat)."""
+def _circumcenters(p: np.ndarray, det=None) -> np.ndarray:
+    """Circumcentres of tetrahedra given as (N, 4, 3) vertex coordinates (NaN when flat);
+    ``det`` the determinant of their edge vectors when the caller has it."""
     a = p[:, 1:] - p[:, :1]                      # (N, 3, 3) edge vectors
     rhs = 0.5 * np.einsum("nij,nij->ni", a, a)   # |e|^2 / 2
-    det = np.linalg.det(a)
+    det = np.linalg.det(a) if det is None else det
     ok = np.abs(det) > 0
     out = np.full((p.shape[0], 3), np.nan)
     if ok.any():
         out[ok] = np.linalg.solve(a[ok], rhs[ok][..., None])[..., 0] + p[ok, 0]
     return out
+
+
+def _norm(v):
+    """Row lengths of an (N, 3) array: np.linalg.norm(v, axis=1), same bits, without the slow
+    reduction over a length-3 axis."""
+    return np.sqrt(v[:, 0] * v[:, 0] + v[:, 1] * v[:, 1] + v[:, 2] * v[:, 2])
 
 
 def _local_frame(centers):
@@ -263,8 +270,9 @@ def tessellate(packing: Packing, *, qhull_options: str = QHULL_OPTIONS,
         b = min(a + _CHUNK, n_p)
         pv = pts[simp[a:b]]                                   # (m, 4, 3)
         centroid[a:b] = pv.mean(axis=1)
-        volume[a:b] = np.abs(np.linalg.det(pv[:, 1:] - pv[:, :1])) / 6.0
-        circ[a:b] = _circumcenters(pv)
+        det = np.linalg.det(pv[:, 1:] - pv[:, :1])
+        volume[a:b] = np.abs(det) / 6.0
+        circ[a:b] = _circumcenters(pv, det)
     flat = volume < flat_tol * dbar**3
 
     # throats: face k of t kept when t < neighbour or neighbour is -1
@@ -302,14 +310,14 @@ def tessellate(packing: Packing, *, qhull_options: str = QHULL_OPTIONS,
     for a in range(0, n_t, _CHUNK):
         b = min(a + _CHUNK, n_t)
         p0, p1, p2 = pts[tv[a:b, 0]], pts[tv[a:b, 1]], pts[tv[a:b, 2]]
-        sides[a:b, 0] = np.linalg.norm(p1 - p0, axis=1)
-        sides[a:b, 1] = np.linalg.norm(p2 - p0, axis=1)
-        sides[a:b, 2] = np.linalg.norm(p2 - p1, axis=1)
-        area[a:b] = 0.5 * np.linalg.norm(np.cross(p1 - p0, p2 - p0), axis=1)
+        sides[a:b, 0] = _norm(p1 - p0)
+        sides[a:b, 1] = _norm(p2 - p0)
+        sides[a:b, 2] = _norm(p2 - p1)
+        area[a:b] = 0.5 * _norm(np.cross(p1 - p0, p2 - p0))
         tcent[a:b] = (p0 + p1 + p2) / 3.0
     tied = np.zeros(n_t, dtype=bool)
     cc = circ[ft[inner]] - circ[fn[inner]]
-    tied[inner] = np.linalg.norm(cc, axis=1) < tie_tol * dbar  # NaN compares False
+    tied[inner] = _norm(cc) < tie_tol * dbar  # NaN compares False
     del cc
     tied[inner] |= flat[ft[inner]] | flat[fn[inner]]
 
