@@ -164,7 +164,7 @@ def procedure_lever(lam, *, headroom=0.3, friction_max=DEPOSITION_FRICTION_RANGE
 
 
 def pack_grains_to_porosity(container, template, *, porosity, porosity_tol=0.005, max_packings=6,
-                            **kwargs):
+                            on_packing=None, **kwargs):
     r"""A packing whose porosity in network's region (``porosity_network_region``) is within
     ``porosity_tol`` of ``porosity``, reached by the packing procedure's lever λ (:func:`procedure_lever`).
 
@@ -173,8 +173,9 @@ def pack_grains_to_porosity(container, template, *, porosity, porosity_tol=0.005
     procedure reaches. A request more than ``porosity_tol`` outside them is a ValueError naming the
     reachable range. Inside, regula falsi on φ(λ) (monotone up to the packing noise) packs until
     a bed lands within ``porosity_tol`` or ``max_packings`` beds are spent (then RuntimeError with the
-    closest). Returns what :func:`pack_grains` returns; the summary gains ``porosity_search``:
-    target, tol, reachable range, every (λ, φ) tried.
+    closest). ``on_packing(dict)`` is called after each packing with its λ, headroom, friction,
+    porosity and wall time. Returns what :func:`pack_grains` returns; the summary gains
+    ``porosity_search``: target, tol, reachable range, every (λ, φ) tried.
     """
     if not (np.isfinite(porosity) and 0 < porosity < 1):
         raise ValueError(f"porosity must be in (0, 1), got {porosity!r}")
@@ -191,6 +192,8 @@ def pack_grains_to_porosity(container, template, *, porosity, porosity_tol=0.005
         tried.append({"lever": float(lam), "lid_headroom": head, "deposition_friction": mu,
                       "porosity": e, "porosity_error": out[4]["porosity_network_region_error"],
                       "wall_time_s": out[4]["wall_time_s"]})
+        if on_packing is not None:
+            on_packing(tried[-1])
         out[4]["procedure_lever"] = float(lam)
         return out, e
 

@@ -131,7 +131,8 @@ def _pack_grains(args) -> int:
     if args.porosity is not None and args.deposition_friction is None:
         try:
             xs, r, gid, grains, s = pack_grains_to_porosity(container, template, porosity=args.porosity,
-                                                            porosity_tol=args.porosity_tol, **kw)
+                                                            porosity_tol=args.porosity_tol,
+                                                            on_packing=_packing_line, **kw)
         except RuntimeError as e:
             print(f"error: {e}", file=sys.stderr)
             return EXIT_FAILED
@@ -151,6 +152,13 @@ def _pack_grains(args) -> int:
         print(f"porosity search: reachable {ps['reachable'][0]:.4f}-{ps['reachable'][1]:.4f}; tried "
               + ", ".join(f"lever {t['lever']:+.3f} -> {t['porosity']:.4f}" for t in ps["tried"]))
     return 0
+
+
+def _packing_line(t):
+    """One stderr line per packing of a porosity search."""
+    print(f"[search] lever {t['lever']:+.3f} (lid headroom {t['lid_headroom']:.3f}, deposition friction "
+          f"{t['deposition_friction']:.3f}): porosity {t['porosity']:.4f} +- {t['porosity_error']:.4f}, "
+          f"{t['wall_time_s']:.0f} s", file=sys.stderr, flush=True)
 
 
 def _grain_porosity(args, name):
