@@ -48,8 +48,14 @@ def as_throats(radii, sides):
 
 def mean_radius(radii):
     """Mean radius r̄ = (r1 + r2 + r3)/3 of each row, (N,), permutation-exact (sorted sum)."""
-    r = np.sort(np.atleast_2d(np.asarray(radii, dtype=float)), axis=1)
-    return (r[:, 0] + r[:, 1] + r[:, 2]) / 3.0
+    r = np.atleast_2d(np.asarray(radii, dtype=float))
+    if r.ndim != 2 or r.shape[1] != 3:
+        r = np.sort(r, axis=1)
+        return (r[:, 0] + r[:, 1] + r[:, 2]) / 3.0
+    # ascending by a sorting network: np.sort's values (NaN aside), without its per-row cost
+    lo1, hi1 = np.minimum(r[:, 0], r[:, 1]), np.maximum(r[:, 0], r[:, 1])
+    x = np.maximum(lo1, r[:, 2])
+    return (np.minimum(lo1, r[:, 2]) + np.minimum(hi1, x) + np.maximum(hi1, x)) / 3.0
 
 
 def triangle_vertices(sides):
