@@ -77,7 +77,7 @@ def rate(n, *, steps=None, repeat=3, threads=None):
     }
 
 
-def grain_lattice_simulation(n_grains, *, grain="soybean", mass_scale=100.0):
+def grain_lattice_simulation(n_grains, *, grain="soybean", mass_scale=100.0, threads=None):
     """G library grains, all aligned with the axes, on a lattice of their extent (L, W, T) shrunk by
     1e-4 (neighbours along x, y, z touch) in a closed box that fits it: the grain rate scene."""
     t = library_template(grain)
@@ -90,12 +90,13 @@ def grain_lattice_simulation(n_grains, *, grain="soybean", mass_scale=100.0):
     c = Container("box", (nx * t.extent_m[0], nx * t.extent_m[1]), nz * t.extent_m[2])
     q = np.tile([1.0, 0.0, 0.0, 0.0], (len(x), 1))
     return ClumpSimulation([t], np.zeros(len(x), int), x, q, np.ones(len(x)), c.walls(lid=True),
-                           mass_scale=mass_scale)
+                           mass_scale=mass_scale, threads=threads)
 
 
-def grain_rate(n_grains, *, steps=None, repeat=3):
-    """Sphere-steps per second of the grain engine on :func:`grain_lattice_simulation`."""
-    sim = grain_lattice_simulation(n_grains)
+def grain_rate(n_grains, *, steps=None, repeat=3, threads=None):
+    """Sphere-steps per second of the grain engine on :func:`grain_lattice_simulation` (``threads``
+    as :func:`rate`)."""
+    sim = grain_lattice_simulation(n_grains, threads=threads)
     n = len(sim.radii)
     for _ in range(5):
         sim.step()
@@ -112,7 +113,8 @@ def grain_rate(n_grains, *, steps=None, repeat=3):
             "wall_contacts": int(len(sim.last_wall_fn)), "seconds": times.tolist(), "cpu_seconds": cpu,
             "rate_best": float(n * steps / times.min()), "rate_median": float(n * steps / np.median(times)),
             "rate_per_cpu_s_best": float(n * steps / min(cpu)), "ms_per_step_best": float(1e3 * times.min() / steps),
-            "loadavg": os.getloadavg()}
+            "loadavg": os.getloadavg(),
+            "steps_by_threads": {str(k): v for k, v in sim.threads.steps_by_threads.items()}}
 
 
 def grain_pack_time(n_grains, *, seed=1, porosity=0.40985, out_dir=None):
@@ -190,14 +192,14 @@ def main(argv=None) -> int:
         result["mass_scale_study"] = mass_scale_study(tuple(args.scales))
     elif args.grains or args.grain_pack:
         print(f"{'grains':>7} {'spheres':>8} {'contacts':>9} {'ms/step':>8} {'s-steps/s best':>15} {'median':>12} "
-              f"{'per CPU-s':>12} {'load':>5}")
+              f"{'per CPU-s':>12} {'threads':>8} {'load':>5}")
         rows = []
         for g in args.grains or []:
-            r = grain_rate(g, steps=args.steps, repeat=args.repeat)
+            r = grain_rate(g, steps=args.steps, repeat=args.repeat, threads=args.threads)
             rows.append(r)
             print(f"{r['grains']:7d} {r['n']:8d} {r['contacts']:9d} {r['ms_per_step_best']:8.2f} "
                   f"{r['rate_best']:15.3e} {r['rate_median']:12.3e} {r['rate_per_cpu_s_best']:12.3e} "
-                  f"{r['loadavg'][0]:5.2f}", flush=True)
+                  f"{max(r['steps_by_threads'], key=r['steps_by_threads'].get):>8} {r['loadavg'][0]:5.2f}", flush=True)
         result["grain_rates"] = rows
         if args.grain_pack:
             r = grain_pack_time(args.grain_pack)
