@@ -27,6 +27,7 @@ from __future__ import annotations
 import json
 import os
 import time
+from concurrent.futures import ProcessPoolExecutor
 from dataclasses import replace
 from pathlib import Path
 
@@ -164,7 +165,7 @@ def procedure_lever(lam, *, headroom=0.3, friction_max=DEPOSITION_FRICTION_RANGE
 
 
 def pack_grains_to_porosity(container, template, *, porosity, porosity_tol=0.005, max_packings=6,
-                            on_packing=None, **kwargs):
+                            on_packing=None, workers=1, **kwargs):
     r"""A packing whose porosity in network's region (``porosity_network_region``) is within
     ``porosity_tol`` of ``porosity``, reached by the packing procedure's lever λ (:func:`procedure_lever`).
 
@@ -174,7 +175,8 @@ def pack_grains_to_porosity(container, template, *, porosity, porosity_tol=0.005
     reachable range. Inside, regula falsi on φ(λ) (monotone up to the packing noise) packs until
     a bed lands within ``porosity_tol`` or ``max_packings`` beds are spent (then RuntimeError with the
     closest). ``on_packing(dict)`` is called after each packing with its λ, headroom, friction,
-    porosity and wall time. Returns what :func:`pack_grains` returns; the summary gains
+    porosity and wall time. ``workers=2`` packs the two ends in two processes (the same beds:
+    a packing depends on its seed only; no progress callback there). Returns what :func:`pack_grains` returns; the summary gains
     ``porosity_search``: target, tol, reachable range, every (λ, φ) tried.
     """
     if not (np.isfinite(porosity) and 0 < porosity < 1):
@@ -184,10 +186,11 @@ def pack_grains_to_porosity(container, template, *, porosity, porosity_tol=0.005
         raise ValueError(f"porosity tolerance must be > 0, got {tol!r}")
     tried, best = [], None
 
-    def pack(lam):
+    def pack(lam, out=None):
         head, mu = procedure_lever(lam)
-        out = pack_grains(container, template, porosity=porosity, deposition_friction=mu,
-                          lid_headroom=head, **kwargs)
+        if out is None:
+            out = pack_grains(container, template, porosity=porosity, deposition_friction=mu,
+                              lid_headroom=head, **kwargs)
         e = out[4]["porosity_network_region"]
         tried.append({"lever": float(lam), "lid_headroom": head, "deposition_friction": mu,
                       "porosity": e, "porosity_error": out[4]["porosity_network_region_error"],
@@ -197,7 +200,15 @@ def pack_grains_to_porosity(container, template, *, porosity, porosity_tol=0.005
         out[4]["procedure_lever"] = float(lam)
         return out, e
 
-    (lo, e_lo), (hi, e_hi) = pack(-1.0), pack(1.0)
+    if workers > 1:
+        with ProcessPoolExecutor(2) as ex:
+            kw = {**kwargs, "progress": None}
+            jobs = [ex.submit(pack_grains, container, template, porosity=porosity,
+                              deposition_friction=procedure_lever(lam)[1],
+                              lid_headroom=procedure_lever(lam)[0], **kw) for lam in (-1.0, 1.0)]
+            (lo, e_lo), (hi, e_hi) = pack(-1.0, jobs[0].result()), pack(1.0, jobs[1].result())
+    else:
+        (lo, e_lo), (hi, e_hi) = pack(-1.0), pack(1.0)
     reach = (min(e_lo, e_hi), max(e_lo, e_hi))
     if not (reach[0] - tol <= porosity <= reach[1] + tol):
         raise ValueError(f"porosity {porosity:g} is outside what this procedure reaches for "

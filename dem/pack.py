@@ -51,6 +51,8 @@ def _parser():
                         "reachable range; without it one packing at --deposition-friction, grain count "
                         "from the grain's measured loose-fill porosity")
     p.add_argument("--porosity-tol", type=float, default=0.005, help="--grain --porosity: tolerance (default 0.005)")
+    p.add_argument("--workers", type=int, default=1, choices=[1, 2],
+                   help="--grain --porosity: processes for the search's two end packings (default 1)")
     p.add_argument("--deposition-friction", type=float, default=None,
                    help="--grain: grain-grain friction while the grains grow and fall (default 0: the densest "
                         "bed; friction then loosens it); the material's friction holds afterwards")
@@ -132,7 +134,8 @@ def _pack_grains(args) -> int:
         try:
             xs, r, gid, grains, s = pack_grains_to_porosity(container, template, porosity=args.porosity,
                                                             porosity_tol=args.porosity_tol,
-                                                            on_packing=_packing_line, **kw)
+                                                            on_packing=_packing_line, workers=args.workers,
+                                                            **kw)
         except RuntimeError as e:
             print(f"error: {e}", file=sys.stderr)
             return EXIT_FAILED
