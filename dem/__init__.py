@@ -14,8 +14,9 @@ pack_bed(container, *, porosity=0.408, rng=None, procedure='lid'|'sediment', ...
 vibrate_bed(centers, radii, container, *, freq_hz, amplitude_m, duration_s, ...) -> VibrationResult
     Sinusoidal vertical motion of the bin (Eq. 3.11) with porosity histories, steady stop and
     checkpoints to resume from; rest_motion tells whether a packing is at rest.
-Simulation, DemInstabilityError, PlaneWall, CylinderWall
-    The time integrator (Verlet list, linear spring–dashpot–Coulomb contacts, walls).
+Simulation, DemInstabilityError, PlaneWall, CylinderWall, ClumpSimulation
+    The time integrator (Verlet list, linear spring–dashpot–Coulomb contacts, walls); rigid
+    multi-sphere grains (ClumpSimulation) run on its kernels with a rigid-body update.
 linear_contact_forces, series_stiffness, damping_coefficient, restitution_coefficient
     The contact law and its closed forms.
 porosity_in_spheres, porosity_in_region, coordination_numbers, Region, lens_volume, sphere_volume

@@ -62,7 +62,8 @@ def _omega(m, lx, ly, lz, ix, iy, iz):
 
 @numba.njit(inline="always", cache=True, error_model="numpy")
 def _rotate_by(px, py, pz, w, x, y, z):
-    """:math:`e^{\\phi} q` for the rotation vector phi = (px, py, pz) (rad): the Hamilton product."""
+    r""":math:`e^{\phi} q` as (w, x, y, z): the unit quaternion of the rotation vector
+    :math:`\phi` = (px, py, pz) (angle :math:`|\phi|` in rad about :math:`\phi/|\phi|`) times q."""
     angle = np.sqrt(px * px + py * py + pz * pz)
     half = 0.5 * angle
     s = np.sin(half) / angle if angle > 1e-8 else 0.5 - angle**2 / 48.0
