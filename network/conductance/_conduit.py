@@ -222,8 +222,11 @@ def side_resistance(radii, sides, h_side, y_window, *, n_sections: int = 8,
             with np.errstate(divide="ignore", invalid="ignore"):
                 cont = np.where(np.isinf(ce), 0.0, yb[rows, last] * ce[rows, last] / ce)
             y[bad] = np.where(mb, cont, yb)
-    closed = ~np.isfinite(y0) | np.any(~np.isfinite(y), axis=1)
-    y = np.where(np.isfinite(y), y, 0.0)
+    fin = np.isfinite(y)
+    closed = ~np.isfinite(y0)
+    for c in range(m + 1):                                      # any(~fin, axis=1), by columns
+        closed |= ~fin[:, c]
+    y = np.where(fin, y, 0.0)
     dth = np.maximum(th_end / m, 1e-300)
     with np.errstate(divide="ignore", invalid="ignore"):
         dy = np.gradient(y, axis=1) / dth[:, None] / dhdth
@@ -241,7 +244,11 @@ def side_resistance(radii, sides, h_side, y_window, *, n_sections: int = 8,
         Hc = H[:, c]
         # the segment [h_{j-1}, h_j] holding Hc; trapezoid up to h_{j-1}, then the part
         # segment with F linearly interpolated
-        j = np.clip(np.sum(h < Hc[:, None] * (1 - 1e-12), axis=1), 1, m)
+        below = Hc * (1 - 1e-12)
+        j = np.zeros(n, dtype=np.int64)
+        for c2 in range(m + 1):                                 # nodes below Hc, by columns
+            j += h[:, c2] < below
+        np.clip(j, 1, m, out=j)
         h0, h1 = h[rows, j - 1], h[rows, j]
         F0, F1 = F[rows, j - 1], F[rows, j]
         with np.errstate(divide="ignore", invalid="ignore"):
@@ -339,7 +346,8 @@ def conduit_conductance(tessellation, throats_idx=None, *, viscosity_pa_s: float
     # conduit heights: normal distance from the face plane to each pore body centre
     xyz = t.packing.centers[t.throat_vertices[idx]]
     nrm = np.cross(xyz[:, 1] - xyz[:, 0], xyz[:, 2] - xyz[:, 0])
-    nrm /= np.maximum(np.linalg.norm(nrm, axis=1, keepdims=True), 1e-300)
+    nrm /= np.maximum(np.sqrt(nrm[:, 0] * nrm[:, 0] + nrm[:, 1] * nrm[:, 1]
+                              + nrm[:, 2] * nrm[:, 2]), 1e-300)[:, None]
     h = np.zeros((idx.size, 2))
     for side in (0, 1):
         pore = tp[:, side]
