@@ -13,15 +13,24 @@ from __future__ import annotations
 
 import numpy as np
 
-from ._boundary import region_boundary
+from ._area_kernel import area_perimeter_rows
+from ._boundary import TOL, region_boundary
 from ._geometry import as_throats, check_rows, mean_radius, triangle_vertices
 
-__all__ = ["area_perimeter_columns", "closed_forms", "exact_area_perimeter", "open_area",
-           "open_area_perimeter"]
+__all__ = ["area_perimeter_columns", "boundary_area_perimeter", "closed_forms", "exact_area_perimeter",
+           "open_area", "open_area_perimeter"]
 
 
 def exact_area_perimeter(r, s):
-    """Exact A and arc perimeter from the boundary engine (units of r̄ in, out)."""
+    """Exact A and arc perimeter of (N, 3) rows ``r``, ``s`` (units of r̄ in, out): the boundary
+    engine's construction as one compiled loop (:mod:`throats._area_kernel`, equal to
+    :func:`boundary_area_perimeter` to 1e-14)."""
+    return area_perimeter_rows(triangle_vertices(s), r, TOL)
+
+
+def boundary_area_perimeter(r, s):
+    """Exact A and arc perimeter from the vectorised boundary engine (units of r̄ in, out):
+    the reference that :func:`exact_area_perimeter`'s loop is tested against."""
     v = triangle_vertices(s)
     res = region_boundary(v, v, r)
     cu, con = res["cu"], res["con"]
