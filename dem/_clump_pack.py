@@ -177,7 +177,8 @@ def pack_grains_to_porosity(container, template, *, porosity, porosity_tol=0.005
     closest). ``on_packing(dict)`` is called after each packing with its λ, headroom, friction,
     porosity and wall time. ``workers=2`` packs the two ends in two processes (the same beds:
     a packing depends on its seed only; no progress callback there). Returns what :func:`pack_grains` returns; the summary gains
-    ``porosity_search``: target, tol, reachable range, every (λ, φ) tried.
+    ``porosity_search``: target, tol, ``reachable`` (the range of all beds made: φ(λ) need not
+    be monotone, wheat's is not), ``ends``, every (λ, φ) tried.
     """
     if not (np.isfinite(porosity) and 0 < porosity < 1):
         raise ValueError(f"porosity must be in (0, 1), got {porosity!r}")
@@ -230,8 +231,10 @@ def pack_grains_to_porosity(container, template, *, porosity, porosity_tol=0.005
             a = (lam, e)
         else:
             b = (lam, e)
+    made = [t["porosity"] for t in tried]  # phi(lambda) need not be monotone: all beds made
     best[4]["porosity_search"] = {
-        "target": float(porosity), "tol": float(tol), "reachable": list(reach), "tried": tried,
+        "target": float(porosity), "tol": float(tol), "reachable": [min(made), max(made)],
+        "ends": list(reach), "tried": tried,
         "lever": "lambda in [-1, 0]: lid headroom 0.3 (1 + lambda), frictionless growth; "
                  "[0, 1]: deposition friction lambda (porosity in network's sample region)"}
     got = best[4]["porosity_network_region"]

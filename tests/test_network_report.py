@@ -167,3 +167,27 @@ def test_end_to_end_bundled_scene(tmp_path, capsys, monkeypatch):
     assert -20 < r["band"]["slopes"][0] < -6            # issue 16: about -11 near 0.40
     op = r["operating_point"]
     assert op["found"] and 0.14 < op["airflow_m3_s"] < 0.2
+
+
+def test_done_when_wheat_from_the_bundled_bed(tmp_path, capsys, monkeypatch):
+    """Issue 16's done-when, with 2 velocities: `--grain wheat --depth 3 --diameter 6` runs on
+    the bundled wheat bed (network/data/wheat_grains.csv, made by dem.pack --porosity 0.402),
+    reports for wheat's measured loose-fill 0.402 (middle of 0.391-0.413, Ramaj 2022), with
+    the kernel density 1240 kg/m^3 (Int. Agrophys. 2003), and writes its figures."""
+    monkeypatch.chdir(tmp_path)
+    out = tmp_path / "w.json"
+    assert main(["--grain", "wheat", "--depth", "3", "--diameter", "6", "--velocities",
+                 "0.01,0.1", "--json", str(out), "-q"]) == 0
+    r = json.loads(out.read_text())
+    assert r["grain"] == "wheat" and r["porosity"] == pytest.approx(0.402, abs=1e-12)
+    assert "Ramaj" in r["porosity_source"] and r["n_spheres"] == 8 * r["n_grains"]
+    assert abs(r["porosity_packing"] - 0.402) < 0.008           # dem.pack's 0.005 + MC noise
+    assert r["bulk_density_kg_m3"] == pytest.approx(1240 * (1 - 0.402), rel=1e-12)
+    assert r["bin"]["grain_mass_t"] == pytest.approx(
+        1240 * 0.598 * np.pi * 9 * 3 / 1000, rel=1e-12)          # 62.9 t in a 6 m x 3 m bin
+    assert r["d272"]["a_pa_s2_m3"] is None
+    assert all(p["d272_pressure_gradient_pa_per_m"] is None for p in r["points"])
+    lo, hi = r["porosity_reachable"]
+    assert lo < 0.402 < hi
+    assert sorted(x.name for x in (tmp_path / "report_wheat").iterdir()) == [
+        "report_band.png", "report_curve.png", "report_system.png"]
