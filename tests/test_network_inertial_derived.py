@@ -104,6 +104,10 @@ def test_turning_cosines_by_hand():
     cos = turning_cosines(centers, verts, xyz, conns, [2.0, 1.0, 1.0], axis=0)
     np.testing.assert_allclose(cos[:, 0], [0.5, 1.0, 0.0], atol=1e-12)   # outlets: the axis
     np.testing.assert_allclose(cos[0, 1], -1.0, atol=1e-12)               # back into 0
+    part = turning_cosines(centers, verts, xyz, conns, [2.0, 1.0, 1.0], axis=0, recovery=0.5)
+    np.testing.assert_allclose(part, cos + 0.5 * (1 - cos), atol=1e-12)
+    with pytest.raises(ValueError, match="recovery"):
+        turning_cosines(centers, verts, xyz, conns, [2.0, 1.0, 1.0], axis=0, recovery=1.5)
 
 
 @pytest.mark.skipif(not FINNEY_PATH.exists(), reason="Finney data not available")

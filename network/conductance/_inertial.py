@@ -180,7 +180,8 @@ def onset_scales(tessellation, throats_idx, h_m, K, *,
     return np.where(np.isfinite(c) & (K > 0), c, 0.0)
 
 
-def turning_cosines(centers_m, throat_vertices, pore_xyz_m, conns, flow_m3_s, axis: int):
+def turning_cosines(centers_m, throat_vertices, pore_xyz_m, conns, flow_m3_s, axis: int, *,
+                    recovery: float = 0.0):
     r"""Cosine between each conduit's jet and the mean outflow of the body it enters, (M, 2).
 
     The jet leaves the window along the face normal :math:`d` (oriented from ``conns[:, 0]``
@@ -188,8 +189,12 @@ def turning_cosines(centers_m, throat_vertices, pore_xyz_m, conns, flow_m3_s, ax
     :math:`M_Q = \sum_{out} |q_g| o_g / \sum_{out} |q_g|` (outflow directions :math:`o_g`,
     weighted by ``flow_m3_s``, e.g. the Stokes flows); a body without outflow (outlet)
     takes the flow axis. Column 0: :math:`d\cdot M_{Q_1}` (flow 0 → 1), column 1:
-    :math:`-d\cdot M_{Q_0}`.
+    :math:`-d\cdot M_{Q_0}`. ``recovery`` f (0 <= f <= 1) recovers that part of the cross
+    momentum: :math:`\cos \to \cos + f(1-\cos)` (f = 0: none, the momentum balance above).
     """
+    f = float(recovery)
+    if not 0.0 <= f <= 1.0:
+        raise ValueError(f"recovery must lie in [0, 1], got {recovery!r}")
     x = np.asarray(centers_m, dtype=float)[np.asarray(throat_vertices, dtype=np.int64)]
     n = np.cross(x[:, 1] - x[:, 0], x[:, 2] - x[:, 0])
     c = np.asarray(conns, dtype=np.int64)
@@ -203,5 +208,6 @@ def turning_cosines(centers_m, throat_vertices, pore_xyz_m, conns, flow_m3_s, ax
     M = np.stack([np.bincount(up, q * n[:, k], npores) for k in range(3)], axis=1)
     with np.errstate(divide="ignore", invalid="ignore"):
         M = np.where(tot[:, None] > 0, M / tot[:, None], np.eye(3)[int(axis)])
-    return np.clip(np.column_stack([np.einsum("ij,ij->i", n, M[c[:, 1]]),
-                                    -np.einsum("ij,ij->i", n, M[c[:, 0]])]), -1.0, 1.0)
+    cos = np.clip(np.column_stack([np.einsum("ij,ij->i", n, M[c[:, 1]]),
+                                   -np.einsum("ij,ij->i", n, M[c[:, 0]])]), -1.0, 1.0)
+    return cos + f * (1.0 - cos)

@@ -87,7 +87,7 @@ class InertialCase:
 def solve_sample_curve(packing, region, velocities_m_s, *, axis=0, policy="table-only",
                        db=None, viscosity_pa_s=1.0, density_kg_m3=1.0, crossover=None,
                        profile="uniform", onset=None, turning=False,
-                       contraction="sharp"):
+                       contraction="sharp", recovery=0.0):
     """The inertial pipeline of :func:`network.solve_network` (conduit model, bodies merged;
     one AMG hierarchy, built for the Stokes solve and reused by every Newton step):
     ``(permeability_m2, length_m, points, seconds)``, ``seconds`` a dict by stage.
@@ -132,7 +132,8 @@ def solve_sample_curve(packing, region, velocities_m_s, *, axis=0, policy="table
     t0 = time.perf_counter()
     if turning:         # expansion into each body against its Stokes outflow direction
         cos = turning_cosines(packing.centers, tess.throat_vertices[sample.throats],
-                              sample.pore_xyz, sample.conns, check["throat_flow"], axis)
+                              sample.pore_xyz, sample.conns, check["throat_flow"], axis,
+                              recovery=recovery)
         K = inertial_coefficients(tess, sample.throats, cres.h_m[keep],
                                   internal=np.asarray(cres.internal)[keep],
                                   density_kg_m3=density_kg_m3, profile=profile, cos_theta=cos,
