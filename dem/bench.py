@@ -117,10 +117,11 @@ def grain_rate(n_grains, *, steps=None, repeat=3, threads=None):
             "steps_by_threads": {str(k): v for k, v in sim.threads.steps_by_threads.items()}}
 
 
-def grain_pack_time(n_grains, *, seed=1, porosity=0.40985, out_dir=None):
+def grain_pack_time(n_grains, *, seed=1, porosity=0.40985, out_dir=None, warm_up=True):
     """Wall time of ``python -m dem.pack --scene box --grain soybean --n-grains G`` in a cube holding
     G soybeans at ``porosity`` (side (G V_g / (1 - porosity))^(1/3)), run as a subprocess after a
-    one-grain-count warm-up that loads numba's cache. Returns the command, times, load, summary."""
+    warm-up of min(20, G) grains that fills numba's cache (``warm_up``). Returns the command, its wall
+    and CPU seconds (s), the load averages, and the packing summary's steps, spheres and porosity."""
     import subprocess
     import tempfile
     side = float((n_grains * library_template("soybean").volume_m3 / (1 - porosity)) ** (1 / 3))
@@ -128,9 +129,10 @@ def grain_pack_time(n_grains, *, seed=1, porosity=0.40985, out_dir=None):
     cmd = [sys.executable, "-m", "dem.pack", "--scene", "box", "--grain", "soybean", "--size", f"{side:.4f}",
            f"{side:.4f}", "--height", f"{side:.4f}", "--n-grains", str(n_grains), "--seed", str(seed),
            "--quiet", "--out", os.path.join(out_dir, "bed.csv")]
-    warm = cmd[:cmd.index("--n-grains") + 1] + ["20"] + cmd[cmd.index("--n-grains") + 2:-1] + \
+    warm = cmd[:cmd.index("--n-grains") + 1] + [str(min(20, n_grains))] + cmd[cmd.index("--n-grains") + 2:-1] + \
         [os.path.join(out_dir, "warm.csv")]
-    subprocess.run(warm, check=True, capture_output=True)
+    if warm_up:
+        subprocess.run(warm, check=True, capture_output=True)
     load0, t0, c0 = os.getloadavg(), time.perf_counter(), os.times()
     done = subprocess.run(cmd, check=True, capture_output=True, text=True)
     wall, c1 = time.perf_counter() - t0, os.times()

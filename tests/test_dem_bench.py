@@ -91,3 +91,13 @@ def test_grain_rate_row_and_json(tmp_path, capsys):
     assert bench.main(["--grains", "16", "--steps", "3", "--repeat", "1", "--json", str(out)]) == 0
     assert "s-steps/s best" in capsys.readouterr().out
     assert [row["grains"] for row in json.loads(out.read_text())["grain_rates"]] == [16]
+
+
+def test_grain_pack_time_runs_dem_pack_for_the_grain_count(tmp_path):
+    # 6 soybeans: a cube of side (6 V_g / (1 - 0.40985))^(1/3) = 11.5 mm, packed by the real CLI
+    r = bench.grain_pack_time(6, out_dir=str(tmp_path), warm_up=False)
+    v_g = bench.library_template("soybean").volume_m3
+    assert r["side_m"] == pytest.approx((6 * v_g / (1 - 0.40985)) ** (1 / 3), rel=1e-12)
+    assert (r["grains"], r["n_spheres"]) == (6, 36) and r["steps"] >= 6000
+    assert 0 < r["pack_wall_time_s"] <= r["wall_s"] and r["cpu_s"] > 0 and len(r["loadavg_before"]) == 3
+    assert "--n-grains 6" in r["command"] and (tmp_path / "bed.csv").exists()
