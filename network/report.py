@@ -311,7 +311,7 @@ def print_report(r) -> None:
     print(f"grain {r['grain']}: packing {r['packing']} ({r['n_grains']} grains, {r['n_spheres']} "
           f"spheres), own porosity {r['porosity_packing']:.4f} (std error "
           f"{r['porosity_packing_std']:.1e})")
-    print(f"porosity of this report {r['porosity']:.4f}: {r['porosity_source']}; moved "
+    print(f"porosity of this report {r['porosity']:.4f}: {r['porosity_source']}; move: "
           f"{r['porosity_move']}")
     f = [p["porosity_shift_ln_stderr"] for p in r["points"]]
     if r["porosity"] != r["porosity_packing"]:
