@@ -47,6 +47,22 @@ __all__ = ["pack_grains", "pack_grains_to_porosity", "procedure_lever", "write_g
 #: deposition friction searched by :func:`pack_grains_to_porosity`: frictionless (densest) to 1.0
 DEPOSITION_FRICTION_RANGE = (0.0, 1.0)
 
+#: grain sizes: the coefficient of variation is below this; normal deviates cut at SIZE_CUT sigma
+SIZE_CV_MAX = 0.3
+SIZE_CUT = 2.5
+
+
+def _mean_cube(cv, n=20001):
+    r"""Mean of :math:`(1 + c z)^3` for z standard normal cut at ±``SIZE_CUT`` (quadrature).
+
+    >>> round(_mean_cube(0.0), 12), round(_mean_cube(0.1), 4)
+    (1.0, 1.0273)
+    """
+    z = np.linspace(-SIZE_CUT, SIZE_CUT, n)
+    w = np.exp(-0.5 * z * z)
+    return float(np.sum(w * (1 + cv * z) ** 3) / np.sum(w))
+
+
 #: margin of network's default sample region, in volume-equivalent grain diameters
 NETWORK_MARGIN_DIAMETERS = 1.5
 
@@ -81,35 +97,51 @@ def union_porosity_in_box(centers, radii, lo, hi, *, log2_points=14, replicates=
 
 
 def pack_grains(container, template, *, material=SOYBEAN, porosity=0.408, n_grains=None, rng=None,
-                initial_multiplier=None, deposition_friction=0.0, mass_scale=100.0, lid_headroom=0.3,
-                grow_steps=3000, sediment_steps=3000, tol=2e-3, max_steps=40000, check_every=200,
-                progress=None):
-    """Settled packing of grains of one template in ``container`` (procedure: module notes).
+                initial_multiplier=None, deposition_friction=0.0, size_cv=0.0, mass_scale=100.0,
+                lid_headroom=0.3, grow_steps=3000, sediment_steps=3000, tol=2e-3, max_steps=40000,
+                check_every=200, progress=None):
+    r"""Settled packing of grains of one template in ``container`` (procedure: module notes).
 
     ``deposition_friction`` is the grain-grain friction coefficient while the grains grow and
     fall (>= 0; walls frictionless then); the material's friction holds afterwards.
+    ``size_cv`` spreads the grains' sizes: grain g is the template scaled by
+    :math:`f_g = 1 + c\,z_g`, :math:`z_g` standard normal cut at ±2.5 (``c`` = ``size_cv`` in
+    [0, 0.3), the coefficient of variation of a kernel's axes); the grain count uses the mean
+    volume :math:`V_t\,\overline{f^3}`. 0 (default) draws nothing: the same packing as before.
     Returns (sphere centres (N, 3), radii (N,), grain_id (N,), grain table dict, summary dict).
     """
     if not (np.isfinite(deposition_friction) and deposition_friction >= 0):
         raise ValueError(f"deposition friction must be finite and >= 0, got {deposition_friction!r}")
+    if not (np.isfinite(size_cv) and 0 <= size_cv < SIZE_CV_MAX):
+        raise ValueError(f"size spread (coefficient of variation) must be in [0, {SIZE_CV_MAX}), got {size_cv!r}")
     t0 = time.perf_counter()
     rng = np.random.default_rng(rng)
-    n = int((1 - porosity) * container.volume_m3 / template.volume_m3) if n_grains is None else int(n_grains)
+    f3 = _mean_cube(size_cv)
+    v_mean = template.volume_m3 * f3
+    n = int((1 - porosity) * container.volume_m3 / v_mean) if n_grains is None else int(n_grains)
     if n < 1:
-        raise ValueError(f"no grain of {template.volume_m3:.3g} m^3 fits the container")
+        raise ValueError(f"no grain of {v_mean:.3g} m^3 fits the container")
     lid = container.fill_height_m * (1 + lid_headroom)
     gen_box = replace(container, fill_height_m=lid)
+    f_max = 1 + SIZE_CUT * size_cv
     if initial_multiplier is None:
-        v_bound = n * 4 / 3 * np.pi * template.bounding_radius_m**3
+        v_bound = n * 4 / 3 * np.pi * (template.bounding_radius_m * f_max) ** 3   # placed at the largest size
         initial_multiplier = max(1.4, float((v_bound / (0.2 * gen_box.volume_m3)) ** (1 / 3)))
-    rb = template.bounding_radius_m / initial_multiplier
+    rb = template.bounding_radius_m * f_max / initial_multiplier
     x, _ = generate_spheres(gen_box, n, rb, rb, rng)
     q = random_quaternions(n, rng)
-    s0 = np.full(n, 1 / initial_multiplier)
+    size = np.ones(n)
+    if size_cv > 0:
+        z = rng.standard_normal(n)
+        while np.any(np.abs(z) > SIZE_CUT):               # redraw past the cut
+            bad = np.abs(z) > SIZE_CUT
+            z[bad] = rng.standard_normal(int(bad.sum()))
+        size = 1 + size_cv * z
+    s0 = size / initial_multiplier
     deposition = replace(material, friction=float(deposition_friction), wall_friction=0.0)
     sim = ClumpSimulation([template], np.zeros(n, int), x, q, s0, container.walls(lid=True, lid_height_m=lid),
                           deposition, mass_scale=mass_scale)
-    stages = {"grow": sim.run(max_steps=grow_steps, grow_from=s0, grow_to=np.ones(n), check_every=check_every,
+    stages = {"grow": sim.run(max_steps=grow_steps, grow_from=s0, grow_to=size, check_every=check_every,
                               callback=progress)}
     stages["sediment"] = sim.run(max_steps=sediment_steps, check_every=check_every, callback=progress)
     sim.set_material(material)
@@ -126,7 +158,7 @@ def pack_grains(container, template, *, material=SOYBEAN, porosity=0.408, n_grai
         h = container.size_m[0] / 2 / np.sqrt(2) - margin
         lo, hi = np.array([-h, -h, margin]), np.array([h, h, top - margin])
     phi, phi_err = (union_porosity_in_box(xs, r, lo, hi) if np.all(hi > lo) else (float("nan"), float("nan")))
-    net_lo, net_hi = network_region(xs, r, template.volume_m3)
+    net_lo, net_hi = network_region(xs, r, float(np.mean(sim.volume_m3)))
     phi_net, phi_net_err = (union_porosity_in_box(xs, r, net_lo, net_hi) if np.all(net_hi > net_lo)
                             else (float("nan"), float("nan")))
     wall = time.perf_counter() - t0
@@ -137,7 +169,8 @@ def pack_grains(container, template, *, material=SOYBEAN, porosity=0.408, n_grai
                "interior_box_m": [lo.tolist(), hi.tolist()], "porosity_network_region": phi_net,
                "porosity_network_region_error": phi_net_err,
                "network_region_m": [net_lo.tolist(), net_hi.tolist()],
-               "deposition_friction": float(deposition_friction),
+               "deposition_friction": float(deposition_friction), "size_cv": float(size_cv),
+               "grain_scale_range": [float(size.min()), float(size.max())],
                "initial_multiplier": float(initial_multiplier), "bed_top_m": top, "stages": stages,
                "steps": steps, "dt_s": sim.dt, "mass_scale": mass_scale, "wall_time_s": wall,
                "material": {k: getattr(material, k) for k in material.__dataclass_fields__},

@@ -53,6 +53,10 @@ def _parser():
     p.add_argument("--porosity-tol", type=float, default=0.005, help="--grain --porosity: tolerance (default 0.005)")
     p.add_argument("--workers", type=int, default=1, choices=[1, 2],
                    help="--grain --porosity: processes for the search's two end packings (default 1)")
+    p.add_argument("--size-cv", type=float, default=None,
+                   help="--grain: size spread, the coefficient of variation of the kernels' axes (grains scaled "
+                        "by 1 + cv z, z normal cut at 2.5; default: the library's axes_sd_mm / axes_mm when "
+                        "sourced, else 0, no spread, said in the summary)")
     p.add_argument("--deposition-friction", type=float, default=None,
                    help="--grain: grain-grain friction while the grains grow and fall (default 0: the densest "
                         "bed; friction then loosens it); the material's friction holds afterwards")
@@ -127,7 +131,8 @@ def _pack_grains(args) -> int:
     container = resolve_container(args.scene, size_m=size, height_m=height)
     material, used = _grain_material(args, template.name)
     pr = progress_printer(quiet=args.quiet)
-    kw = dict(material=material, n_grains=args.n_grains, rng=args.seed, mass_scale=args.mass_scale,
+    size_cv, size_cv_source = _size_cv(args, template.name)
+    kw = dict(material=material, n_grains=args.n_grains, rng=args.seed, mass_scale=args.mass_scale, size_cv=size_cv,
               tol=args.tol, max_steps=min(args.max_steps, 60000),
               progress=lambda sim, f: pr("grains", _Progress(sim), None))
     if args.porosity is not None and args.deposition_friction is None:
@@ -142,7 +147,8 @@ def _pack_grains(args) -> int:
     else:
         xs, r, gid, grains, s = pack_grains(container, template, porosity=_grain_porosity(args, template.name),
                                             deposition_friction=args.deposition_friction or 0.0, **kw)
-    s.update(scene=args.scene, seed=args.seed, container=container.to_dict(), material_from_library=used)
+    s.update(scene=args.scene, seed=args.seed, container=container.to_dict(), material_from_library=used,
+             size_cv_source=size_cv_source)
     write_grain_packing(args.out, xs, r, gid, grains, s)
     print(f"{s['n_grains']} grains of {template.n} spheres ({s['n_spheres']} spheres) -> {args.out} "
           f"(+ {grains_path(args.out).name}, {summary_path(args.out).name})")
@@ -162,6 +168,21 @@ def _packing_line(t):
     print(f"[search] lever {t['lever']:+.3f} (lid headroom {t['lid_headroom']:.3f}, deposition friction "
           f"{t['deposition_friction']:.3f}): porosity {t['porosity']:.4f} +- {t['porosity_error']:.4f}, "
           f"{t['wall_time_s']:.0f} s", file=sys.stderr, flush=True)
+
+
+def _size_cv(args, name):
+    """(size spread, where it came from): --size-cv, else the library's mean axis standard
+    deviation over the mean axis (axes_sd_mm / axes_mm), else 0 (no sourced spread)."""
+    if args.size_cv is not None:
+        return args.size_cv, "--size-cv"
+    try:
+        lib = grain(name)
+    except ValueError:
+        return 0.0, "template file: no library spread"
+    sd, ax = lib.axes_sd_mm.value, lib.axes_mm.value
+    if sd is None or ax is None:
+        return 0.0, f"none: the library has no axis standard deviations for {name} ({lib.axes_sd_mm.note})"
+    return float(np.mean(np.asarray(sd) / np.asarray(ax))), f"library axes_sd_mm / axes_mm ({lib.axes_sd_mm.source})"
 
 
 def _grain_porosity(args, name):
