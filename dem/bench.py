@@ -51,13 +51,11 @@ def lattice_simulation(n, *, rng=0, mass_scale=100.0, threads=None):
                            threads=threads)
 
 
-def rate(n, *, steps=None, repeat=3, threads=None):
-    """Particle-steps per second for N (min/median over ``repeat`` timings); ``threads`` None
-    lets the simulation choose (the steps each thread count ran are in ``steps_by_threads``)."""
-    sim = lattice_simulation(n, threads=threads)
+def _time_steps(sim, steps, repeat):
+    """(wall seconds array, CPU seconds list) of ``repeat`` runs of ``steps`` steps, after 5 warm-up
+    steps (compilation, first neighbour list)."""
     for _ in range(5):
         sim.step()
-    steps = steps or max(20, int(2e6 / n))
     times, cpu = [], []
     for _ in range(repeat):
         t, c = time.perf_counter(), time.process_time()
@@ -65,7 +63,15 @@ def rate(n, *, steps=None, repeat=3, threads=None):
             sim.step()
         times.append(time.perf_counter() - t)
         cpu.append(time.process_time() - c)
-    times = np.array(times)
+    return np.array(times), cpu
+
+
+def rate(n, *, steps=None, repeat=3, threads=None):
+    """Particle-steps per second for N (min/median over ``repeat`` timings); ``threads`` None
+    lets the simulation choose (the steps each thread count ran are in ``steps_by_threads``)."""
+    sim = lattice_simulation(n, threads=threads)
+    steps = steps or max(20, int(2e6 / n))
+    times, cpu = _time_steps(sim, steps, repeat)
     return {
         "n": int(sim.n), "steps": steps, "pairs": int(len(sim.verlet.pairs)), "contacts": int(len(sim.contact_fn)),
         "rebuilds": int(sim.stats["rebuilds"]), "seconds": times.tolist(),
@@ -98,17 +104,8 @@ def grain_rate(n_grains, *, steps=None, repeat=3, threads=None):
     as :func:`rate`)."""
     sim = grain_lattice_simulation(n_grains, threads=threads)
     n = len(sim.radii)
-    for _ in range(5):
-        sim.step()
     steps = steps or max(10, int(1e6 / n))
-    times, cpu = [], []
-    for _ in range(repeat):
-        t, c = time.perf_counter(), time.process_time()
-        for _ in range(steps):
-            sim.step()
-        times.append(time.perf_counter() - t)
-        cpu.append(time.process_time() - c)
-    times = np.array(times)
+    times, cpu = _time_steps(sim, steps, repeat)
     return {"grains": int(sim.n_grains), "n": int(n), "steps": steps, "contacts": int(len(sim.contact_fn)),
             "wall_contacts": int(len(sim.last_wall_fn)), "seconds": times.tolist(), "cpu_seconds": cpu,
             "rate_best": float(n * steps / times.min()), "rate_median": float(n * steps / np.median(times)),
