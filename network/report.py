@@ -40,8 +40,6 @@ from .flow import DEFAULT_DEPTH_M, asabe_d272_gradient, ergun_gradient, fit_curv
 from .packing import UNITS, read_container
 from .pores import sample_region
 
-#: soybean kernel density, kg/m^3: thesis Table 3.1 (DESIGN.md), also dem.grains' soybean entry
-SOYBEAN_PARTICLE_DENSITY = BED["soybean"].particle_density_kg_m3
 #: below this porosity difference the packing's own porosity is the report's (no move)
 SAME_POROSITY = 5e-4
 KEYS = ["velocity_m_s", "reynolds_particle", "pressure_gradient_pa_per_m",
