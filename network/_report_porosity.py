@@ -107,7 +107,9 @@ def check_reachable(porosity: float, own: float | None, reach, grain: str) -> No
     """
     if reach is not None:
         lo, hi = reach
-        how = "dem.pack --porosity: its densest and loosest packing +- its tolerance"
+        how = ("dem.pack --porosity: this bed's densest and loosest packing +- its tolerance; "
+               f"another grain count may reach further: dem.pack --grain {grain} --porosity "
+               f"{porosity:g}, then --packing")
     elif own is not None:
         lo, hi = own - MAX_SHIFT, own + MAX_SHIFT
         how = f"the packing's own {own:.4f} +- {MAX_SHIFT} along the band; no recorded range"
