@@ -11,8 +11,14 @@ Re_w = rho u_w D_w/mu (u_w = Q/A_w, D_w = 2 sqrt(A_w/pi)): the excess viscous di
 Stokes at the same flow, per rho u_w^2 Q/2, in the whole domain (k_pore), in the tetrahedron
 (k_body) and in the inlet prism (k_prism; plug development and the contraction).
 
+Any tetrahedron: ``pore(..., V=(4, 3) vertices, r=radii, e=prism length)``, face (0, 1, 2)
+the inlet. The first row (Re_w 0) gives the conduit model's sigma of the inlet window (open
+area over the section at the centroid's height), the turning cosine of the Stokes outflow
+split (inlet normal against the flow-weighted outflow normal) and that split.
+
 Not part of the package (network never imports scikit-fem or gmsh): run by hand,
-``python docs/scripts/inertial_pore_ns.py 0.1`` (h; about 4 min on one core at h 0.1).
+``python docs/scripts/inertial_pore_ns.py 0.1`` (h; about 4 min on one core at h 0.1), or
+``... 0.05 '[[x,y,z], ...]' 0.5`` for another tetrahedron (prism length stays 0.5).
 """
 
 import json
@@ -20,15 +26,31 @@ import sys
 
 import gmsh
 import numpy as np
+import throats
 from skfem import (Basis, BilinearForm, ElementTetP1, ElementTetP2, ElementVector, FacetBasis,
                    Functional, LinearForm, MeshTet, asm, bmat, condense, solve)
 from skfem.helpers import ddot, div, dot, grad
 
 
-def build(L=2.0, r=0.9, e=0.5, h=0.1):
-    """Tetrahedron (shared edges) + inlet prism, minus the four spheres: (MeshTet, vertices)."""
-    V = np.array([[0, 0, 0], [L, 0, 0], [L / 2, L * np.sqrt(3) / 2, 0],
-                  [L / 2, L * np.sqrt(3) / 6, L * np.sqrt(2 / 3)]])
+def regular(L=2.0):
+    """Vertices of a regular tetrahedron of edge L, face (0, 1, 2) in the plane z = 0."""
+    return np.array([[0, 0, 0], [L, 0, 0], [L / 2, L * np.sqrt(3) / 2, 0],
+                     [L / 2, L * np.sqrt(3) / 6, L * np.sqrt(2 / 3)]])
+
+
+def inward_normal(V, face):
+    """Unit normal of triangle V[face] pointing to the fourth vertex."""
+    a, b, c = V[list(face)]
+    n = np.cross(b - a, c - a)
+    n /= np.linalg.norm(n)
+    other = V[[k for k in range(4) if k not in face][0]]
+    return n if n @ (other - a) > 0 else -n
+
+
+def build(V, r, e=0.5, h=0.1):
+    """Tetrahedron V (4, 3) (shared edges) + a prism of length e extruded outward from face
+    (0, 1, 2), minus the spheres of radii r at the vertices: MeshTet."""
+    r = np.broadcast_to(np.asarray(r, float), (4,))
     gmsh.initialize()
     gmsh.option.setNumber("General.Verbosity", 0)
     occ = gmsh.model.occ
@@ -48,9 +70,10 @@ def build(L=2.0, r=0.9, e=0.5, h=0.1):
     base = occ.addPlaneSurface([occ.addCurveLoop([occ.addLine(q[0], q[1]),
                                                   occ.addLine(q[1], q[2]),
                                                   occ.addLine(q[2], q[0])])])
-    prism = [d for d in occ.extrude([(2, base)], 0, 0, -e) if d[0] == 3][0]
+    out = -e * inward_normal(V, (0, 1, 2))
+    prism = [d for d in occ.extrude([(2, base)], *out) if d[0] == 3][0]
     body, _ = occ.fuse([(3, tet)], [prism])
-    occ.cut(body, [(3, occ.addSphere(*v, r)) for v in V])
+    occ.cut(body, [(3, occ.addSphere(*v, rk)) for v, rk in zip(V, r)])
     occ.synchronize()
     gmsh.option.setNumber("Mesh.CharacteristicLengthMax", h)
     gmsh.option.setNumber("Mesh.CharacteristicLengthMin", h / 2)
@@ -66,7 +89,7 @@ def build(L=2.0, r=0.9, e=0.5, h=0.1):
     used = np.unique(tets)
     remap = np.full(xyz.shape[0], -1)
     remap[used] = np.arange(used.size)
-    return MeshTet(xyz[used].T.copy(), remap[tets].T.copy()), V
+    return MeshTet(xyz[used].T.copy(), remap[tets].T.copy())
 
 
 @BilinearForm
@@ -97,9 +120,13 @@ def dissipation(w):
     return ddot(grad(w["u"]), grad(w["u"]))
 
 
-def pore(reynolds, *, h=0.1, L=2.0, r=0.9, e=0.5):
-    """Rows (dict) per window Reynolds number, as in the module docstring."""
-    m, V = build(L, r, e, h)
+def pore(reynolds, *, h=0.1, V=None, r=0.9, e=0.5):
+    """Rows (dict) per window Reynolds number, as in the module docstring; the first row
+    (Re_w 0) gives the conduit-model sigma of the inlet window, the turning cosine of the
+    Stokes outflow split and the open window area."""
+    V = regular() if V is None else np.asarray(V, float)
+    r = np.broadcast_to(np.asarray(r, float), (4,))
+    m = build(V, r, e, h)
     bu = Basis(m, ElementVector(ElementTetP2()), intorder=4)
     bp = Basis(m, ElementTetP1(), intorder=4)
     A, B = asm(viscous, bu), asm(divergence, bu, bp)
@@ -108,20 +135,24 @@ def pore(reynolds, *, h=0.1, L=2.0, r=0.9, e=0.5):
     bf = m.boundary_facets()
     fc = m.p[:, m.facets[:, bf]].mean(axis=1)
     on_sphere = np.zeros(bf.size, bool)
-    for v in V:
-        on_sphere |= np.abs(np.linalg.norm(fc.T - v, axis=1) - r) < 0.05 * h + 0.02
-    inlet = np.abs(fc[2] + e) < 1e-6
-    outlet = np.zeros(bf.size, bool)
-    for a, b, c in ((0, 1, 3), (1, 2, 3), (0, 2, 3)):
-        n = np.cross(V[b] - V[a], V[c] - V[a])
-        outlet |= (np.abs((fc.T - V[a]) @ (n / np.linalg.norm(n))) < 1e-6) & ~on_sphere
+    for v, rk in zip(V, r):
+        on_sphere |= np.abs(np.linalg.norm(fc.T - v, axis=1) - rk) < 0.05 * h + 0.02
+    n_in = inward_normal(V, (0, 1, 2))
+    inlet = np.abs((fc.T - V[0]) @ n_in + e) < 1e-6
+    out_faces = ((0, 1, 3), (1, 2, 3), (0, 2, 3))
+    outlets = []
+    for f in out_faces:
+        n = inward_normal(V, f)
+        outlets.append((np.abs((fc.T - V[f[0]]) @ n) < 1e-6) & ~on_sphere)
+    outlet = np.any(outlets, axis=0)
     walls = bf[~(inlet | outlet)]
     d_wall, d_in = bu.get_dofs(walls).all(), bu.get_dofs(bf[inlet]).all()
     D = np.unique(np.concatenate([d_wall, d_in]))
-    axial = np.zeros(nu, bool)
-    axial[bu.dofs.nodal_dofs[2]] = axial[bu.dofs.edge_dofs[2]] = True
     x = np.zeros(nu + bp.N)
-    x[np.setdiff1d(d_in[axial[d_in]], d_wall)] = 1.0          # plug inflow along +z
+    for k in range(3):                                         # plug inflow along n_in
+        comp = np.zeros(nu, bool)
+        comp[bu.dofs.nodal_dofs[k]] = comp[bu.dofs.edge_dofs[k]] = True
+        x[np.setdiff1d(d_in[comp[d_in]], d_wall)] = n_in[k]
     U = solve(*condense(stokes, np.zeros_like(x), x=x, D=D))
     in_body = m.p[2, m.t].mean(axis=0) > 0
 
@@ -131,11 +162,24 @@ def pore(reynolds, *, h=0.1, L=2.0, r=0.9, e=0.5):
 
     stokes_d = split(U)
     flux = Functional(lambda w: dot(w["u"], w.n))
-    fb = FacetBasis(m, ElementVector(ElementTetP2()), facets=bf[inlet], intorder=4)
-    Q = -flux.assemble(fb, u=fb.interpolate(U[:nu]))
-    a_w = np.sqrt(3) / 4 * L**2 - 0.5 * np.pi * r**2           # window: triangle - 3 sectors
+
+    def through(mask):
+        fb = FacetBasis(m, ElementVector(ElementTetP2()), facets=bf[mask], intorder=4)
+        return flux.assemble(fb, u=fb.interpolate(U[:nu]))
+
+    Q = -through(inlet)
+    # conduit-model quantities of the inlet window (throats.open_area, centroid height)
+    sides = np.array([[np.linalg.norm(V[1] - V[2]), np.linalg.norm(V[0] - V[2]),
+                       np.linalg.norm(V[0] - V[1])]])
+    a_w = float(throats.open_area(r[None, :3], sides)[0])
+    hc = float((V.mean(axis=0) - V[0]) @ n_in)
+    a_b = float(throats.open_area(np.sqrt(np.maximum(r[None, :3] ** 2 - hc**2, 1e-24)),
+                                  sides)[0])
+    q_out = np.array([through(mk) for mk in outlets])
+    M = sum(qg * inward_normal(V, f) * -1 for qg, f in zip(q_out, out_faces)) / q_out.sum()
     u_w, d_w = Q / a_w, 2 * np.sqrt(a_w / np.pi)
-    rows = []
+    rows = [{"Re_w": 0, "sigma": a_w / a_b, "cos_theta": float(n_in @ M), "A_w": a_w,
+             "outflow_split": (q_out / q_out.sum()).round(4).tolist()}]
     for re in reynolds:
         rho = re / (u_w * d_w)                                 # mu = 1
         for it in range(30):
@@ -154,5 +198,7 @@ def pore(reynolds, *, h=0.1, L=2.0, r=0.9, e=0.5):
 
 
 if __name__ == "__main__":
-    for row in pore([1, 5, 10, 20, 50, 100, 200], h=float(sys.argv[1]) if sys.argv[1:] else 0.1):
+    for row in pore([1, 5, 10, 20, 50, 100, 200], h=float(sys.argv[1]) if sys.argv[1:] else 0.1,
+                    V=json.loads(sys.argv[2]) if sys.argv[2:] else None,
+                    r=float(sys.argv[3]) if sys.argv[3:] else 0.9):
         print(json.dumps(row), flush=True)
