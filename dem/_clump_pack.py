@@ -209,8 +209,8 @@ def pack_grains_to_porosity(container, template, *, porosity, porosity_tol=0.005
     a bed lands within ``porosity_tol`` or ``max_packings`` beds are spent (then RuntimeError with the
     closest). ``on_packing(dict)`` is called after each packing with its λ, headroom, friction,
     porosity and wall time. ``workers=2`` packs the two ends in two processes (the same beds:
-    a packing depends on its seed only; no progress callback there). Returns what :func:`pack_grains` returns; the summary gains
-    ``porosity_search``: target, tol, ``reachable`` (the range of all beds made: φ(λ) need not
+    a packing depends on its seed only; no progress callback there). Returns what
+    :func:`pack_grains` returns; the summary gains ``porosity_search``: target, tol, ``reachable`` (the range of all beds made: φ(λ) need not
     be monotone, wheat's is not), ``ends``, every (λ, φ) tried.
     """
     if not (np.isfinite(porosity) and 0 < porosity < 1):
@@ -218,6 +218,8 @@ def pack_grains_to_porosity(container, template, *, porosity, porosity_tol=0.005
     tol = porosity_tol
     if not (np.isfinite(tol) and tol > 0):
         raise ValueError(f"porosity tolerance must be > 0, got {tol!r}")
+    if int(max_packings) < 2:
+        raise ValueError(f"the search packs its two ends at least: max packings >= 2, got {max_packings!r}")
     tried, best = [], None
 
     def pack(lam, out=None):

@@ -51,6 +51,8 @@ def _parser():
                         "reachable range; without it one packing at --deposition-friction, grain count "
                         "from the grain's measured loose-fill porosity")
     p.add_argument("--porosity-tol", type=float, default=0.005, help="--grain --porosity: tolerance (default 0.005)")
+    p.add_argument("--max-packings", type=int, default=6,
+                   help="--grain --porosity: packings the search may spend, the two ends included (default 6)")
     p.add_argument("--workers", type=int, default=1, choices=[1, 2],
                    help="--grain --porosity: processes for the search's two end packings (default 1)")
     p.add_argument("--size-cv", type=float, default=None,
@@ -140,6 +142,7 @@ def _pack_grains(args) -> int:
             xs, r, gid, grains, s = pack_grains_to_porosity(container, template, porosity=args.porosity,
                                                             porosity_tol=args.porosity_tol,
                                                             on_packing=_packing_line, workers=args.workers,
+                                                            max_packings=args.max_packings,
                                                             **kw)
         except RuntimeError as e:
             print(f"error: {e}", file=sys.stderr)

@@ -81,5 +81,7 @@ def test_bad_requests():
     box = Container("box", (0.01, 0.01), 0.01)
     with pytest.raises(ValueError, match="porosity must be in"):
         pack_grains_to_porosity(box, sphere_template(0.001), porosity=1.2)
+    with pytest.raises(ValueError, match="max packings >= 2"):
+        pack_grains_to_porosity(box, sphere_template(0.001), porosity=0.4, max_packings=1)
     with pytest.raises(ValueError, match="deposition friction"):
         cp.pack_grains(box, sphere_template(0.001), deposition_friction=-0.1)
