@@ -152,6 +152,8 @@ def _pack_grains(args) -> int:
                                             deposition_friction=args.deposition_friction or 0.0, **kw)
     s.update(scene=args.scene, seed=args.seed, container=container.to_dict(), material_from_library=used,
              size_cv_source=size_cv_source)
+    settle = s["stages"]["settle"]
+    s["converged"] = bool(settle["converged"])
     write_grain_packing(args.out, xs, r, gid, grains, s)
     print(f"{s['n_grains']} grains of {template.n} spheres ({s['n_spheres']} spheres) -> {args.out} "
           f"(+ {grains_path(args.out).name}, {summary_path(args.out).name})")
@@ -163,6 +165,11 @@ def _pack_grains(args) -> int:
         ps = s["porosity_search"]
         print(f"porosity search: reachable {ps['reachable'][0]:.4f}-{ps['reachable'][1]:.4f}; tried "
               + ", ".join(f"lever {t['lever']:+.3f} -> {t['porosity']:.4f}" for t in ps["tried"]))
+    if not s["converged"]:
+        print(f"error: not at equilibrium: the grains' settle stage stopped at the step limit (unbalanced force "
+              f"ratio {settle['ratio']:.3g} > tol {args.tol:.3g}); written with \"converged\": false",
+              file=sys.stderr)
+        return EXIT_FAILED
     return 0
 
 

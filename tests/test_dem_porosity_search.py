@@ -85,3 +85,19 @@ def test_bad_requests():
         pack_grains_to_porosity(box, sphere_template(0.001), porosity=0.4, max_packings=1)
     with pytest.raises(ValueError, match="deposition friction"):
         cp.pack_grains(box, sphere_template(0.001), deposition_friction=-0.1)
+
+
+def test_grain_bed_not_at_equilibrium_exits_1(tmp_path, capsys):
+    """dem.pack --grain marks a bed whose settle stage hit the step limit as it does spheres:
+    written with "converged": false, one error line, exit 1 (141 one-sphere grains, 0.8 s)."""
+    import json
+    from dem.pack import main
+    tpl = tmp_path / "one.csv"
+    tpl.write_text("x,y,z,r\n0,0,0,1\n")
+    out = tmp_path / "bed.csv"
+    assert main(["--scene", "box", "--size", "0.01", "0.01", "--height", "0.01", "--grain",
+                 str(tpl), "--max-steps", "200", "--out", str(out), "--quiet"]) == 1
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and err[0].startswith("error: not at equilibrium"), err
+    s = json.loads(out.with_suffix(".json").read_text())
+    assert s["converged"] is False and s["stages"]["settle"]["steps"] == 200
