@@ -252,16 +252,23 @@ def pack_grains_to_porosity(container, template, *, porosity, porosity_tol=0.005
                          "(lever -1: closed-box growth, +1: deposition friction 1; network's "
                          "sample region)")
     a, b = (-1.0, e_lo), (1.0, e_hi)
-    best = min((lo, hi), key=lambda o: abs(o[4]["porosity_network_region"] - porosity))
-    while abs(best[4]["porosity_network_region"] - porosity) > tol and len(tried) < max_packings:
+    def rank(o):  # a bed at equilibrium within tol first, then the closest
+        s = o[4]
+        settled = s.get("stages", {}).get("settle", {}).get("converged", True)
+        miss = abs(s["porosity_network_region"] - porosity)
+        return (miss > tol or not settled, miss)
+
+    best = min((lo, hi), key=rank)
+    while rank(best)[0] and len(tried) < max_packings:
         if b[1] == a[1]:
             break
         lam = a[0] + (porosity - a[1]) * (b[0] - a[0]) / (b[1] - a[1])
         w = 0.05 * abs(b[0] - a[0])
         lam = float(np.clip(lam, min(a[0], b[0]) + w, max(a[0], b[0]) - w))
+        if any(abs(lam - t["lever"]) < 1e-9 for t in tried):  # the same bed again: step aside
+            lam = float(lam + (0.5 * w if a[0] > lam else -0.5 * w))
         out, e = pack(lam)
-        if abs(e - porosity) < abs(best[4]["porosity_network_region"] - porosity):
-            best = out
+        best = min((best, out), key=rank)
         if (e - porosity) * (a[1] - porosity) > 0:
             a = (lam, e)
         else:

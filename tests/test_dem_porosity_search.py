@@ -101,3 +101,21 @@ def test_grain_bed_not_at_equilibrium_exits_1(tmp_path, capsys):
     assert len(err) == 1 and err[0].startswith("error: not at equilibrium"), err
     s = json.loads(out.with_suffix(".json").read_text())
     assert s["converged"] is False and s["stages"]["settle"]["steps"] == 200
+
+
+def test_search_passes_over_a_bed_not_at_equilibrium(monkeypatch):
+    """A bed within the tolerance whose settle stage did not converge is not the answer while
+    packings remain: the search steps aside (the same lever would give the same bed) to one at
+    equilibrium."""
+    calls = []
+    law = _fake(lambda lam: 0.38 + 0.02 * (lam + 1), calls)
+
+    def pack(*a, **kw):
+        out = law(*a, **kw)
+        out[4]["stages"] = {"settle": {"converged": abs(calls[-1] - 0.05) > 1e-6}}
+        return out
+    monkeypatch.setattr(cp, "pack_grains", pack)
+    box = Container("box", (0.01, 0.01), 0.01)
+    out = pack_grains_to_porosity(box, sphere_template(0.001), porosity=0.401, porosity_tol=0.002)
+    assert len(calls) == 4 and out[4]["stages"]["settle"]["converged"]
+    assert abs(out[4]["porosity_network_region"] - 0.401) <= 0.002
