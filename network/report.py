@@ -72,7 +72,13 @@ def build_parser() -> CliParser:
     ap.add_argument("--particle-density", type=float, default=None,
                     help="kernel (true) density, kg/m^3, for the bulk density rho_p (1 - "
                          "porosity); default: the grain library's (network/_grains.py BED)")
-    ap.add_argument("--depth", type=float, default=DEFAULT_DEPTH_M, help="bed depth, m, > 0")
+    ap.add_argument("--depth", type=float, default=DEFAULT_DEPTH_M,
+                    help="grain the air crosses, m, > 0: the bed depth for --axis z, the bed's "
+                         "thickness across the airflow for --axis x")
+    ap.add_argument("--axis", default="z", type=str.lower, choices=["z", "x"],
+                    help="the bin's airflow for the system curve, --airflow and --fan: z vertical "
+                         "(floor aeration, default) or x horizontal (cross-flow: the floor area "
+                         "options then give the face the air enters); both curves are reported")
     area = ap.add_mutually_exclusive_group()
     area.add_argument("--diameter", type=float, default=None, help="round bin diameter, m")
     area.add_argument("--floor-area", type=float, default=None,
@@ -253,7 +259,8 @@ def build_report(args, opts, path, packing) -> dict:
             dict(zip([f"{o:+.2f}" for o in BAND_OFFSETS],
                      band_gradients(p["pressure_gradient_pa_per_m"], p["band_slope"]))))
     area = floor_area(args.diameter, args.floor_area)
-    ok = [p for p in pts if p["converged"]]
+    flow = pts if args.axis == "z" else pts_x          # the direction the bin's air takes
+    ok = [p for p in flow if p["converged"]]
     su = [p["velocity_m_s"] for p in ok]
     sg = [p["pressure_gradient_pa_per_m"] for p in ok]
     system = system_rows(su, sg, depth_m=args.depth, area_m2=area, bulk_density_kg_m3=rho_b)
@@ -276,10 +283,11 @@ def build_report(args, opts, path, packing) -> dict:
            "fits": _fits(args, pts, e, d32), "fits_horizontal": _fits(args, pts_x, e, d32),
            "points": pts, "band": band,
            "bin": {"depth_m": args.depth, "diameter_m": args.diameter, "floor_area_m2": area,
+                   "flow_axis": args.axis,
                    "grain_mass_t": rho_b * area * args.depth / 1000.0},
            "system_curve": system, "airflow": None, "operating_point": None}
     if u_air is not None:
-        g = next(p["pressure_gradient_pa_per_m"] for p in pts
+        g = next(p["pressure_gradient_pa_per_m"] for p in flow
                  if abs(p["velocity_m_s"] - u_air) <= 1e-12 * u_air)
         out["airflow"] = system_rows([u_air], [g], depth_m=args.depth, area_m2=area,
                                      bulk_density_kg_m3=rho_b)[0]
@@ -351,7 +359,9 @@ def print_report(r) -> None:
                   f"Pa s^2/m^3, b {f['d272_b']:.4g} s/m; Ergun A {f['ergun_A']:.4g}, "
                   f"B {f['ergun_B']:.4g}")
     bn = r["bin"]
-    print(f"system curve: depth {bn['depth_m']:g} m, floor {bn['floor_area_m2']:.4g} m^2, "
+    way = ("vertical airflow (z): depth" if bn["flow_axis"] == "z"
+           else "horizontal airflow (x): thickness crossed")
+    print(f"system curve, {way} {bn['depth_m']:g} m, floor {bn['floor_area_m2']:.4g} m^2, "
           f"{bn['grain_mass_t']:.4g} t of grain (static pressure of the grain only)")
     print(f"{'U m/s':>8} {'Q m^3/s':>10} {'m^3/(min t)':>12} {'m^3/(min m^3)':>14} {'P Pa':>10}")
     for s in r["system_curve"]:

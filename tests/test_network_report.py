@@ -191,3 +191,27 @@ def test_done_when_wheat_from_the_bundled_bed(tmp_path, capsys, monkeypatch):
     assert lo < 0.402 < hi
     assert sorted(x.name for x in (tmp_path / "report_wheat").iterdir()) == [
         "report_band.png", "report_curve.png", "report_system.png"]
+
+
+def test_axis_x_puts_the_horizontal_curve_into_the_system_curve(tmp_path, capsys, monkeypatch):
+    """--axis x (cross-flow): the system curve, --airflow and the operating point use the
+    horizontal pressure gradient, P = thickness x dP/L(x) at each velocity; the vertical curve
+    is still reported."""
+    monkeypatch.chdir(tmp_path)
+    out = tmp_path / "x.json"
+    assert main(["--grain", "soybean", "--velocities", "0.01,0.1", "--no-band", "--no-figures",
+                 "--axis", "X", "--depth", "2", "--floor-area", "3", "--airflow", "0.05", "m/s",
+                 "--json", str(out), "-q"]) == 0
+    r = json.loads(out.read_text())
+    assert r["bin"]["flow_axis"] == "x"
+    by_u = {p["velocity_m_s"]: p for p in r["points"]}
+    assert sorted(by_u) == [0.01, 0.05, 0.1]
+    for s in r["system_curve"]:
+        p = by_u[s["velocity_m_s"]]
+        assert s["static_pressure_pa"] == pytest.approx(
+            2.0 * p["pressure_gradient_horizontal_pa_per_m"], rel=1e-12)
+        assert s["airflow_m3_s"] == pytest.approx(3.0 * s["velocity_m_s"], rel=1e-12)
+        assert p["pressure_gradient_horizontal_pa_per_m"] != p["pressure_gradient_pa_per_m"]
+    assert r["airflow"]["static_pressure_pa"] == pytest.approx(
+        2.0 * by_u[0.05]["pressure_gradient_horizontal_pa_per_m"], rel=1e-12)
+    assert "horizontal airflow (x): thickness crossed 2 m" in capsys.readouterr().out
