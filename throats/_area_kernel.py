@@ -36,7 +36,9 @@ def area_perimeter_rows(verts, radii, tol=1e-11):
     if not _COMPILED:
         import numba  # a dependency, loaded only when some row needs the exact engine
 
-        _COMPILED.append(numba.njit(cache=True, error_model="numpy")(_rows))
+        jit = numba.njit(cache=True, error_model="numpy")
+        globals()["_sort"] = jit(_sort)   # the compiled loop calls the compiled sort
+        _COMPILED.append(jit(_rows))
     v = np.ascontiguousarray(verts, dtype=np.float64)
     r = np.ascontiguousarray(radii, dtype=np.float64)
     area = np.empty(v.shape[0])
@@ -74,13 +76,7 @@ def _rows(V, R, tol, area, per):  # compiled by area_perimeter_rows
                         if tol < t < 1.0 - tol:
                             lt[m] = t
                             m += 1
-            for i in range(1, m):            # insertion sort of the m breakpoints
-                x = lt[i]
-                j = i - 1
-                while j >= 0 and lt[j] > x:
-                    lt[j + 1] = lt[j]
-                    j -= 1
-                lt[j + 1] = x
+            _sort(lt, m)
             for j in range(m - 1):
                 t0, t1 = lt[j], lt[j + 1]
                 if not t1 - t0 > 1e-14:
@@ -133,13 +129,7 @@ def _rows(V, R, tol, area, per):  # compiled by area_perimeter_rows
                     if 1e-13 < u < 1.0 - 1e-13:
                         cu[m] = u
                         m += 1
-            for i in range(1, m):            # insertion sort of the m breakpoints
-                x = cu[i]
-                j = i - 1
-                while j >= 0 and cu[j] > x:
-                    cu[j + 1] = cu[j]
-                    j -= 1
-                cu[j + 1] = x
+            _sort(cu, m)
             for j in range(m - 1):
                 u0, u1 = cu[j], cu[j + 1]
                 if not u1 - u0 > 1e-14:
@@ -163,3 +153,13 @@ def _rows(V, R, tol, area, per):  # compiled by area_perimeter_rows
         area[n] = max(a_sum, 0.0)
         per[n] = p_sum
 
+
+def _sort(a, m):
+    """Insertion sort of ``a[:m]`` in place (at most 12 breakpoints; compiled with the loop)."""
+    for i in range(1, m):
+        x = a[i]
+        j = i - 1
+        while j >= 0 and a[j] > x:
+            a[j + 1] = a[j]
+            j -= 1
+        a[j + 1] = x
