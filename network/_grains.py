@@ -7,8 +7,11 @@ the form and units of ASAE/ASABE D272.3. The values are for a loose fill of clea
 grain; D272.3's note (ASAE D272.3 MAR96, section 2, the one part of the standard found in a stored
 copy: https://ro.scribd.com/document/458884232/droppressuregrains-pdf) says packing in a bin may
 raise the resistance by up to 50 %, and grain in equilibrium with air above 85 % RH takes 80 % of
-the pressure drop. Only constants read from a source are here; a grain whose constants were not
-found has ``a = b = None`` and a note. Grain names are those of ``dem.grains.GRAINS``.
+the pressure drop. Soybean's constants are the thesis's; wheat, shelled corn, sorghum and rough
+rice come from one secondary source (a fan-sizing program's table, each entry's ``source``),
+the standard's own table not seen. Only constants read from a source are here; a grain whose
+constants were not found has ``a = b = None`` and a note. Grain names are those of
+``dem.grains.GRAINS``.
 
 >>> c = D272["soybean"]
 >>> round(0.25 * c.a_pa_s2_m3 * 0.013**2 / __import__("math").log1p(c.b_s_m * 0.013), 2)
@@ -42,6 +45,19 @@ _NOT_FOUND = ("not found: the D272.3 table of constants was not in any stored co
               "scribd copy of ASAE D272.3 MAR96 shows only its first page); no other source found "
               "quoting this grain's constants")
 
+#: The secondary source of every grain but soybean: a stored public GitHub file that the
+#: project's search index names by id only (its repository is not given).
+_SRC_A = ("secondary source: stored public GitHub file, search-index id 70324629401, a JavaScript "
+          "port of the VBA macros of the spreadsheet Resistencia_Fluxo_de_Ar.xls (silo aeration "
+          "fan sizing); its table ('A, B: constantes de Shedd'; 'Perda de carga por metro "
+          "(Shedd):  dP/L = A·Q² / ln(1 + B·Q)   [Pa/m, Q em m³/(s·m²)]') names ASAE D272.3 (its "
+          "canola comment: 'Conferir com a ASAE D272.3'), and its soybean row 'Soja: ... A: "
+          "10200, B: 16' is the thesis's D272.3 soybean pair")
+_EDITION_A = "ASAE D272.3 (as quoted by a secondary source; edition not stated)"
+_NOTE_A = ("secondary source only: the standard's own table was not seen; the source gives no "
+           "valid airflow range and no edition (D272.3 is inferred from its canola comment and "
+           "its soybean row)")
+
 D272: dict[str, D272Constants] = {
     "soybean": D272Constants(
         1.02e4, 16.0, None, None, "ASABE D272.3 (ASABE 2011)",
@@ -49,12 +65,40 @@ D272: dict[str, D272Constants] = {
         "be a = 1.02e4 Pa s^2 m^-3 and b = 16.0 m^-1 s'), quoting ASABE Standards D272.3 (2011); "
         "its 2.28 Pa at 0.013 m/s over 0.25 m (Table 4.5) checks them",
         "secondary source (the standard's own table not seen); valid airflow range not found"),
-    "wheat": D272Constants(None, None, None, None, "ASABE D272.3", "not found", _NOT_FOUND),
-    "shelled_corn": D272Constants(None, None, None, None, "ASABE D272.3", "not found", _NOT_FOUND),
+    "wheat": D272Constants(
+        2.70e4, 8.77, None, None, _EDITION_A,
+        _SRC_A + "; wheat row: \"Trigo: { massa: 772, repouso: 30, faixas: [{ ate: Infinity, "
+        "A: 27000, B: 8.77 }] }\"", _NOTE_A),
+    "shelled_corn": D272Constants(
+        2.07e4, 30.4, None, None, _EDITION_A,
+        _SRC_A + "; corn row, upper band: \"Milho: ... { ate: Infinity, A: 20700, B: 30.4 }\"; "
+        "confirmed by a second stored public GitHub file, search-index id 70970216257 (a "
+        "shelled-corn aeration sizing script): '# ASABE D272 Shedd constants for shelled corn: "
+        "dP/L = a Q² / ln(1 + b Q), Pa/m, Q in m³/(s m²)' and "
+        "'SHEDD_A, SHEDD_B = 2.07e4, 30.4'",
+        _NOTE_A + ". The same file splits corn at Q = 0.0203 m/s ('Milho tem duas faixas de "
+        "vazão (corte em Q = 0,0203 m³/(s·m²))'): '{ ate: 0.0203, A: 9970, B: 8.55 }' below, "
+        "the pair here above; that low band is confirmed by no second source, so it is not "
+        "used: the upper band's pair here is applied at every velocity"),
     "barley": D272Constants(None, None, None, None, "ASABE D272.3", "not found", _NOT_FOUND),
-    "rough_rice": D272Constants(None, None, None, None, "ASABE D272.3", "not found", _NOT_FOUND),
-    "canola": D272Constants(None, None, None, None, "ASABE D272.3", "not found", _NOT_FOUND),
-    "sorghum": D272Constants(None, None, None, None, "ASABE D272.3", "not found", _NOT_FOUND),
+    "rough_rice": D272Constants(
+        2.57e4, 13.2, None, None, _EDITION_A,
+        _SRC_A + "; rice row: \"Arroz: { massa: 570, repouso: 36, faixas: [{ ate: Infinity, "
+        "A: 25700, B: 13.2 }] }\"",
+        _NOTE_A + ". The source says 'Arroz' (rice) without saying rough or milled; it is taken "
+        "as rough rice because D272's grain list has rough rice: an inference, not stated by "
+        "the source"),
+    "canola": D272Constants(
+        None, None, None, None, "ASABE D272.3", "not found",
+        "not found: the D272.3 table of constants was not in any stored copy searched (the "
+        "scribd copy of ASAE D272.3 MAR96 shows only its first page); the only source found "
+        "quoting canola constants (search-index id 70324629401, A 28000, B 12) marks them "
+        "provisional: 'A e B: PROVISÓRIOS. Conferir com a ASAE D272.3 / Jayas et al. (1987) "
+        "antes de usar em dimensionamento.', so they are not used"),
+    "sorghum": D272Constants(
+        2.12e4, 8.06, None, None, _EDITION_A,
+        _SRC_A + "; sorghum row: \"Sorgo: { massa: 721, repouso: 30, faixas: [{ ate: Infinity, "
+        "A: 21200, B: 8.06 }] }\"", _NOTE_A),
 }
 
 

@@ -87,7 +87,7 @@ def test_same_grain_names():
 @pytest.mark.parametrize("name", sorted(D272))
 def test_d272_entries(name):
     c = D272[name]
-    assert isinstance(c, D272Constants) and c.edition.startswith("ASABE D272")
+    assert isinstance(c, D272Constants) and c.edition.startswith(("ASABE D272", "ASAE D272"))
     if c.a_pa_s2_m3 is None or c.b_s_m is None:
         assert c.a_pa_s2_m3 is None and c.b_s_m is None and "not found" in c.note
     else:
@@ -107,6 +107,48 @@ def test_d272_soybean_gives_the_thesis_check():
 
     assert dp(0.013, 0.25) == pytest.approx(2.28, abs=0.005)
     assert dp(0.027, 0.25) == pytest.approx(5.18, abs=0.005)
+
+
+#: issue 16 item 1: the D272.3 pairs of the secondary source (stored file id 70324629401, a
+#: port of the fan-sizing spreadsheet Resistencia_Fluxo_de_Ar.xls), corn's confirmed by a second
+#: (id 70970216257)
+SECONDARY = {"wheat": (27000.0, 8.77, "Trigo"), "shelled_corn": (20700.0, 30.4, "Milho"),
+             "sorghum": (21200.0, 8.06, "Sorgo"), "rough_rice": (25700.0, 13.2, "Arroz")}
+
+
+@pytest.mark.parametrize("name", sorted(SECONDARY))
+def test_d272_secondary_source_grains(name):
+    a, b, word = SECONDARY[name]
+    c = D272[name]
+    assert (c.a_pa_s2_m3, c.b_s_m) == (a, b)
+    assert "70324629401" in c.source and "Resistencia_Fluxo_de_Ar.xls" in c.source
+    assert word in c.source and f"A: {a:.0f}, B: {b:g}" in c.source      # the quoted row
+    assert "secondary source" in c.source and "secondary source" in c.note
+    assert c.edition == "ASAE D272.3 (as quoted by a secondary source; edition not stated)"
+    assert "not seen" in c.note and "no valid airflow range" in c.note
+    assert c.velocity_range_m_s is None and c.airflow_range_m3_min_m2 is None
+
+
+def test_d272_corn_confirmed_and_its_low_band_not_used():
+    c = D272["shelled_corn"]
+    assert "70970216257" in c.source and "SHEDD_A, SHEDD_B = 2.07e4, 30.4" in c.source
+    assert "A: 9970, B: 8.55" in c.note and "not used" in c.note
+
+
+def test_d272_rice_is_rough_rice_by_inference():
+    assert "inference" in D272["rough_rice"].note and "Arroz" in D272["rough_rice"].note
+
+
+def test_d272_canola_and_barley_stay_unsourced():
+    from network._grains import d272_constants, grains_with_d272
+    for name in ("canola", "barley"):
+        c = D272[name]
+        assert c.a_pa_s2_m3 is None and c.b_s_m is None and "not found" in c.note
+        with pytest.raises(ValueError, match=f"no sourced ASABE D272 constants for {name}"):
+            d272_constants(name)
+    assert "PROVISÓRIOS" in D272["canola"].note and "not used" in D272["canola"].note
+    assert grains_with_d272() == ["soybean", "wheat", "shelled_corn", "rough_rice", "sorghum"]
+    assert d272_constants("corn") == (20700.0, 30.4) and d272_constants("rice") == (25700.0, 13.2)
 
 
 def test_d272_soybean_agrees_with_the_empirical_module():

@@ -98,7 +98,7 @@ def test_unwritable_folder_is_refused(tmp_path):
     (["--velocities", "0.01,-0.2"], "--velocities value -0.2 must be finite and > 0"),
     (["--velocities", "0.3:0.01:0"], "--velocities needs n >= 1"),
     (["--grain", "oats"], "unknown grain 'oats'; known grains: soybean, wheat"),
-    (["--grain", "rice"], "no sourced ASABE D272 constants for rough_rice"),
+    (["--grain", "rapeseed"], "no sourced ASABE D272 constants for canola"),
     (["--density", "-1.2"], "--density must be finite and > 0, got -1.2"),
     (["--viscosity", "-1.8e-5"], "--viscosity must be finite and > 0"),
     (["--axis", "xy"], "invalid choice: 'xy'"),

@@ -85,11 +85,21 @@ def test_fit_curve_recovers_forchheimer():
 @pytest.mark.parametrize("argv, match", [
     (["--velocities", "0,0.1"], "0.0"), (["--velocities", "nan"], "nan"),
     (["--velocities", ""], "empty"), (["--density", "0"], "--density"),
-    (["--viscosity", "-1"], "--viscosity"), (["--grain", "wheat"], "grains with constants: soybean")])
+    (["--viscosity", "-1"], "--viscosity"), (["--grain", "barley"],
+                                                 "grains with constants: soybean, wheat")])
 def test_curve_bad_input_exit_2(argv, match, capsys):
     assert curve.main(["-q"] + argv) == 2
     err = capsys.readouterr().err
     assert match in err and "Traceback" not in err and len(err.strip().splitlines()) == 1
+
+
+@pytest.mark.parametrize("grain", ["wheat", "corn", "shelled_corn", "sorghum", "rice"])
+def test_curve_takes_every_grain_with_d272(grain):
+    """Issue 16 item 1: the grains with D272 constants (network._grains) are --grain choices."""
+    from network.flow import GRAINS
+    args = curve.build_parser().parse_args(["--grain", grain])
+    assert curve._check_options(args)
+    assert set(GRAINS) == {"soybean", "wheat", "shelled_corn", "rough_rice", "sorghum"}
 
 
 def test_curve_writes_points_fits_and_plot(tmp_path):

@@ -185,8 +185,13 @@ def test_done_when_wheat_from_the_bundled_bed(tmp_path, capsys, monkeypatch):
     assert r["bulk_density_kg_m3"] == pytest.approx(1240 * (1 - 0.402), rel=1e-12)
     assert r["bin"]["grain_mass_t"] == pytest.approx(
         1240 * 0.598 * np.pi * 9 * 3 / 1000, rel=1e-12)          # 62.9 t in a 6 m x 3 m bin
-    assert r["d272"]["a_pa_s2_m3"] is None
-    assert all(p["d272_pressure_gradient_pa_per_m"] is None for p in r["points"])
+    # wheat's D272.3 pair from the secondary source (network._grains): 27000 Pa s^2/m^3, 8.77 s/m
+    assert (r["d272"]["a_pa_s2_m3"], r["d272"]["b_s_m"]) == (27000.0, 8.77)
+    assert "70324629401" in r["d272"]["source"] and "secondary source" in r["d272"]["note"]
+    for p in r["points"]:
+        u = p["velocity_m_s"]
+        assert p["d272_pressure_gradient_pa_per_m"] == pytest.approx(
+            27000.0 * u**2 / np.log1p(8.77 * u), rel=1e-12)
     lo, hi = r["porosity_reachable"]
     assert lo < 0.402 < hi
     assert sorted(x.name for x in (tmp_path / "report_wheat").iterdir()) == [
