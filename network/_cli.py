@@ -219,6 +219,15 @@ def check_plot(option: str = "--plot") -> None:
                          "pip install '.[plot]' (or pip install matplotlib)") from exc
 
 
+def available_cores() -> int:
+    """Cores this process may run on (its CPU affinity; ``os.cpu_count()`` where the platform
+    has no affinity), at least 1."""
+    try:
+        return max(1, len(os.sched_getaffinity(0)))
+    except AttributeError:
+        return max(1, os.cpu_count() or 1)
+
+
 def check_common(args) -> None:
     """The numeric options every command may have, checked once (ValueError names them)."""
     for name in ("viscosity", "density", "velocity", "depth", "rtol"):

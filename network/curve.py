@@ -23,9 +23,9 @@ import time
 import numpy as np
 
 from ._air import check_positive
-from ._cli import (CliError, CliParser, add_air, add_packing, add_sample, add_table, bad_input,
-                   check_common, check_outputs, check_plot, computing, load_packing, progress_log, run,
-                   sample_box_m)
+from ._cli import (CliError, CliParser, add_air, add_packing, add_sample, add_table,
+                   available_cores, bad_input, check_common, check_outputs, check_plot, computing,
+                   load_packing, progress_log, run, sample_box_m)
 from .conductance import POLICIES
 from ._grains import GRAIN_ALIASES, d272_constants
 from .flow import (DEFAULT_DEPTH_M, GRAINS, asabe_d272_gradient, ergun_gradient,
@@ -95,6 +95,11 @@ def build_parser() -> CliParser:
     ap.add_argument("--plot", default=None, metavar="OUT.png",
                     help="write the D272-style log-log plot (needs matplotlib: "
                          "pip install '.[plot]'; default: not drawn)")
+    ap.add_argument("--workers", type=int, default=available_cores(),
+                    help="processes for the nonlinear solves: the velocities are dealt into "
+                         "this many continuation chains (at least 4 velocities each) solved "
+                         "side by side (default: the cores this process may use, "
+                         f"{available_cores()} here)")
     ap.add_argument("--quiet", "-q", action="store_true", help="no stage progress on stderr")
     return ap
 
@@ -177,7 +182,7 @@ def _main(args) -> int:
                             viscosity_pa_s=args.viscosity, velocity_m_s=us[0],
                             depth_m=args.depth, rtol=args.rtol, db=args.db, inertia=True,
                             density_kg_m3=args.density, curve_velocities_m_s=us[1:],
-                            inertial_law=args.inertial_law)
+                            inertial_law=args.inertial_law, inertial_workers=args.workers)
         pts = [{k: p[k] for k in KEYS} | {"newton_iterations": p["newton_iterations"],
                                           "cg_iterations": p["cg_iterations"]}
                for p in res.curve_points()]
@@ -197,8 +202,9 @@ def _main(args) -> int:
         print(f"  {k} = {v:.5g}" if isinstance(v, float) else f"  {k} = {v}")
     total = time.perf_counter() - t0
     print(f"total {total:.2f} s")
-    out = {"packing": str(path), "units": args.units, "n_spheres": packing.n, "axis": args.axis, "grain": args.grain,
-           "density_kg_m3": args.density, "viscosity_pa_s": args.viscosity,
+    out = {"packing": str(path), "units": args.units, "n_spheres": packing.n, "axis": args.axis,
+           "grain": args.grain, "workers": args.workers, "density_kg_m3": args.density,
+           "viscosity_pa_s": args.viscosity,
            "porosity": res.porosity, "sauter_diameter_m": res.sauter_diameter_m,
            "permeability_stokes_m2": res.permeability_m2, "points": pts} | fits | {
            "seconds": dict(res.timings_s, wall=total)}

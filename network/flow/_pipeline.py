@@ -56,7 +56,8 @@ def solve_network(packing: Packing, *, axis="z", region: Region | None = None,
                   qstar_fn: Callable | None = None, model_options: dict | None = None,
                   core_margin_m: float | None = None, inertia: bool = False,
                   density_kg_m3: float = RHO_AIR_KG_M3,
-                  curve_velocities_m_s=None, inertial_law: str = "onset") -> FlowResult:
+                  curve_velocities_m_s=None, inertial_law: str = "onset",
+                  inertial_workers: int = 1) -> FlowResult:
     """Permeability and pressure drop of a packing by the Delaunay network model.
 
     Parameters
@@ -120,6 +121,10 @@ def solve_network(packing: Packing, *, axis="z", region: Region | None = None,
         Per-conduit inertial loss (:data:`INERTIAL_LAWS`): 'onset' (default) the expansion
         with the laminar jet profile and the Re² onset (crossover 1); 'quadratic' the
         flat-profile loss K q|q| from the start (``docs/inertial-flow.md`` compares them).
+    inertial_workers : int
+        Processes for the nonlinear solves (``workers`` of
+        :func:`network.flow.solve_inertial`: parallel continuation chains of at least 4
+        velocities each; default 1).
 
     Returns
     -------
@@ -200,7 +205,7 @@ def solve_network(packing: Packing, *, axis="z", region: Region | None = None,
             us = [velocity_m_s] + curve_u
             pts = solve_inertial(sample.n_pores, sample.conns, g, K, sample.inlet,
                                  sample.outlet, np.asarray(us) * sample.area_m2,
-                                 crossover=crossover, amg=info.amg)
+                                 crossover=crossover, amg=info.amg, workers=inertial_workers)
             inertial = {"density_kg_m3": density_kg_m3, "velocities_m_s": us, "points": pts,
                         "law": inertial_law}
     times["assemble"] = info.assemble_s
