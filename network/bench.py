@@ -99,9 +99,14 @@ def main(argv=None) -> int:
                     help="run part 4 alone: inertial curve speed and drag-law errors")
     ap.add_argument("--inertial-spheres", type=int, default=20000,
                     help="spheres of the inertial speed packing (default 20000)")
+    ap.add_argument("--inertial-workers", type=int, default=None,
+                    help="continuation chains of the timed curve, solved side by side "
+                         "(default: the usable cores, as network.curve --workers)")
     ap.add_argument("--one", default=None, help=argparse.SUPPRESS)
     ap.add_argument("--no-trace", action="store_true", help=argparse.SUPPRESS)
     args = ap.parse_args(argv)
+    if args.inertial_workers is not None and args.inertial_workers < 1:
+        ap.error(f"--inertial-workers must be >= 1, got {args.inertial_workers}")
     if args.references_only and args.skip_references:
         ap.error("--references-only and --skip-references exclude each other")
     if args.ref_repeats < 1 or args.ref_spheres < 1:
@@ -123,7 +128,7 @@ def main(argv=None) -> int:
         report = {"machine_start": machine()}
         print(f"inertial curve on {args.inertial_spheres} spheres and drag laws:", flush=True)
         report["inertial_speed"] = inertial_speed(args.inertial_spheres, seed=args.seed,
-                                                  db=args.db)
+                                                  db=args.db, workers=args.inertial_workers)
         report["inertial_validation"] = inertial_validation(n_spheres=args.ref_spheres,
                                                             seed=args.ref_seed, db=args.db)
         print("\n".join(inertial_lines(report["inertial_speed"],

@@ -17,6 +17,7 @@ import time
 
 import numpy as np
 
+from .._cli import available_cores
 from ..packing import random_packing
 from ..pores import default_region
 from ..validation import (DERIVED_LAW, finney_inertial_case, random_inertial_case,
@@ -33,21 +34,35 @@ def _load() -> float:
     return float(os.getloadavg()[0])
 
 
+def _cpu_s() -> float:
+    """CPU seconds of this process and its finished children (the forked chains)."""
+    t = os.times()
+    return t.user + t.system + t.children_user + t.children_system
+
+
 def inertial_speed(n_spheres: int = 20_000, *, seed: int = 1, n_points: int = 12,
-                   policy: str = "table-only", db=None, law: str = "onset") -> dict:
+                   policy: str = "table-only", db=None, law: str = "onset",
+                   workers: int | None = None) -> dict:
     """Stage times (s) of a ``n_points`` curve 0.005-0.3 m/s on the benchmark packing, with
-    the conduit ``law`` of :data:`INERTIAL_LAWS` (default 'onset', ``network.solve``'s)."""
+    the conduit ``law`` of :data:`INERTIAL_LAWS` (default 'onset', ``network.solve``'s), its
+    Newton solves in ``workers`` continuation chains (default: the usable cores); the
+    process CPU time of the whole curve beside the wall times."""
+    if workers is None:
+        workers = available_cores()
     t0 = time.perf_counter()
     pk = random_packing(int(n_spheres), rng=seed, periodic=True, solid_fraction=0.60)
     gen = time.perf_counter() - t0
     region = default_region(pk, axis="z")
     us = np.geomspace(0.005, 0.3, int(n_points))
     load0 = _load()
+    cpu0 = _cpu_s()
     k, _, pts, t = solve_sample_curve(pk, region, us, axis=2, policy=policy, db=db,
                                       viscosity_pa_s=1.932e-5, density_kg_m3=1.2,
-                                      **INERTIAL_LAWS[law])
+                                      workers=workers, **INERTIAL_LAWS[law])
+    cpu = _cpu_s() - cpu0
     stokes = t["tessellate"] + t["conductance"] + t["stokes"]
-    return {"n_spheres": int(n_spheres), "law": law, "generate_s": gen,
+    return {"n_spheres": int(n_spheres), "law": law, "workers": int(workers),
+            "cpu_s": cpu, "generate_s": gen,
             **{f"{k2}_s": v for k2, v in t.items()},
             "stokes_pipeline_s": stokes, "curve_total_s": stokes + t["inertial"],
             "curve_over_stokes": (stokes + t["inertial"]) / stokes,
@@ -88,7 +103,9 @@ def inertial_lines(speed: dict | None, rows: list[dict]) -> list[str]:
                    f"{speed['conductance_s']:.2f} s, "
                    f"Stokes solve {speed['stokes_s']:.2f} s, Newton {speed['inertial_s']:.2f} s: "
                    f"curve {speed['curve_over_stokes']:.2f}x the Stokes pipeline; Newton "
-                   f"iterations {speed['newton_iterations']}, load {speed['load_before']:.1f}"
+                   f"iterations {speed['newton_iterations']}, CG {speed['cg_iterations']}, "
+                   f"{speed.get('workers', 1)} chain(s), CPU {speed.get('cpu_s', float('nan')):.2f}"
+                   f" s, load {speed['load_before']:.1f}"
                    f"-{speed['load_after']:.1f}")
     if rows:
         out.append(f"{'law':<9} {'case':<34} {'Re_p':>6} {'k/k_app':>8} {'Beetstra':>9} "

@@ -87,7 +87,7 @@ class InertialCase:
 def solve_sample_curve(packing, region, velocities_m_s, *, axis=0, policy="table-only",
                        db=None, viscosity_pa_s=1.0, density_kg_m3=1.0, crossover=None,
                        profile="uniform", onset=None, turning=False,
-                       contraction="sharp", recovery=0.0):
+                       contraction="sharp", recovery=0.0, workers: int = 1):
     """The inertial pipeline of :func:`network.solve_network` (conduit model, bodies merged;
     one AMG hierarchy, built for the Stokes solve and reused by every Newton step):
     ``(permeability_m2, length_m, points, seconds)``, ``seconds`` a dict by stage.
@@ -97,7 +97,8 @@ def solve_sample_curve(packing, region, velocities_m_s, *, axis=0, policy="table
     :func:`network.conductance.onset_scales`); the expansion ``profile``, ``contraction``
     ('sharp' | 'smooth') and ``turning`` (expansion against each body's Stokes outflow
     direction, :func:`network.conductance.turning_cosines`) of
-    :func:`network.conductance.inertial_coefficients`. :data:`DERIVED_LAW` is the law
+    :func:`network.conductance.inertial_coefficients`; ``workers`` continuation chains
+    (:func:`network.flow.solve_inertial`). :data:`DERIVED_LAW` is the law
     derived from single-constriction Navier-Stokes (``docs/inertial-flow.md``)."""
     if onset not in (None, "throat"):
         raise ValueError(f"onset must be None or 'throat', got {onset!r}")
@@ -144,7 +145,8 @@ def solve_sample_curve(packing, region, velocities_m_s, *, axis=0, policy="table
                             density_kg_m3=density_kg_m3, viscosity_pa_s=viscosity_pa_s)
     pts = solve_inertial(sample.n_pores, sample.conns, g, K, sample.inlet, sample.outlet,
                          np.asarray(velocities_m_s, dtype=float) * sample.area_m2,
-                         crossover=crossover, onset_scale=c_on, amg=held.get("amg"))
+                         crossover=crossover, onset_scale=c_on, amg=held.get("amg"),
+                         workers=workers)
     t["inertial"] = time.perf_counter() - t0
     return k, sample.length_m, pts, t
 
