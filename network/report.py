@@ -5,14 +5,16 @@ Examples
     python -m network.report --grain wheat --depth 3 --diameter 6   # bundled wheat bed
     python -m network.report --grain soybean --depth 3 --diameter 6 --fan fan.csv --html r.html
     python -m network.report --grain wheat --porosity 0.41 --packing bed.csv --json r.json
+    python -m network.report --grain wheat --seed 2        # packs a new bed (dem.pack, minutes)
 
 The inertial resistance curve (vertical z and horizontal x) of a packing, with ASABE D272 and
 Ergun beside it and the fits of :func:`network.flow.fit_curve`; the porosity band (d ln(ΔP/L)/dε
 computed by packing and solving neighbouring porosities, :mod:`network._report_band`); the
 system curve of a bin and, with ``--fan``, its operating point (:mod:`network._report_system`).
 The porosity reported is the grain's measured loose-fill porosity, ``--porosity``, or the
-packing's own, moved along the band's slope (:mod:`network._report_porosity`); figures go to
-``report_<grain>/`` unless ``--plot-dir``/``--no-figures`` say otherwise.
+packing's own, moved along the band's slope (:mod:`network._report_porosity`); ``--seed`` or a
+porosity away from the bundled bed's packs a new bed with ``dem.pack`` (:mod:`network._report_bed`).
+Figures go to ``report_<grain>/`` unless ``--plot-dir``/``--no-figures`` say otherwise.
 Exit 0 done, 1 a solve failed, 2 bad input: one ``error:`` line (docs/cli.md, docs/report.md).
 """
 
@@ -29,6 +31,7 @@ from ._cli import (CliError, CliParser, add_air, add_sample, bad_input, check_co
                    check_outputs, check_plot, computing, load_packing, progress_log, run,
                    sample_box_m)
 from ._grains import BED, D272, GRAIN_ALIASES, grains_with_d272
+from ._report_bed import add_bed_options, bed_json, plan_bed, prepare_bed
 from ._report_band import BAND_OFFSETS, band_gradients, pack_band, slope_at
 from ._report_porosity import (bundled_grains, bundled_packing, check_reachable, packing_meta,
                                reachable_range, requested_porosity, shift_factor)
@@ -56,8 +59,9 @@ def build_parser() -> CliParser:
                     help=f"crop: {', '.join(D272)} (D272 constants sourced for "
                          f"{', '.join(grains_with_d272())})")
     ap.add_argument("--packing", default=None, metavar="FILE",
-                    help="packing of that grain (any format the readers take); default: the "
-                         f"bundled one ({', '.join(bundled_grains())}); others: dem.pack")
+                    help="packing of that grain (any format the readers take), used as it is; "
+                         f"default: the bundled one ({', '.join(bundled_grains())}), or a new "
+                         "one (--seed, --porosity)")
     ap.add_argument("--units", default="m", type=str.lower, choices=list(UNITS),
                     help="length unit of the packing file")
     add_sample(ap, cylinder=False)
@@ -66,9 +70,11 @@ def build_parser() -> CliParser:
                     help="superficial velocities, m/s: a,b,c or start:stop:n (log-spaced)")
     ap.add_argument("--porosity", type=float, default=None,
                     help="porosity the report is for (default: the grain's measured loose-fill "
-                         "porosity, middle of its range); reached by moving along the band's "
-                         "computed slope from the packing's own, within the range a packing of "
-                         "the grain reaches")
+                         "porosity, middle of its range); more than 0.005 from the bundled bed's "
+                         "own, a grain with a dem template is packed anew at it (dem.pack, "
+                         "minutes); else (or --move-along-band, --packing) the prediction moves "
+                         "along the band's computed slope from the packing's own, within the "
+                         "range a packing of the grain reaches")
     ap.add_argument("--particle-density", type=float, default=None,
                     help="kernel (true) density, kg/m^3, for the bulk density rho_p (1 - "
                          "porosity); default: the grain library's (network/_grains.py BED)")
@@ -87,8 +93,7 @@ def build_parser() -> CliParser:
                     help=f"an airflow to report, UNIT one of {', '.join(AIRFLOW_UNITS)}")
     ap.add_argument("--fan", default=None, metavar="FILE",
                     help="fan curve CSV airflow_m3_s,static_pressure_pa: operating point")
-    ap.add_argument("--seed", type=int, default=1,
-                    help="first seed of the porosity band's packings (seed, seed + 1)")
+    add_bed_options(ap)
     ap.add_argument("--no-band", action="store_true", help="skip the porosity band (~15 s)")
     ap.add_argument("--json", dest="json_out", default=None, metavar="OUT.json",
                     help="write everything here")
@@ -125,18 +130,29 @@ def _check(args) -> dict:
             raise ValueError(f"no sourced kernel density for {key} (docs/grain-library.md): "
                              "give --particle-density (kg/m^3)")
         rho_p, rho_src = bed.particle_density_kg_m3, bed.particle_density_source
-    if args.packing is None:
-        if bundled_packing(key) is None:
-            raise ValueError(f"no bundled packing for {key} (bundled: "
-                             f"{', '.join(bundled_grains())}): pack one with python -m dem.pack "
-                             f"--scene box --grain {key} --porosity P --out bed.csv, then add "
-                             "--packing bed.csv")
-        args.packing = str(bundled_packing(key))
+    for opt in ("seed", "band_seed"):
+        if getattr(args, opt) is not None and getattr(args, opt) < 0:
+            raise ValueError(f"--{opt.replace('_', '-')} must be >= 0, got {getattr(args, opt)}")
     target, why = requested_porosity(key, args.porosity)
-    meta = packing_meta(args.packing)
-    reach = reachable_range(meta)
-    if target is not None:
-        check_reachable(target, meta.get("porosity_network_region"), reach, key)
+    if args.packing is None and bundled_packing(key) is None and args.seed is None \
+            and args.porosity is None:
+        raise ValueError(f"no bundled packing for {key} (bundled: "
+                         f"{', '.join(bundled_grains())}): give --porosity P or --seed N to pack "
+                         f"one (dem.pack, minutes), or pack it with python -m dem.pack --scene "
+                         f"box --grain {key} --porosity P --out bed.csv, then add --packing "
+                         "bed.csv")
+    bed = plan_bed(key, porosity=args.porosity, seed=args.seed, packing=args.packing,
+                   move_along_band=args.move_along_band, bed_box=args.bed_box,
+                   bed_dir=args.bed_dir or Path(args.plot_dir or f"report_{key}") / "beds")
+    reach = None
+    if bed["action"] == "pack":
+        target, why = None, "requested: " + bed["porosity_why"]  # the new bed's own
+    else:
+        args.packing = bed["packing"]
+        meta = packing_meta(args.packing)
+        reach = reachable_range(meta)
+        if target is not None:
+            check_reachable(target, meta.get("porosity_network_region"), reach, key)
     airflow = None
     if args.airflow is not None:
         value, unit = args.airflow
@@ -168,7 +184,7 @@ def _check(args) -> dict:
     return {"grain": key, "particle_density": rho_p, "particle_density_source": rho_src,
             "airflow": airflow, "fan": fan, "velocities": parse_velocities(args.velocities),
             "porosity": target, "porosity_source": why, "reachable": reach,
-            "plot_dir": plot_dir}
+            "plot_dir": plot_dir, "bed": bed}
 
 
 def _solve(args, packing, container, box, margin, axis, us, porosity=None):
@@ -230,7 +246,8 @@ def build_report(args, opts, path, packing) -> dict:
         ub = sorted(us)
         band = pack_band(packing, e_p, velocities_m_s=[ub[0], float(np.sqrt(ub[0] * ub[-1])),
                                                      ub[-1]],
-                         seeds=(args.seed, args.seed + 1), viscosity_pa_s=args.viscosity,
+                         seeds=(args.band_seed, args.band_seed + 1),
+                         viscosity_pa_s=args.viscosity,
                          density_kg_m3=args.density, inertial_law=args.inertial_law)
     c = D272[opts["grain"]]
     for p, px in zip(pts, pts_x):
@@ -265,7 +282,8 @@ def build_report(args, opts, path, packing) -> dict:
     sg = [p["pressure_gradient_pa_per_m"] for p in ok]
     system = system_rows(su, sg, depth_m=args.depth, area_m2=area, bulk_density_kg_m3=rho_b)
     out = {"grain": opts["grain"], "packing": str(path), "n_spheres": packing.n,
-           "n_grains": packing.n_grains, "porosity": e, "porosity_source": why,
+           "n_grains": packing.n_grains, "porosity": e,
+           "porosity_source": f"{opts['bed']['label']}; {why}", "bed": bed_json(opts["bed"], path),
            "porosity_packing": e_p, "porosity_packing_std": rz.porosity_std,
            "porosity_reachable": opts["reachable"],
            "porosity_move": ("none: the packing's own porosity" if not move else
@@ -317,6 +335,11 @@ def print_report(r) -> None:
     print(f"grain {r['grain']}: packing {r['packing']} ({r['n_grains']} grains, {r['n_spheres']} "
           f"spheres), own porosity {r['porosity_packing']:.4f} (std error "
           f"{r['porosity_packing_std']:.1e})")
+    b = r["bed"]
+    print(f"bed: {b['how']}" + (f" with seed {b['seed']}" if b["how"] == "packed anew" else "")
+          + (" (reused)" if b["reused"] else "")
+          + (f", dem.pack {b['pack_seconds']:.0f} s" if b["pack_seconds"] else "")
+          + (f"; not packed anew: {b['not_packed']}" if b["not_packed"] else ""))
     print(f"porosity of this report {r['porosity']:.4f}: {r['porosity_source']}; move: "
           f"{r['porosity_move']}")
     f = [p["porosity_shift_ln_stderr"] for p in r["points"]]
@@ -390,6 +413,8 @@ def _main(args) -> int:
     progress_log(args)
     with bad_input():
         opts = _check(args)
+    prepare_bed(args, opts)
+    with bad_input():
         path, packing = load_packing(args)
     with computing():
         rep = build_report(args, opts, path, packing)

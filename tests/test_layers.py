@@ -41,7 +41,7 @@ LAYERS = {
         {"airpaths"},
         {"validation"},
         {"__init__", "_cli", "solve", "throats", "paths", "curve", "report", "_report_band",
-         "_report_porosity",
+         "_report_porosity", "_report_bed",
          "_report_system", "_report_html", "bench", "benchmarks",
          "__main__"},
     ],

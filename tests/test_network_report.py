@@ -98,13 +98,14 @@ def test_bad_input_exits_2(tmp_path, capsys):
 @pytest.mark.parametrize("porosity, where", [("0.45", "0.3440-0.4164"), ("0.3", "0.3440-0.4164")])
 def test_porosity_outside_the_reachable_range_exits_2(tmp_path, capsys, monkeypatch, porosity,
                                                       where):
-    """The bundled soybean bed records what dem.pack --porosity reaches (0.3490-0.4114 +- its
-    0.005 tolerance, network/data/soybean_grains.json): outside it exit 2 before any solve,
+    """--move-along-band (no packing anew): the bundled soybean bed records what dem.pack
+    --porosity reaches (0.3490-0.4114 +- its 0.005 tolerance,
+    network/data/soybean_grains.json): outside it exit 2 before any solve,
     naming the range; the measured top of soybean's loose fill, 0.419, is out of reach too."""
     monkeypatch.chdir(tmp_path)
     out = tmp_path / "r.json"
     assert main(["--porosity", porosity, "--velocities", "0.01,0.1", "--no-band", "-q",
-                 "--json", str(out)]) == 2
+                 "--move-along-band", "--json", str(out)]) == 2
     err = capsys.readouterr().err.strip().splitlines()
     assert len(err) == 1, err
     assert (f"porosity {porosity} is outside the range a packing of soybean reaches: {where}"
