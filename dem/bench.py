@@ -5,6 +5,7 @@
     python -m dem.bench --mass-scale-study    # small packing made with S = 1, 10, 100
     python -m dem.bench --grains 500 2000 5000   # the grain engine (soybean templates)
     python -m dem.bench --grain-pack 5000        # + wall time of dem.pack for 5000 soybeans
+    python -m dem.bench --study DIR              # the thesis vibration study (about 1 h): its row
 
 Scene for the rate: N spheres of radius 3.25 mm on a simple cubic lattice 6.5 mm apart
 (overlap 1e-4 r, six contacts each, close to the 4–6 true contacts of a settled bed),
@@ -164,6 +165,36 @@ def mass_scale_study(scales=(1.0, 10.0, 100.0), *, seed=1, settle_time_s=0.3, gr
     return out
 
 
+#: The vibration study's representative scene (docs/dem-vibration.md: a cylinder 0.10 m across at
+#: the thesis's 0.25 m fill height; it compacts as the full 0.15 m bin within 0.0024 porosity).
+STUDY_ARGS = ["--study", "thesis", "--scene", "cylinder", "--size", "0.1", "--height", "0.25", "--seed", "1"]
+#: Issue 17's target for the five-intensity study on two cores, s.
+STUDY_TARGET_S = 3600.0
+
+
+def study_row(out_dir, *, threads=None) -> dict:
+    """Run (or resume, or reuse) ``python -m dem.vibrate`` with :data:`STUDY_ARGS` in ``out_dir``
+    and return its bench row: scene, spheres, per intensity the simulated seconds, steps and
+    wall seconds, the bed's packing and the timed network steps, the total against
+    :data:`STUDY_TARGET_S`, and particle-steps/s of the vibration."""
+    from .vibrate import main as vibrate_main
+    argv = [*STUDY_ARGS, "--out", str(out_dir)] + ([] if threads is None else ["--threads", str(threads)])
+    code = vibrate_main(argv)
+    if code != 0:
+        raise RuntimeError(f"dem.vibrate {' '.join(argv)} exited {code}")
+    with open(os.path.join(out_dir, "study.json")) as f:
+        st = json.load(f)
+    rows, w = st["rows"], st["wall_time_s"]
+    steps = [int(r["vibration_steps"]) for r in rows]
+    vib_wall = float(sum(w["vibration"]))
+    return {"command": "python -m dem.vibrate " + " ".join(argv), "scene": st["scene"],
+            "container": st["container"], "n_spheres": st["n_spheres"], "dt_s": st["dt_s"],
+            "intensities_g": [r["intensity_g"] for r in rows], "vibrated_s": [r["vibrated_s"] for r in rows],
+            "stopped_by": [r["stopped_by"] for r in rows], "steps": steps, "wall_s": w,
+            "total_wall_s": w["total"], "target_s": STUDY_TARGET_S, "met": w["total"] <= STUDY_TARGET_S,
+            "particle_steps_per_s": st["n_spheres"] * sum(steps) / vib_wall if vib_wall > 0 else None}
+
+
 def main(argv=None) -> int:
     tune_malloc()
     p = argparse.ArgumentParser(prog="python -m dem.bench", description=__doc__.split("\n")[0])
@@ -181,13 +212,30 @@ def main(argv=None) -> int:
                    help="instead of the sphere rates: grain-engine rates for these soybean grain counts")
     p.add_argument("--grain-pack", type=int, default=None, metavar="G",
                    help="also time python -m dem.pack --grain soybean for G grains in a cube (e.g. 5000)")
+    p.add_argument("--study", metavar="DIR", default=None,
+                   help="instead of the rates: run (or resume, or reuse) the thesis vibration study on the "
+                        "representative 0.10 x 0.25 m cylinder in DIR (about an hour on two cores) and print "
+                        "its row against issue 17's one-hour target")
     p.add_argument("--json", default="dem_bench.json", help="output JSON path (default dem_bench.json)")
     args = p.parse_args(argv)
     meta = {"loadavg_before": os.getloadavg(), "platform": platform.platform(), "cpu_count": os.cpu_count(),
             "python": sys.version.split()[0], "numpy": np.__version__,
             "timestamp": time.strftime("%Y-%m-%dT%H:%M:%SZ", time.gmtime())}
     result = {"meta": meta}
-    if args.mass_scale_study:
+    if args.study:
+        r = result["study"] = study_row(args.study, threads=args.threads)
+        print(f"{'scene':>9} {'spheres':>8} {'intensities g':>30} {'vibrated s':>30} {'steps':>9} {'bed s':>6} "
+              f"{'vibration s':>12} {'network s':>10} {'total s':>8} {'p-steps/s':>10}  target 3600 s")
+        print(f"{r['scene']:>9} {r['n_spheres']:8d} {' '.join(f'{g:.2f}' for g in r['intensities_g']):>30} "
+              f"{' '.join(f'{v:.1f}' for v in r['vibrated_s']):>30} {sum(r['steps']):9d} "
+              f"{r['wall_s']['bed'] or 0:6.0f} {sum(r['wall_s']['vibration']):12.0f} "
+              f"{r['wall_s']['network_timed']:10.0f} {r['total_wall_s']:8.0f} {r['particle_steps_per_s'] or 0:10.3e}  "
+              f"{'met' if r['met'] else 'missed'}", flush=True)
+        if r["wall_s"]["incomplete"] or r["wall_s"]["network_steps_untimed"]:
+            print(f"  not in the total: the wall time of earlier runs of amplitudes {r['wall_s']['incomplete']} "
+                  f"(checkpoints without it) and {r['wall_s']['network_steps_untimed']} network steps done before",
+                  flush=True)
+    elif args.mass_scale_study:
         result["mass_scale_study"] = mass_scale_study(tuple(args.scales))
     elif args.grains or args.grain_pack:
         print(f"{'grains':>7} {'spheres':>8} {'contacts':>9} {'ms/step':>8} {'s-steps/s best':>15} {'median':>12} "

@@ -72,11 +72,13 @@ def _network(csv, container, out_json, quiet, timeout_s=1800):
     result = {}
     for name, (module, extra) in NETWORK_STEPS.items():
         target = out_json.with_name(f"{out_json.stem}_{name}.json")
+        t0 = None                    # a step done by an earlier run: its time is not known here
         if not target.exists():
             cmd = [sys.executable, "-m", module, str(csv), "--json", str(target), *extra]
             if name == "solve" and container.kind == "cylinder":
                 cmd.append("--cylinder")
             _log(f"  {' '.join(cmd[1:])}", quiet)
+            t0 = time.perf_counter()
             try:
                 run = subprocess.run(cmd, capture_output=True, text=True, timeout=timeout_s)
                 err = None if run.returncode == 0 else (run.stderr.strip().splitlines() or ["?"])[-1]
@@ -87,6 +89,8 @@ def _network(csv, container, out_json, quiet, timeout_s=1800):
                 _log(f"  {module} failed: {err}", quiet)
                 continue
         result[name] = _network_numbers(name, json.loads(target.read_text()))
+        if t0 is not None:
+            result[name]["seconds"] = time.perf_counter() - t0
     return result
 
 
@@ -114,15 +118,22 @@ def _row(amp, freq, s, coord_before):
             "porosity_spheres_after": s["history"]["porosity_spheres"][-1],
             "min_local_porosity_during": s["minimum_during"]["porosity_spheres_min"],
             "vibrated_s": s["vibrated_s"], "stopped_by": s["stopped_by"], "vibration_steps": s["vibration_steps"],
-            "wall_time_s": s["wall_time_s"], "coordination_before": coord_before, "coordination_after": s["coordination"]}
+            "wall_time_s": s["wall_time_s"], "wall_time_note": s.get("wall_time_note"),
+            "coordination_before": coord_before, "coordination_after": s["coordination"]}
 
 
-def _checkpointer(path):
+def _checkpointer(path, wall_before_s=0.0, t0=None):
+    """Checkpoint writer; it also keeps the wall time of the vibration so far (``wall_s``:
+    ``wall_before_s`` of earlier runs plus this run's since ``t0``), so a resumed intensity
+    reports its whole cost."""
+    t0 = time.perf_counter() if t0 is None else t0
+
     def save(ck):
         arrays = {f"state__{k}": np.asarray(v) for k, v in ck["state"].items()}
         arrays.update({f"snap__{t!r}": x for t, x in ck["snapshots"].items()})
         meta = {"history": {k: np.asarray(v).tolist() for k, v in ck["history"].items()},
-                "next_record_s": ck["next_record_s"], "next_checkpoint_s": ck["next_checkpoint_s"]}
+                "next_record_s": ck["next_record_s"], "next_checkpoint_s": ck["next_checkpoint_s"],
+                "wall_s": wall_before_s + time.perf_counter() - t0}
         tmp = path.with_name(path.stem + ".tmp.npz")
         np.savez(tmp, meta=np.array(json.dumps(meta)), **arrays)
         os.replace(tmp, path)
@@ -136,7 +147,7 @@ def _load_checkpoint(path):
         snaps = {float(k[len("snap__"):]): f[k] for k in f.files if k.startswith("snap__")}
     hist = {k: (list(map(np.asarray, v)) if k == "porosity_spheres" else v) for k, v in meta["history"].items()}
     return {"state": state, "history": hist, "snapshots": snaps, "next_record_s": meta["next_record_s"],
-            "next_checkpoint_s": meta["next_checkpoint_s"]}
+            "next_checkpoint_s": meta["next_checkpoint_s"], "wall_s": meta.get("wall_s")}
 
 
 def _progress(label, duration_s, quiet):
@@ -188,21 +199,25 @@ def run_study(args, container, amplitudes) -> int:
                 bar.update(round(float(resume["state"]["time_s"]), 3))
                 progress.steps0 = int(resume["state"]["steps"])
             t0 = time.perf_counter()
+            wall_before = float((resume or {}).get("wall_s") or 0.0)
             try:
                 res = vibrate_bed(centers, radii, container, freq_hz=args.freq, amplitude_m=amp, duration_s=duration,
                                   material=_material(bed_summary), mass_scale=args.mass_scale,
                                   record_every_s=1.0 / args.freq, measure_spheres=measure,
                                   max_settle_steps=args.settle_steps, steady_window_s=steady or None,
                                   rest_tol=args.rest_tol if resume is None else None, progress=progress,
-                                  checkpoint=_checkpointer(ck_path), checkpoint_every_s=args.checkpoint_every,
+                                  checkpoint=_checkpointer(ck_path, wall_before, t0), checkpoint_every_s=args.checkpoint_every,
                                   resume=resume, threads=args.threads)
             except DemInstabilityError as e:
                 raise DemInstabilityError(f"A = {amp} m: {e}; what was saved stays in {out}") from e
             finally:
                 bar.close()
             s = res.summary
-            s["wall_time_s"] = time.perf_counter() - t0  # this session's (a resumed run: since the restart)
+            s["wall_time_s"] = wall_before + time.perf_counter() - t0  # earlier runs' from the checkpoint
             s["resumed_at_s"] = None if resume is None else float(resume["state"]["time_s"])
+            if resume is not None and resume.get("wall_s") is None:
+                s["wall_time_note"] = (f"since the restart at {s['resumed_at_s']:.2f} s simulated: the checkpoint "
+                                       "kept no wall time of the earlier run")
             s["history"] = {"times_s": res.times_s.tolist(), "porosity_spheres": res.porosity_spheres.tolist(),
                             "porosity_interior": res.porosity_interior.tolist(),
                             "porosity_global": res.porosity_global.tolist(),
@@ -233,6 +248,7 @@ def run_study(args, container, amplitudes) -> int:
                 "porosity_global_surface": bed_summary["porosity_global_surface"],
                 "coordination": bed_summary["coordination"], "network": network_before},
         "rows": rows, "series": series, "wall_time_s_this_run": time.perf_counter() - t_study,
+        "wall_time_s": _wall_times(bed_summary, network_before, rows),
     }
     (out / "study.json").write_text(json.dumps(study, indent=1))
     plots = plot_study(study, out)
@@ -240,6 +256,19 @@ def run_study(args, container, amplitudes) -> int:
     made = f", {', '.join(p.name for p in plots)}" if plots else " (no matplotlib: no plots; pip install '.[plot]')"
     print(f"-> {out / 'study.json'}{made}")
     return 0
+
+
+def _wall_times(bed_summary, network_before, rows):
+    """Wall seconds of the study's parts as recorded (earlier runs included where the files kept
+    them): packing the bed, each intensity's vibration, the network steps timed; ``total``."""
+    nets = [network_before] + [r.get("network_after") for r in rows]
+    net = [v.get("seconds") for n in nets for v in (n or {}).values() if isinstance(v, dict)]
+    out = {"bed": bed_summary.get("wall_time_s"), "vibration": [r["wall_time_s"] for r in rows],
+           "network_timed": float(sum(x for x in net if x is not None)),
+           "network_steps_untimed": sum(x is None for x in net),
+           "incomplete": [r["amplitude_m"] for r in rows if r.get("wall_time_note")]}
+    out["total"] = float((out["bed"] or 0.0) + sum(out["vibration"]) + out["network_timed"])
+    return out
 
 
 def _material(summary):

@@ -106,9 +106,26 @@ def test_study_command_runs_resumes_and_writes_what_it_says(tmp_path, capsys):
         assert len(r["porosity_spheres_after"]) == 5  # B1-B5
     assert (tmp_path / "bed.csv").exists() and (tmp_path / "vib_2mm" / "after.csv").exists()
     assert (tmp_path / "porosity_time.png").exists() and (tmp_path / "porosity_intensity.png").exists()
+    w = study["wall_time_s"]
+    assert all(x > 0 for x in w["vibration"]) and w["bed"] > 0 and w["incomplete"] == []
+    assert w["total"] == pytest.approx(w["bed"] + sum(w["vibration"]) + w["network_timed"])
     first = capsys.readouterr().out
     assert "A mm" in first
     # a second run reuses the bed and both results: same table
     assert vib_main(args) == 0
     assert json.loads((tmp_path / "study.json").read_text())["rows"] == study["rows"]
     assert vib_main([*args[:-2], "--out", str(tmp_path), "extra.csv"]) == 2  # --study takes no packing
+
+
+def test_checkpoint_keeps_the_wall_time_of_earlier_runs(tmp_path):
+    """A resumed intensity reports its whole wall time: the checkpoint stores earlier runs'
+    seconds plus this run's (here 5 s before and 1 s in this run)."""
+    import time
+    from dem.study import _checkpointer, _load_checkpoint
+    path = tmp_path / "checkpoint.npz"
+    ck = {"state": {"time_s": np.array(0.5), "steps": np.array(10)}, "snapshots": {},
+          "history": {"times_s": [0.0, 0.5]}, "next_record_s": 0.6, "next_checkpoint_s": 1.0}
+    _checkpointer(path, 5.0, time.perf_counter() - 1.0)(ck)
+    back = _load_checkpoint(path)
+    assert back["wall_s"] == pytest.approx(6.0, abs=0.2)
+    assert float(back["state"]["time_s"]) == 0.5 and back["history"]["times_s"] == [0.0, 0.5]
