@@ -61,6 +61,20 @@ def plot_study(study, out_dir):
         ax.legend(fontsize=8)
         fig.tight_layout()
         paths.append(_save(fig, out_dir / "pressure_drop_intensity.png", plt))
+
+    curves = [("before", (study["bed"].get("network") or {}).get("curve"))]
+    curves += [(f"{gi:.2f} g", (r.get("network_after") or {}).get("curve")) for gi, r in zip(g, rows)]
+    curves = [(lab, c) for lab, c in curves if c and c.get("velocity_m_s")]
+    if curves:
+        fig, ax = plt.subplots(figsize=(5.5, 4.2))
+        for lab, c in curves:
+            ax.loglog(c["velocity_m_s"], c["pressure_gradient_pa_per_m"], "k--" if lab == "before" else "o-",
+                      ms=3, label=lab)
+        ax.set(xlabel="superficial air velocity, m/s", ylabel="pressure gradient, Pa/m (network, with inertia)",
+               title="resistance before and after vibration")
+        ax.legend(fontsize=8)
+        fig.tight_layout()
+        paths.append(_save(fig, out_dir / "resistance_curves.png", plt))
     return paths
 
 

@@ -9,13 +9,14 @@ for 16 s each. In ``--out`` (default ``vibration_study``) the command
    measurement spheres B1–B5 every period (``vib_<A>mm/after.csv`` + ``.json``), with a
    checkpoint every ``--checkpoint-every`` s of simulated time: an interrupted study started
    again goes on from the checkpoints and ends with the same numbers;
-3. runs ``python -m network.solve`` (pressure drop, permeability) and ``python -m network.paths``
+3. runs ``python -m network.solve`` (pressure drop, permeability), ``python -m network.curve`` (the
+   resistance curve with inertia, 0.005-0.3 m/s, and its fits) and ``python -m network.paths``
    (tortuosity, widths) on the bed before and after each vibration, as subprocesses: dem imports
    no other project package; a failed or missing network step is recorded and retried on the
    next run;
 4. writes ``study.json`` (one row per intensity, coordination distributions, dt, stiffnesses)
    and the plots ``porosity_time.png`` (thesis Figs. 4.11, 4.13), ``porosity_intensity.png``
-   (Fig. 4.14) and ``pressure_drop_intensity.png``.
+   (Fig. 4.14), ``pressure_drop_intensity.png`` and ``resistance_curves.png``.
 """
 
 from __future__ import annotations
@@ -40,7 +41,10 @@ from ._vibrate import intensity_g, vibrate_bed
 __all__ = ["run_study", "NETWORK_STEPS"]
 
 #: network CLIs run on every bed: name -> (module, extra arguments)
-NETWORK_STEPS = {"solve": ("network.solve", ["--quiet"]), "paths": ("network.paths", ["--no-branched"])}
+NETWORK_STEPS = {"solve": ("network.solve", ["--quiet"]), "paths": ("network.paths", ["--no-branched"]),
+                 "curve": ("network.curve", ["--quiet"])}
+#: steps that sample the container's cylinder (the others trace paths in the box)
+_CYLINDER_STEPS = ("solve", "curve")
 
 
 def _log(msg, quiet):
@@ -75,7 +79,7 @@ def _network(csv, container, out_json, quiet, timeout_s=1800):
         t0 = None                    # a step done by an earlier run: its time is not known here
         if not target.exists():
             cmd = [sys.executable, "-m", module, str(csv), "--json", str(target), *extra]
-            if name == "solve" and container.kind == "cylinder":
+            if name in _CYLINDER_STEPS and container.kind == "cylinder":
                 cmd.append("--cylinder")
             _log(f"  {' '.join(cmd[1:])}", quiet)
             t0 = time.perf_counter()
@@ -95,6 +99,11 @@ def _network(csv, container, out_json, quiet, timeout_s=1800):
 
 
 def _network_numbers(name, data):
+    if name == "curve":     # the resistance curve with inertia: its fits and points
+        keys = ("permeability_m2", "forchheimer_beta_per_m", "d272_a", "d272_b", "ergun_A", "ergun_B")
+        return {**{k: data.get(k) for k in keys},
+                "velocity_m_s": [p["velocity_m_s"] for p in data.get("points", [])],
+                "pressure_gradient_pa_per_m": [p["pressure_gradient_pa_per_m"] for p in data.get("points", [])]}
     if name == "solve":
         keys = ("pressure_drop_pa", "pressure_gradient_pa_per_m", "permeability_m2", "pressure_drop_stokes_pa",
                 "porosity", "velocity_m_s", "depth_m", "n_pores", "n_throats")
@@ -224,7 +233,8 @@ def run_study(args, container, amplitudes) -> int:
                             "floor_z_m": res.motion["floor_z_m"].tolist(), "bed_z_m": res.motion["bed_z_m"].tolist()}
             write_packing(d / "after.csv", res.centers, res.radii, s)
             ck_path.unlink(missing_ok=True)
-        if not args.no_network and (not s.get("network") or any("error" in v for v in s["network"].values())):
+        if not args.no_network and (set(NETWORK_STEPS) - set(s.get("network") or {})
+                                    or any("error" in v for v in s["network"].values())):
             s["network"] = _network(d / "after.csv", container, d / "network.json", quiet)
             write_summary(d / "after.csv", s)
         row = _row(amp, args.freq, s, bed_summary["coordination"])

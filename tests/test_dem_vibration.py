@@ -129,3 +129,25 @@ def test_checkpoint_keeps_the_wall_time_of_earlier_runs(tmp_path):
     back = _load_checkpoint(path)
     assert back["wall_s"] == pytest.approx(6.0, abs=0.2)
     assert float(back["state"]["time_s"]) == 0.5 and back["history"]["times_s"] == [0.0, 0.5]
+
+
+def test_study_keeps_each_beds_resistance_curve_and_plots_them(tmp_path):
+    """The study's network steps include network.curve: its fits and points are kept per bed
+    (numbers passed through unchanged) and drawn before/after in resistance_curves.png."""
+    pytest.importorskip("matplotlib")
+    from dem._plots import plot_study
+    from dem.study import NETWORK_STEPS, _network_numbers
+    assert NETWORK_STEPS["curve"][0] == "network.curve"
+    data = {"permeability_m2": 4e-8, "forchheimer_beta_per_m": 1800.0, "d272_a": 5500.0, "d272_b": 13.0,
+            "ergun_A": 171.0, "ergun_B": 1.26,
+            "points": [{"velocity_m_s": 0.005, "pressure_gradient_pa_per_m": 2.3},
+                       {"velocity_m_s": 0.3, "pressure_gradient_pa_per_m": 342.0}]}
+    c = _network_numbers("curve", data)
+    assert c["forchheimer_beta_per_m"] == 1800.0 and c["pressure_gradient_pa_per_m"] == [2.3, 342.0]
+    after = dict(c, pressure_gradient_pa_per_m=[2.9, 420.0])
+    row = {"intensity_g": 1.81, "porosity_global_before": 0.41, "porosity_global_after": 0.39,
+           "porosity_interior_after": 0.37, "porosity_spheres_after": [0.36] * 5,
+           "network_after": {"curve": after}}
+    study = {"bed": {"network": {"curve": c}}, "rows": [row], "series": {}}
+    names = [p.name for p in plot_study(study, tmp_path)]
+    assert "resistance_curves.png" in names and (tmp_path / "resistance_curves.png").stat().st_size > 1000
