@@ -34,6 +34,7 @@ from ._procedures import pack_bed
 from ._perf import tune_malloc
 from .clumps import ClumpSimulation
 from .templates import library_template
+from .vibrate import main as vibrate_main
 
 
 def lattice_simulation(n, *, rng=0, mass_scale=100.0, threads=None):
@@ -177,7 +178,6 @@ def study_row(out_dir, *, threads=None) -> dict:
     and return its bench row: scene, spheres, per intensity the simulated seconds, steps and
     wall seconds, the bed's packing and the timed network steps, the total against
     :data:`STUDY_TARGET_S`, and particle-steps/s of the vibration."""
-    from .vibrate import main as vibrate_main
     argv = [*STUDY_ARGS, "--out", str(out_dir)] + ([] if threads is None else ["--threads", str(threads)])
     code = vibrate_main(argv)
     if code != 0:
