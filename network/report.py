@@ -27,9 +27,9 @@ from pathlib import Path
 
 import numpy as np
 
-from ._cli import (CliError, CliParser, add_air, add_sample, bad_input, check_common,
-                   check_outputs, check_plot, computing, load_packing, progress_log, run,
-                   sample_box_m)
+from ._cli import (CliError, CliParser, add_air, add_sample, available_cores, bad_input,
+                   check_common, check_outputs, check_plot, computing, load_packing,
+                   progress_log, run, sample_box_m)
 from ._grains import BED, D272, GRAIN_ALIASES, grains_with_d272
 from ._report_bed import add_bed_options, bed_json, plan_bed, prepare_bed
 from ._report_band import BAND_OFFSETS, band_gradients, pack_band, slope_at
@@ -193,7 +193,8 @@ def _solve(args, packing, container, box, margin, axis, us, porosity=None):
     return solve_network(packing, axis=axis, region=region, viscosity_pa_s=args.viscosity,
                          velocity_m_s=us[0], depth_m=args.depth, inertia=True,
                          density_kg_m3=args.density, curve_velocities_m_s=us[1:],
-                         inertial_law=args.inertial_law, porosity=porosity)
+                         inertial_law=args.inertial_law, porosity=porosity,
+                         inertial_workers=available_cores())
 
 
 def _fits(args, pts, porosity, d32):
