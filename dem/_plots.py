@@ -32,7 +32,8 @@ def plot_study(study, out_dir):
         a2.plot(t, np.mean(np.asarray(s["porosity_spheres"]), axis=1), label=f"{s['intensity_g']:.2f} g")
     a1.set(xlabel="time, s", ylabel="global porosity", title="global porosity (cf. thesis Fig. 4.11)")
     a2.set(xlabel="time, s", ylabel="local porosity, mean of B1–B5", title="local porosity (cf. Fig. 4.13)")
-    a1.legend(fontsize=8)
+    if study["series"]:
+        a1.legend(fontsize=8)
     fig.tight_layout()
     paths.append(_save(fig, out_dir / "porosity_time.png", plt))
 
