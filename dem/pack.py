@@ -35,6 +35,10 @@ from ._procedures import PROCEDURES, pack_bed
 from .grains import grain
 from .templates import resolve_template
 
+#: default step limit of each stage: sphere beds; multi-sphere grain beds (a grain step costs
+#: 6-11 sphere steps; corn's 0.08 m cube settles in ~100 000, give --max-steps)
+SPHERE_MAX_STEPS, GRAIN_MAX_STEPS = 200_000, 60_000
+
 
 def _parser():
     p = argparse.ArgumentParser(prog="python -m dem.pack", description=__doc__.split("\n")[1])
@@ -81,8 +85,9 @@ def _parser():
                    help="'sediment': amplitude falls linearly to 0 over the taps (annealed)")
     p.add_argument("--keep-lid", action="store_true", help="do not remove the lid before the last settling")
     p.add_argument("--tol", type=float, default=2e-3, help="mean unbalanced-force ratio at equilibrium")
-    p.add_argument("--max-steps", type=int, default=200000, help="step limit of each stage (default 200000); a bed not at "
-                   "equilibrium by then is written with \"converged\": false and exit 1")
+    p.add_argument("--max-steps", type=int, default=None, help="step limit of each stage (default 200000 for spheres, "
+                   f"{GRAIN_MAX_STEPS} for --grain beds); a bed not at equilibrium by then is written with "
+                   "\"converged\": false and exit 1")
     p.add_argument("--dt-safety", type=float, default=0.25, help="time step as this fraction of sqrt(mass_scale m_min / "
                    "max(k_n, k_s)), the critical step of the lightest sphere (default 0.25)")
     for name, default, what in [("density", 1285.0, "particle density, kg/m^3"),
@@ -135,7 +140,7 @@ def _pack_grains(args) -> int:
     pr = progress_printer(quiet=args.quiet)
     size_cv, size_cv_source = _size_cv(args, template.name)
     kw = dict(material=material, n_grains=args.n_grains, rng=args.seed, mass_scale=args.mass_scale, size_cv=size_cv,
-              tol=args.tol, max_steps=min(args.max_steps, 60000),
+              tol=args.tol, max_steps=GRAIN_MAX_STEPS if args.max_steps is None else args.max_steps,
               progress=lambda sim, f: pr("grains", _Progress(sim), None))
     if args.porosity is not None and args.deposition_friction is None:
         try:
@@ -239,6 +244,8 @@ def _procedure_options(args):
 
 
 def _pack(args) -> int:
+    if args.max_steps is not None and args.max_steps < 1:
+        raise ValueError(f"--max-steps must be >= 1, got {args.max_steps}")
     if args.grain is not None:
         return _pack_grains(args)
     material = _material(args)
@@ -251,7 +258,8 @@ def _pack(args) -> int:
     porosity = 0.408 if args.porosity is None else args.porosity
     res = pack_bed(container, material=material, porosity=porosity, n_particles=args.n_particles,
                    rng=args.seed, mass_scale=args.mass_scale, packing_friction=args.packing_friction,
-                   open_top=not args.keep_lid, tol=args.tol, max_steps=args.max_steps,
+                   open_top=not args.keep_lid, tol=args.tol,
+                   max_steps=SPHERE_MAX_STEPS if args.max_steps is None else args.max_steps,
                    dt_safety=args.dt_safety, measure_spheres=measure,
                    progress=progress_printer(quiet=args.quiet), **opts)
     s = res.summary

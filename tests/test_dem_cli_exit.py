@@ -38,3 +38,23 @@ def test_ctrl_c_exits_1_with_one_line_and_writes_nothing(tmp_path, capsys, monke
     err = capsys.readouterr().err.strip().splitlines()
     assert code == 1 and len(err) == 1 and err[0].startswith("interrupted: "), err
     assert not list(tmp_path.iterdir())
+
+
+def test_grain_beds_take_the_users_step_limit(tmp_path, monkeypatch, capsys):
+    """--max-steps reaches the grain packer as given (it was silently capped at 60 000, so a
+    corn bed that settles in ~100 000 steps could not be packed); the default stays 60 000;
+    0 is refused (exit 2)."""
+    seen = []
+
+    def fake_pack_grains(*a, **kw):
+        seen.append(kw["max_steps"])
+        raise KeyboardInterrupt          # stop before any work: exit 1, nothing written
+
+    monkeypatch.setattr(pack, "pack_grains", fake_pack_grains)
+    base = ["--scene", "box", "--grain", "soybean", "--out", str(tmp_path / "g.csv"), "--quiet"]
+    assert pack.main([*base, "--max-steps", "240000"]) == 1
+    assert pack.main(base) == 1
+    assert seen == [240000, pack.GRAIN_MAX_STEPS] and pack.GRAIN_MAX_STEPS == 60000
+    assert pack.main([*base, "--max-steps", "0"]) == 2
+    assert "--max-steps must be >= 1" in capsys.readouterr().err
+    assert not (tmp_path / "g.csv").exists()
