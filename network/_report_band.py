@@ -17,18 +17,24 @@ size gives S ≈ -11 to -13 (issue 16 quotes -11).
 
 from __future__ import annotations
 
+import json
 import logging
 import time
+from pathlib import Path
 
 import numpy as np
 
 from .flow import solve_network
 from .packing import Packing, random_packing
 
-__all__ = ["BAND_OFFSETS", "fit_log_slope", "band_gradients", "slope_at", "pack_band"]
+__all__ = ["BAND_OFFSETS", "fit_log_slope", "band_gradients", "slope_at", "pack_band",
+           "measured_band", "GRAIN_BANDS"]
 
 log = logging.getLogger(__name__)
 
+#: grains whose band was measured on their own DEM grain beds: network/data/band_<grain>.json
+#: (beds, gradients at three velocities, how they were made)
+GRAIN_BANDS = {"wheat": Path(__file__).resolve().parent / "data" / "band_wheat.json"}
 #: porosity offsets of the reported band
 BAND_OFFSETS = (-0.02, -0.01, 0.01, 0.02)
 #: interior porosity of random_packing beds ≈ WALL_OFFSET - solid fraction (the walls loosen
@@ -146,3 +152,29 @@ def pack_band(packing: Packing, porosity: float, *, velocities_m_s, axis: str = 
             "packer": "network.packing.random_packing (geometric grow-and-push, no gravity or "
                       "friction; closed box of the packing's shape)",
             "seconds": time.perf_counter() - t0}
+
+
+def measured_band(grain: str) -> dict | None:
+    """The band of ``grain`` from its own multi-sphere DEM beds (:data:`GRAIN_BANDS`), or None.
+
+    The bundled beds' porosities and gradients are fitted here as :func:`pack_band` fits its
+    sphere beds (:func:`fit_log_slope`, one family), and the same keys are returned. Sphere beds
+    of the grain's volume-equivalent size give a steeper slope: for wheat -12.8 / -12.4 / -11.6
+    against its grain beds' -10.8 / -10.4 / -9.0 at 0.005 / 0.039 / 0.3 m/s
+    (``docs/report.md``), so a grain with measured beds uses them.
+    """
+    path = GRAIN_BANDS.get(grain)
+    if path is None:
+        return None
+    data = json.loads(path.read_text())
+    e = np.array([b["porosity"] for b in data["beds"]])
+    g = np.array([b["pressure_gradient_pa_per_m"] for b in data["beds"]])
+    fits = [fit_log_slope(e, g[:, j]) for j in range(g.shape[1])]
+    return {"velocities_m_s": list(data["velocities_m_s"]), "slopes": [f["slope"] for f in fits],
+            "slope_stderrs": [f["slope_stderr"] for f in fits],
+            "rms_residuals": [f["rms_residual"] for f in fits],
+            "beds": [{"name": b["name"], "seed": b["seed"], "porosity": b["porosity"],
+                      "pressure_gradient_pa_per_m": b["pressure_gradient_pa_per_m"]}
+                     for b in data["beds"]],
+            "packer": f"dem.pack (the grain's own multi-sphere beds, network/data/{path.name})",
+            "source": data["source"], "seconds": 0.0}

@@ -32,7 +32,8 @@ from ._cli import (CliError, CliParser, add_air, add_sample, available_cores, ba
                    progress_log, run, sample_box_m)
 from ._grains import BED, D272, GRAIN_ALIASES, grains_with_d272
 from ._report_bed import add_bed_options, bed_json, plan_bed, prepare_bed
-from ._report_band import BAND_OFFSETS, band_gradients, pack_band, slope_at
+from ._report_band import (BAND_OFFSETS, band_gradients, measured_band, pack_band,
+                           slope_at)
 from ._report_porosity import (bundled_grains, bundled_packing, check_reachable, packing_meta,
                                reachable_range, requested_porosity, shift_factor)
 from ._report_html import write_figures, write_html
@@ -95,6 +96,10 @@ def build_parser() -> CliParser:
                     help="fan curve CSV airflow_m3_s,static_pressure_pa: operating point")
     add_bed_options(ap)
     ap.add_argument("--no-band", action="store_true", help="skip the porosity band (~15 s)")
+    ap.add_argument("--sphere-band", action="store_true",
+                    help="compute the band on sphere beds of the grain's volume-equivalent size "
+                         "even for a grain whose own DEM beds are bundled (wheat: "
+                         "network/data/band_wheat.json, used by default for a grain bed)")
     ap.add_argument("--json", dest="json_out", default=None, metavar="OUT.json",
                     help="write everything here")
     ap.add_argument("--html", default=None, metavar="OUT.html",
@@ -243,7 +248,9 @@ def build_report(args, opts, path, packing) -> dict:
     rx = _solve(args, packing, container, box, margin, "x", us)
     pts, pts_x = _points(rz), _points(rx)
     band = None
-    if not args.no_band:
+    if not args.no_band and packing.n_grains < packing.n and not args.sphere_band:
+        band = measured_band(opts["grain"])     # the grain's own DEM beds, where bundled
+    if not args.no_band and band is None:
         ub = sorted(us)
         band = pack_band(packing, e_p, velocities_m_s=[ub[0], float(np.sqrt(ub[0] * ub[-1])),
                                                      ub[-1]],

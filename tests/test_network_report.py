@@ -195,6 +195,16 @@ def test_done_when_wheat_from_the_bundled_bed(tmp_path, capsys, monkeypatch):
             27000.0 * u**2 / np.log1p(8.77 * u), rel=1e-12)
     lo, hi = r["porosity_reachable"]
     assert lo < 0.402 < hi
+    # the band from wheat's own eight DEM beds (network/data/band_wheat.json), not sphere beds:
+    # each point's band is g exp(S de) with S interpolated in ln U between the beds' velocities
+    b = r["band"]
+    assert b["packer"].startswith("dem.pack") and len(b["beds"]) == 8
+    for p in r["points"]:
+        S = np.interp(np.log(p["velocity_m_s"]), np.log(b["velocities_m_s"]), b["slopes"])
+        band = p["pressure_gradient_band_pa_per_m"]
+        assert [band[k] for k in ("-0.02", "-0.01", "+0.01", "+0.02")] == pytest.approx(
+            [p["pressure_gradient_pa_per_m"] * np.exp(S * d) for d in (-0.02, -0.01, 0.01, 0.02)],
+            rel=1e-9)
     assert sorted(x.name for x in (tmp_path / "report_wheat").iterdir()) == [
         "report_band.png", "report_curve.png", "report_system.png"]
 
@@ -221,3 +231,20 @@ def test_axis_x_puts_the_horizontal_curve_into_the_system_curve(tmp_path, capsys
     assert r["airflow"]["static_pressure_pa"] == pytest.approx(
         2.0 * by_u[0.05]["pressure_gradient_horizontal_pa_per_m"], rel=1e-12)
     assert "horizontal airflow (x): thickness crossed 2 m" in capsys.readouterr().out
+
+
+def test_measured_band_is_the_fit_of_the_grain_beds():
+    """measured_band fits ln g = c + S e over the bundled wheat beds (one family): the slope and
+    its standard error equal an independent numpy least-squares fit; grains without measured
+    beds get None (the report then packs sphere beds)."""
+    from network._report_band import GRAIN_BANDS, measured_band
+    data = json.loads(GRAIN_BANDS["wheat"].read_text())
+    b = measured_band("wheat")
+    e = np.array([x["porosity"] for x in data["beds"]])
+    for j in range(3):
+        y = np.log([x["pressure_gradient_pa_per_m"][j] for x in data["beds"]])
+        coef, cov = np.polyfit(e, y, 1, cov=True)
+        assert b["slopes"][j] == pytest.approx(coef[0], rel=1e-9)
+        assert b["slope_stderrs"][j] == pytest.approx(np.sqrt(cov[0, 0]), rel=1e-6)
+    assert [round(x, 2) for x in b["slopes"]] == [-10.8, -10.41, -9.01]
+    assert measured_band("soybean") is None and len(data["beds"]) == 8
