@@ -97,9 +97,8 @@ def build_parser() -> CliParser:
     add_bed_options(ap)
     ap.add_argument("--no-band", action="store_true", help="skip the porosity band (~15 s)")
     ap.add_argument("--sphere-band", action="store_true",
-                    help="compute the band on sphere beds of the grain's volume-equivalent size "
-                         "even for a grain whose own DEM beds are bundled (wheat: "
-                         "network/data/band_wheat.json, used by default for a grain bed)")
+                    help="band on sphere beds of the grain's volume-equivalent size even where "
+                         "the grain's own DEM beds are bundled (wheat: data/band_wheat.json)")
     ap.add_argument("--json", dest="json_out", default=None, metavar="OUT.json",
                     help="write everything here")
     ap.add_argument("--html", default=None, metavar="OUT.html",
