@@ -21,6 +21,8 @@ from skfem import (Basis, BilinearForm, ElementTriP1, ElementTriP2, ElementVecto
                    MeshTri, asm, bmat, condense, solve)
 from skfem.helpers import ddot, dot, grad
 
+from _ns_newton import newton      # this folder's Newton loop, shared by both scripts
+
 
 @BilinearForm
 def viscous(u, v, w):
@@ -104,17 +106,11 @@ def constriction(rw, h, reynolds, *, a=1.0, up=3.0, down=25.0, dz=0.025, n_radia
     rows = []
     for re in reynolds:
         rho = re / (uw * 2 * rw)             # mu = 1
-        for it in range(60):
-            u0 = bu.interpolate(U[:nu])
-            J = bmat([[A + rho * asm(convection_jacobian, bu, u0=u0), B.T], [B, None]], "csr")
-            F = stokes @ U
-            F[:nu] += rho * asm(convection, bu, u0=u0)
-            dU = solve(*condense(J, -F, x=np.zeros_like(U), D=D))
-            U = U + dU
-            if np.linalg.norm(dU) <= 1e-9 * np.linalg.norm(U):
-                break
+        U, steps = newton(U, rho, A=A, B=B, stokes=stokes, basis_u=bu, nu=nu, D=D,
+                          convection=convection, convection_jacobian=convection_jacobian,
+                          rtol=1e-9, maxiter=60)
         dp = section_mean(U[nu:], zs[0]) - section_mean(U[nu:], z_out)
-        rows.append({"rw": rw, "h": h, "sigma": rw**2 / rb**2, "Re": re, "newton": it + 1,
+        rows.append({"rw": rw, "h": h, "sigma": rw**2 / rb**2, "Re": re, "newton": steps,
                      "k_excess": (dp - dp_stokes) / (0.5 * rho * uw**2),
                      "excess_over_conduit_stokes": (dp - dp_stokes) / dp_conduit})
     return rows

@@ -31,6 +31,8 @@ from skfem import (Basis, BilinearForm, ElementTetP1, ElementTetP2, ElementVecto
                    Functional, LinearForm, MeshTet, asm, bmat, condense, solve)
 from skfem.helpers import ddot, div, dot, grad
 
+from _ns_newton import newton      # this folder's Newton loop, shared by both scripts
+
 
 def regular(L=2.0):
     """Vertices of a regular tetrahedron of edge L, face (0, 1, 2) in the plane z = 0."""
@@ -182,17 +184,11 @@ def pore(reynolds, *, h=0.1, V=None, r=0.9, e=0.5):
              "outflow_split": (q_out / q_out.sum()).round(4).tolist()}]
     for re in reynolds:
         rho = re / (u_w * d_w)                                 # mu = 1
-        for it in range(30):
-            u0 = bu.interpolate(U[:nu])
-            J = bmat([[A + rho * asm(convection_jacobian, bu, u0=u0), B.T], [B, None]], "csr")
-            F = stokes @ U
-            F[:nu] += rho * asm(convection, bu, u0=u0)
-            dU = solve(*condense(J, -F, x=np.zeros_like(U), D=D))
-            U = U + dU
-            if np.linalg.norm(dU) <= 1e-8 * np.linalg.norm(U):
-                break
+        U, steps = newton(U, rho, A=A, B=B, stokes=stokes, basis_u=bu, nu=nu, D=D,
+                          convection=convection, convection_jacobian=convection_jacobian,
+                          rtol=1e-8, maxiter=30)
         k = (split(U) - stokes_d) / (0.5 * rho * u_w**2 * Q)
-        rows.append({"h": h, "n_tets": int(m.t.shape[1]), "Re_w": re, "newton": it + 1,
+        rows.append({"h": h, "n_tets": int(m.t.shape[1]), "Re_w": re, "newton": steps,
                      "k_pore": float(k[0]), "k_body": float(k[1]), "k_prism": float(k[2])})
     return rows
 

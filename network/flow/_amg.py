@@ -153,8 +153,10 @@ class AMGSolver:
             with threadpool_limits(limits=1, user_api="blas"):
                 # pyamg's CG (its residual history) with the project's V-cycle: what
                 # ml.solve(accel='cg') does, less two residual norms per V-cycle
-                y, _ = pyamg_cg(ml.levels[0].A, bs, x0=y, tol=tol, maxiter=limit,
-                                M=self._cycle_operator(ml), residuals=res_abs)
+                M = spla.LinearOperator((self.n, self.n), matvec=self._held_cycle(ml),
+                                        dtype=float)
+                y, _ = pyamg_cg(ml.levels[0].A, bs, x0=y, tol=tol, maxiter=limit, M=M,
+                                residuals=res_abs)
             solve_t += time.perf_counter() - t1
             hist.extend(r / bsn for r in res_abs[1:])    # res_abs[0] is the initial residual
             if np.linalg.norm(bs - As @ y) <= tol * bsn * 1.0000001:
@@ -190,12 +192,8 @@ class AMGSolver:
         """
         ml, _ = self._hierarchy(self.strength)
         if A is None:
-            op = self._cycle_operator(ml)
-            s = self._s
-            return spla.LinearOperator((self.n, self.n), matvec=lambda r: s * op.matvec(
-                s * np.ravel(r)), dtype=float)    # callers limit BLAS threads around the CG
-        ops = [lv.A for lv in ml.levels]
-        if A is not None:
+            cycle = self._held_cycle(ml)
+        else:
             A = sp.csr_array(A)
             if A.shape != (self.n, self.n):
                 raise ValueError(f"A must have shape ({self.n}, {self.n}), got {A.shape}")
@@ -203,8 +201,8 @@ class AMGSolver:
             ops = [sp.csr_matrix(S @ A @ S)]
             for lv in ml.levels[:-1]:
                 ops.append(sp.csr_matrix(lv.R @ (ops[-1] @ lv.P)))
-        cycle = _VCycle(ops, [lv.P for lv in ml.levels[:-1]], [lv.R for lv in ml.levels[:-1]],
-                        self.smoother)
+            cycle = _VCycle(ops, [lv.P for lv in ml.levels[:-1]],
+                            [lv.R for lv in ml.levels[:-1]], self.smoother)
         s = self._s
 
         def apply(r):           # callers limit BLAS threads around the whole CG
@@ -212,15 +210,13 @@ class AMGSolver:
 
         return spla.LinearOperator((self.n, self.n), matvec=apply, dtype=float)
 
-
-    def _cycle_operator(self, ml) -> spla.LinearOperator:
+    def _held_cycle(self, ml) -> "_VCycle":
         """One V-cycle of hierarchy ``ml`` (scaled variables), built once per hierarchy."""
         if getattr(self, "_cycle_of", None) is not ml:
             self._cycle = _VCycle([lv.A for lv in ml.levels], [lv.P for lv in ml.levels[:-1]],
                                   [lv.R for lv in ml.levels[:-1]], self.smoother)
             self._cycle_of = ml
-        n = ml.levels[0].A.shape[0]
-        return spla.LinearOperator((n, n), matvec=self._cycle, dtype=float)
+        return self._cycle
 
 
 class _VCycle:
@@ -231,13 +227,15 @@ class _VCycle:
     symmetric sweep on both sides ('symmetric'); LU on the coarsest level."""
 
     def __init__(self, ops, P, R, smoother):
+        from pyamg.relaxation.relaxation import gauss_seidel   # pyamg: imported when used
+        self.gs = gauss_seidel
         self.ops, self.P, self.R = ops, P, R
         self.pre, self.post = (("forward", "backward") if smoother == "forward-backward"
                                else ("symmetric", "symmetric"))
         self.lu = spla.splu(sp.csc_matrix(ops[-1]))
 
     def __call__(self, b):
-        from pyamg.relaxation.relaxation import gauss_seidel
+        gauss_seidel = self.gs
         xs, bs = [], [b]
         for A, R in zip(self.ops[:-1], self.R):        # down: pre-smooth, restrict
             x = np.zeros_like(bs[-1])
