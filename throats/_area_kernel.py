@@ -37,7 +37,8 @@ def area_perimeter_rows(verts, radii, tol=1e-11):
         import numba  # a dependency, loaded only when some row needs the exact engine
 
         jit = numba.njit(cache=True, error_model="numpy")
-        globals()["_sort"] = jit(_sort)   # the compiled loop calls the compiled sort
+        globals()["_sort"] = jit(_sort)   # the compiled loop calls the compiled helpers
+        globals()["_line_circle"] = jit(_line_circle)
         _COMPILED.append(jit(_rows))
     v = np.ascontiguousarray(verts, dtype=np.float64)
     r = np.ascontiguousarray(radii, dtype=np.float64)
@@ -64,15 +65,11 @@ def _rows(V, R, tol, area, per):  # compiled by area_perimeter_rows
         for k in range(3):
             m = 2
             lt[0], lt[1] = 0.0, 1.0
-            aa = dx[k] * dx[k] + dy[k] * dy[k]
             for c in range(3):
-                fx, fy = ax[k] - V[n, c, 0], ay[k] - V[n, c, 1]
-                bb = 2.0 * (fx * dx[k] + fy * dy[k])
-                cc = fx * fx + fy * fy - R[n, c] * R[n, c]
-                disc = bb * bb - 4.0 * aa * cc
-                if disc >= 0.0:
-                    sq = np.sqrt(disc)
-                    for t in ((-bb - sq) / (2.0 * aa), (-bb + sq) / (2.0 * aa)):
+                meets, t_lo, t_hi = _line_circle(ax[k], ay[k], dx[k], dy[k], V[n, c, 0],
+                                                 V[n, c, 1], R[n, c])
+                if meets:
+                    for t in (t_lo, t_hi):
                         if tol < t < 1.0 - tol:
                             lt[m] = t
                             m += 1
@@ -98,14 +95,9 @@ def _rows(V, R, tol, area, per):  # compiled by area_perimeter_rows
             m = 2
             cu[0], cu[1] = 0.0, 1.0
             for q in range(3):
-                aa = dx[q] * dx[q] + dy[q] * dy[q]
-                fx, fy = ax[q] - cx, ay[q] - cy
-                bb = 2.0 * (fx * dx[q] + fy * dy[q])
-                cc = fx * fx + fy * fy - rc * rc
-                disc = bb * bb - 4.0 * aa * cc
-                if disc >= 0.0:
-                    sq = np.sqrt(disc)
-                    for t in ((-bb - sq) / (2.0 * aa), (-bb + sq) / (2.0 * aa)):
+                meets, t_lo, t_hi = _line_circle(ax[q], ay[q], dx[q], dy[q], cx, cy, rc)
+                if meets:
+                    for t in (t_lo, t_hi):
                         if -tol <= t <= 1.0 + tol:
                             u = (-np.arctan2(ay[q] + t * dy[q] - cy, ax[q] + t * dx[q] - cx)) % two_pi / two_pi
                             if 1e-13 < u < 1.0 - 1e-13:
@@ -152,6 +144,20 @@ def _rows(V, R, tol, area, per):  # compiled by area_perimeter_rows
                     p_sum += two_pi * (u1 - u0) * rc
         area[n] = max(a_sum, 0.0)
         per[n] = p_sum
+
+
+def _line_circle(ax, ay, dx, dy, cx, cy, r):
+    """Where the line (ax, ay) + t (dx, dy) meets the circle (cx, cy, r): ``(meets, t_lo, t_hi)``,
+    the roots of |a + t d - c|^2 = r^2 (compiled with the loop; edges and circles both use it)."""
+    aa = dx * dx + dy * dy
+    fx, fy = ax - cx, ay - cy
+    bb = 2.0 * (fx * dx + fy * dy)
+    cc = fx * fx + fy * fy - r * r
+    disc = bb * bb - 4.0 * aa * cc
+    if disc < 0.0:
+        return False, 0.0, 0.0
+    sq = np.sqrt(disc)
+    return True, (-bb - sq) / (2.0 * aa), (-bb + sq) / (2.0 * aa)
 
 
 def _sort(a, m):
