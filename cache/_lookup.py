@@ -24,6 +24,7 @@ from __future__ import annotations
 
 import logging
 import os
+import threading
 import time
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -91,6 +92,9 @@ def shipped_grid_path(name=DEFAULT_GRID):
 
 # cache of loaded tables: (path, grid, solver_version, mtime_ns) -> GridTable
 _TABLES: dict = {}
+# one loader at a time: threads looking up at once (network's conductance blocks) would
+# otherwise build and save the same derived arrays twice
+_TABLES_LOCK = threading.RLock()
 
 
 def grid_from_store(store, name, solver_version):
@@ -146,6 +150,11 @@ def load_grid_table(db=None, *, grid=None, solver_version=None):
     grid of ``db`` (cells with unsolved corners are never served).  Returns None when there
     is none for the current solver version.
     """
+    with _TABLES_LOCK:
+        return _load_grid_table(db, grid, solver_version)
+
+
+def _load_grid_table(db, grid, solver_version):
     if solver_version is None:
         solver_version = _build.default_solver()[1]
     partial = None

@@ -235,8 +235,9 @@ def check_common(args) -> None:
             check_positive(f"--{name}", getattr(args, name))
     if getattr(args, "margin", None) is not None and not args.margin >= 0:
         raise ValueError(f"--margin must be >= 0 (packing units), got {args.margin!r}")
-    if getattr(args, "workers", 1) < 1:
-        raise ValueError(f"--workers must be >= 1, got {args.workers!r}")
+    for name in ("workers", "threads"):
+        if getattr(args, name, 1) < 1:
+            raise ValueError(f"--{name} must be >= 1, got {getattr(args, name)!r}")
 
 
 def load_packing(args):

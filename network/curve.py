@@ -98,7 +98,8 @@ def build_parser() -> CliParser:
     ap.add_argument("--workers", type=int, default=available_cores(),
                     help="processes for the nonlinear solves: the velocities are dealt into "
                          "this many continuation chains (at least 4 velocities each) solved "
-                         "side by side (default: the cores this process may use, "
+                         "side by side; also the threads of the conductance stage "
+                         "(default: the cores this process may use, "
                          f"{available_cores()} here)")
     ap.add_argument("--quiet", "-q", action="store_true", help="no stage progress on stderr")
     return ap
@@ -182,7 +183,8 @@ def _main(args) -> int:
                             viscosity_pa_s=args.viscosity, velocity_m_s=us[0],
                             depth_m=args.depth, rtol=args.rtol, db=args.db, inertia=True,
                             density_kg_m3=args.density, curve_velocities_m_s=us[1:],
-                            inertial_law=args.inertial_law, inertial_workers=args.workers)
+                            inertial_law=args.inertial_law, inertial_workers=args.workers,
+                            threads=args.workers)
         pts = [{k: p[k] for k in KEYS} | {"newton_iterations": p["newton_iterations"],
                                           "cg_iterations": p["cg_iterations"]}
                for p in res.curve_points()]

@@ -198,7 +198,7 @@ def _solve(args, packing, container, box, margin, axis, us, porosity=None):
                          velocity_m_s=us[0], depth_m=args.depth, inertia=True,
                          density_kg_m3=args.density, curve_velocities_m_s=us[1:],
                          inertial_law=args.inertial_law, porosity=porosity,
-                         inertial_workers=available_cores())
+                         inertial_workers=available_cores(), threads=available_cores())
 
 
 def _fits(args, pts, porosity, d32):

@@ -22,9 +22,9 @@ from pathlib import Path
 
 import numpy as np
 
-from ._cli import (CliError, CliParser, add_air, add_packing, add_sample, add_table, bad_input,
-                   check_common, check_outputs, computing, load_packing, progress_log, run,
-                   sample_box_m)
+from ._cli import (CliError, CliParser, add_air, add_packing, add_sample, add_table,
+                   available_cores, bad_input, check_common, check_outputs, computing,
+                   load_packing, progress_log, run, sample_box_m)
 from .conductance import MODELS, POLICIES, throat_qstar
 from .flow import (DEFAULT_DEPTH_M, DEFAULT_VELOCITY_M_S, combined_summary, solve_axes,
                    write_network_vtu)
@@ -66,6 +66,10 @@ def build_parser() -> CliParser:
                     help="throat conductance model (thesis = Eq. 3.41, L = 2 r̄)")
     add_table(ap)
     ap.add_argument("--workers", type=int, default=1, help="processes for FE solves, >= 1")
+    ap.add_argument("--threads", type=int, default=available_cores(),
+                    help="threads for the conductances and the porosity (beside the "
+                         "tessellation), >= 1; the result does not depend on it (default: "
+                         "the cores this process may use)")
     ap.add_argument("--json", dest="json_out", default=None, metavar="OUT.json",
                     help="write every number here (default: not written)")
     ap.add_argument("--vtk", default=None, metavar="OUT.vtu",
@@ -225,7 +229,8 @@ def _main(args) -> int:
             viscosity_pa_s=args.viscosity, velocity_m_s=args.velocity, depth_m=args.depth,
             rtol=args.rtol, db=args.db, workers=args.workers, progress=not args.quiet,
             inertia=not args.stokes and args.conductance_model == "conduit",
-            density_kg_m3=args.density, inertial_law=args.inertial_law, tessellation=tess)
+            density_kg_m3=args.density, inertial_law=args.inertial_law, tessellation=tess,
+            threads=args.threads)
         written = [p for res in results for p in (_write_tables(res, tess, args, len(axes) > 1)
                                                   if tables else [])]
     for p in written:

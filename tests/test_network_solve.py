@@ -6,6 +6,7 @@ from scipy.sparse.linalg import spsolve
 
 import throats
 from network import Packing, tessellate
+from network.conductance import conduit_conductance
 from network.packing import random_packing
 from network.packing import lattice_packing
 from network.flow import solve_network
@@ -275,3 +276,24 @@ def test_bad_options_are_refused_before_the_tessellation(small_bed, monkeypatch)
                       (dict(axis="w"), "axis must be one of")):
         with pytest.raises(ValueError, match=match):
             solve_network(small_bed, **kw)
+
+
+def test_threads_do_not_change_the_answer(small_bed):
+    """Conductance blocks on several threads and the porosity beside Qhull (issue 18): the same
+    conductances to the last bit, the same porosity, and a bad thread count refused."""
+    tess = tessellate(small_bed)
+    idx = np.arange(tess.n_throats)
+    one = conduit_conductance(tess, idx, policy="table-only", threads=1)
+    for n in (2, 5):
+        many = conduit_conductance(tess, idx, policy="table-only", threads=n)
+        assert np.array_equal(one.g, many.g, equal_nan=True)
+        assert np.array_equal(one.qstar, many.qstar, equal_nan=True)
+        assert many.stats["section_qstar_stats"] == one.stats["section_qstar_stats"]
+    kw = dict(conductance_model="conduit", policy="table-only", porosity_points=20_000)
+    serial = solve_network(small_bed, threads=1, **kw)
+    threaded = solve_network(small_bed, threads=2, **kw)
+    assert threaded.porosity == serial.porosity and threaded.porosity_std == serial.porosity_std
+    assert np.array_equal(threaded.throat_conductance, serial.throat_conductance)
+    assert threaded.permeability_m2 == pytest.approx(serial.permeability_m2, rel=1e-10)
+    with pytest.raises(ValueError, match="threads must be >= 1"):
+        solve_network(small_bed, threads=0, **kw)

@@ -17,6 +17,7 @@ from __future__ import annotations
 import logging
 import time
 import tracemalloc
+from concurrent.futures import ThreadPoolExecutor
 from typing import Callable
 
 import numpy as np
@@ -57,7 +58,7 @@ def solve_network(packing: Packing, *, axis="z", region: Region | None = None,
                   core_margin_m: float | None = None, inertia: bool = False,
                   density_kg_m3: float = RHO_AIR_KG_M3,
                   curve_velocities_m_s=None, inertial_law: str = "onset",
-                  inertial_workers: int = 1) -> FlowResult:
+                  inertial_workers: int = 1, threads: int = 1) -> FlowResult:
     """Permeability and pressure drop of a packing by the Delaunay network model.
 
     Parameters
@@ -125,6 +126,10 @@ def solve_network(packing: Packing, *, axis="z", region: Region | None = None,
         Processes for the nonlinear solves (``workers`` of
         :func:`network.flow.solve_inertial`: parallel continuation chains of at least 4
         velocities each; default 1).
+    threads : int
+        Threads (default 1): the porosity runs beside the tessellation (Qhull releases the
+        GIL) and the conduit conductances in blocks on ``threads`` threads; the result does
+        not depend on it.
 
     Returns
     -------
@@ -155,12 +160,24 @@ def solve_network(packing: Packing, *, axis="z", region: Region | None = None,
     def stage(name):
         return _Stage(name, times, peaks, trace_memory)
 
+    threads = int(threads)
+    if threads < 1:
+        raise ValueError(f"threads must be >= 1, got {threads}")
+    reg = (default_region(packing, margin=margin, cylinder=cylinder, container=container,
+                          axis=axis) if region is None else region)
+    eps_job = None
+    if threads > 1 and porosity is None and porosity_points:
+        # the porosity needs only the spheres and the region: beside Qhull (which releases
+        # the GIL) on a second core; the thread ends with its job
+        eps_pool = ThreadPoolExecutor(1)
+        eps_job = eps_pool.submit(region_porosity, packing, reg, ax, n_points=porosity_points)
+        eps_pool.shutdown(wait=False)
     with stage("tessellate"):
         tess = tessellate(packing) if tessellation is None else tessellation
     with stage("sample"):
-        reg = (default_region(packing, margin=margin, cylinder=cylinder, container=container,
-                              axis=axis) if region is None else region)
         labels, model_opts = None, dict(model_options or {})
+        if conductance is None and conductance_model == "conduit":
+            model_opts.setdefault("threads", threads)
         if conductance is None and conductance_model == "conduit" and merge_ties:
             # the conduit model's pore bodies (near-co-spherical groups, slivers) are
             # contracted here, so its near-infinite internal conductances never reach the solver
@@ -216,6 +233,8 @@ def solve_network(packing: Packing, *, axis="z", region: Region | None = None,
     with stage("porosity"):
         if porosity is not None:
             eps, eps_err = map(float, porosity)
+        elif eps_job is not None:
+            eps, eps_err = eps_job.result()
         elif porosity_points:
             eps, eps_err = region_porosity(packing, reg, ax, n_points=porosity_points)
         else:
