@@ -16,8 +16,9 @@ the packing file's unit (``--units``, default m); physical quantities (``--depth
 from __future__ import annotations
 
 import argparse
-import logging
 import contextlib
+import gc
+import logging
 import os
 import re
 import sys
@@ -136,6 +137,19 @@ def run(body, parser: argparse.ArgumentParser, argv=None) -> int:
         warn(f"{len(caught)} numerical warning(s) from numpy/scipy suppressed "
              f"({len(distinct)} distinct; first: {distinct[0][:160]})")
     return code
+
+
+def finish(code: int):
+    """Exit the process with ``code``, the cyclic garbage collector frozen first.
+
+    At exit the interpreter collects every object still alive: 0.1-0.15 s after a
+    20 000-sphere solve (its arrays, the tessellation, the AMG hierarchy), about 5 % of the
+    command. ``gc.freeze`` moves them out of the collector's reach; files are closed and
+    outputs written by then (the ``with`` blocks of the commands), so nothing is lost.
+    """
+    sys.stdout.flush()
+    gc.freeze()
+    sys.exit(code)
 
 
 # ------------------------------------------------------------------ arguments

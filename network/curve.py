@@ -25,7 +25,7 @@ import numpy as np
 from ._air import check_positive
 from ._cli import (CliError, CliParser, add_air, add_packing, add_sample, add_table,
                    available_cores, bad_input, check_common, check_outputs, check_plot, computing,
-                   load_packing, progress_log, run, sample_box_m)
+                   finish, load_packing, progress_log, run, sample_box_m)
 from .conductance import POLICIES
 from ._grains import GRAIN_ALIASES, d272_constants
 from .flow import (DEFAULT_DEPTH_M, GRAINS, asabe_d272_gradient, ergun_gradient,
@@ -220,4 +220,4 @@ def _main(args) -> int:
 
 
 if __name__ == "__main__":
-    sys.exit(main())
+    finish(main())

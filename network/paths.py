@@ -38,7 +38,7 @@ import time
 import numpy as np
 
 from ._cli import (CliParser, add_air, add_packing, bad_input, check_outputs,
-                   check_plot, computing, load_packing, run)
+                   check_plot, computing, finish, load_packing, run)
 from ._air import check_positive
 from .airpaths import (bed_depth, branched_table, face_graph, plot_paths, pore_pressure_array,
                        pressure_along_path, random_entry_points, trace_paths)
@@ -409,4 +409,4 @@ def _pressure_along(args, x, r, source, tess, graph, paths):
 
 
 if __name__ == "__main__":
-    sys.exit(main())
+    finish(main())

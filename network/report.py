@@ -29,7 +29,7 @@ import numpy as np
 
 from ._cli import (CliError, CliParser, add_air, add_sample, available_cores, bad_input,
                    check_common, check_outputs, check_plot, computing, load_packing,
-                   progress_log, run, sample_box_m)
+                   finish, progress_log, run, sample_box_m)
 from ._grains import BED, D272, GRAIN_ALIASES, grains_with_d272
 from ._report_bed import add_bed_options, bed_json, plan_bed, prepare_bed
 from ._report_band import (BAND_OFFSETS, band_gradients, measured_band, pack_band,
@@ -447,4 +447,4 @@ def _main(args) -> int:
 
 
 if __name__ == "__main__":
-    sys.exit(main())
+    finish(main())

@@ -24,7 +24,7 @@ import numpy as np
 
 from ._cli import (CliError, CliParser, add_air, add_packing, add_sample, add_table,
                    available_cores, bad_input, check_common, check_outputs, computing,
-                   load_packing, progress_log, run, sample_box_m)
+                   finish, load_packing, progress_log, run, sample_box_m)
 from .conductance import MODELS, POLICIES, throat_qstar
 from .flow import (DEFAULT_DEPTH_M, DEFAULT_VELOCITY_M_S, combined_summary, solve_axes,
                    write_network_vtu)
@@ -277,4 +277,4 @@ def _main(args) -> int:
 
 
 if __name__ == "__main__":
-    sys.exit(main())
+    finish(main())

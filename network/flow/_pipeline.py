@@ -23,7 +23,8 @@ from typing import Callable
 import numpy as np
 
 from .._air import MU_AIR_PA_S, RHO_AIR_KG_M3, check_density, check_positive, check_viscosity
-from ..conductance import check_model, check_policy, inertial_coefficients, throat_conductance
+from ..conductance import (check_model, check_policy, has_grid, inertial_coefficients,
+                           throat_conductance)
 from ..packing import Packing
 from ..pores import (Region, Tessellation, axis_index, default_region, merge_pores,
                      prune_disconnected, region_porosity, select_sample, tessellate, tie_groups)
@@ -166,12 +167,16 @@ def solve_network(packing: Packing, *, axis="z", region: Region | None = None,
     reg = (default_region(packing, margin=margin, cylinder=cylinder, container=container,
                           axis=axis) if region is None else region)
     eps_job = None
-    if threads > 1 and porosity is None and porosity_points:
-        # the porosity needs only the spheres and the region: beside Qhull (which releases
-        # the GIL) on a second core; the thread ends with its job
-        eps_pool = ThreadPoolExecutor(1)
-        eps_job = eps_pool.submit(region_porosity, packing, reg, ax, n_points=porosity_points)
-        eps_pool.shutdown(wait=False)
+    if threads > 1:
+        # work that needs no tessellation, on a second core while Qhull (which releases the
+        # GIL) runs: the Q* table's load, pyamg's import, the porosity; the thread ends
+        # with its job
+        side = ThreadPoolExecutor(1)
+        eps_job = side.submit(_beside_qhull, packing, reg, ax,
+                              porosity_points if porosity is None else 0,
+                              db if conductance is None and policy != "shape-factor"
+                              else False)
+        side.shutdown(wait=False)
     with stage("tessellate"):
         tess = tessellate(packing) if tessellation is None else tessellation
     with stage("sample"):
@@ -233,7 +238,7 @@ def solve_network(packing: Packing, *, axis="z", region: Region | None = None,
     with stage("porosity"):
         if porosity is not None:
             eps, eps_err = map(float, porosity)
-        elif eps_job is not None:
+        elif eps_job is not None and porosity_points:
             eps, eps_err = eps_job.result()
         elif porosity_points:
             eps, eps_err = region_porosity(packing, reg, ax, n_points=porosity_points)
@@ -280,6 +285,17 @@ def solve_network(packing: Packing, *, axis="z", region: Region | None = None,
         conns=sample.conns, pore_xyz=sample.pore_xyz, pore_groups=sample.groups,
         permeability_core_m2=k_core, core_margin_m=core_margin, inertial=inertial,
         throat_qstar=None if window_qstar is None else window_qstar[sample.throats])
+
+
+def _beside_qhull(packing, reg, ax, porosity_points, db):
+    """The Q* table loaded (``db``; False: none needed), pyamg imported, and the region's
+    (porosity, standard error) when ``porosity_points`` (else None): what
+    :func:`solve_network` runs beside the tessellation."""
+    if db is not False:
+        has_grid(db)
+    import pyamg  # noqa: F401 - imported here, beside Qhull, instead of in the solve stage
+    return region_porosity(packing, reg, ax, n_points=porosity_points) if porosity_points \
+        else None
 
 
 #: Per-conduit inertial laws: (velocity profile of the expansion, crossover X_c of the onset).
