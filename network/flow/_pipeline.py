@@ -178,7 +178,7 @@ def solve_network(packing: Packing, *, axis="z", region: Region | None = None,
                               else False)
         side.shutdown(wait=False)
     with stage("tessellate"):
-        tess = tessellate(packing) if tessellation is None else tessellation
+        tess = tessellate(packing, threads=threads) if tessellation is None else tessellation
     with stage("sample"):
         labels, model_opts = None, dict(model_options or {})
         if conductance is None and conductance_model == "conduit":

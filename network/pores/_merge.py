@@ -168,7 +168,10 @@ def merge_pores(tessellation, *, tolerance: float = 0.02, min_quality: float = 0
     pv = t.pore_vertices
     n_p = pv.shape[0]
     xyz = pts[pv]                                        # (Np, 4, 3)
-    cen, rad = circumspheres(xyz)
+    # the tessellation's circumcentres (the same solve; NaN only for |det| = 0, where the
+    # quality below is 0 and the tetrahedron flat either way)
+    cen = t.pore_circumcenter
+    rad = _norm(cen - xyz[:, 0])
     # radius ratio 3 r_in / R, r_in = 3 V / (sum of face areas)
     fa = 0.0
     for f in ((1, 2, 3), (0, 2, 3), (0, 1, 3), (0, 1, 2)):
