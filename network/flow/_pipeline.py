@@ -211,12 +211,13 @@ def solve_network(packing: Packing, *, axis="z", region: Region | None = None,
     with stage("prune"):
         sample, g = prune_disconnected(sample, tess, g)
     with stage("solve"):
-        # with inertia the Stokes hierarchy (forward-backward sweeps, as Newton's) is kept and
-        # preconditions the Newton steps: one AMG setup instead of two
+        # one Gauss-Seidel sweep forward before and one backward after the coarse correction
+        # (pyamg's default sweeps both ways twice): 38 CG iterations instead of 31 at 20 000
+        # spheres but 0.22 instead of 0.26 s; with inertia the hierarchy then preconditions
+        # the Newton steps too (one AMG setup instead of two)
         p, info, check = solve_fixed_pressure(sample.n_pores, sample.conns, g, sample.inlet,
                                               sample.outlet, p_in=1.0, p_out=0.0, solver=solver,
-                                              smoother="forward-backward" if inertia
-                                              else "symmetric")
+                                              smoother="forward-backward")
     inertial = None
     if inertia:
         with stage("inertial"):
