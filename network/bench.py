@@ -30,6 +30,7 @@ Examples
     python -m network.bench --references-only --json references.json
     python -m network.bench --references-only --fe-random 0.36 0.40 0.45   # ~30 min
     python -m network.bench --inertial --json inertial.json                 # ~4 min
+    python -m network.bench --per-packing --json per_packing.json           # ~1 min
 """
 
 from __future__ import annotations
@@ -40,17 +41,17 @@ import sys
 from pathlib import Path
 
 from .benchmarks import (REF_LATTICE_CASES, REF_RANDOM_POROSITIES, has_grid, inertial_lines,
-                         inertial_speed, inertial_validation, lattice_case, machine, policies,
-                         policy_lines, references, references_table, run_one, scaling,
+                         inertial_speed, inertial_validation, lattice_case, machine, per_packing,
+                         policies, policy_lines, references, references_table, run_one, scaling,
                          scaling_exponent)
 from .conductance import MODELS, POLICIES
 
 
 def main(argv=None) -> int:
     ap = argparse.ArgumentParser(prog="python -m network.bench", description=__doc__.split("\n")[0])
-    ap.add_argument("--sizes", type=int, nargs="*", default=[5000, 20000, 100000],
+    ap.add_argument("--sizes", type=int, nargs="*", default=None,
                     help="sphere counts of the scaling part (default 5000 20000 100000; add "
-                         "500000 for the full run)")
+                         "500000 for the full run; --per-packing: default 5000 20000)")
     ap.add_argument("--policy", default="table-only", choices=POLICIES,
                     help="Q* policy of the scaling part (default table-only: a precomputed table)")
     ap.add_argument("--policies", nargs="*", default=list(POLICIES), choices=POLICIES,
@@ -91,7 +92,8 @@ def main(argv=None) -> int:
     ap.add_argument("--workdir", default=None,
                     help="where generated packings are kept (default ~/.cache/grainflow/bench)")
     ap.add_argument("--seed", type=int, default=1, help="seed of the generated packings (default 1)")
-    ap.add_argument("--repeats", type=int, default=2, help="repeats per size (minimum reported)")
+    ap.add_argument("--repeats", type=int, default=None,
+                    help="repeats per size (minimum reported; default 2, --per-packing 7)")
     ap.add_argument("--timeout", type=float, default=1800.0, help="per-size limit, s")
     ap.add_argument("--json", dest="json_out", default="network_bench.json",
                     help="output JSON path (default network_bench.json)")
@@ -102,6 +104,11 @@ def main(argv=None) -> int:
     ap.add_argument("--inertial-workers", type=int, default=None,
                     help="continuation chains of the timed curve, solved side by side "
                          "(default: the usable cores, as network.curve --workers)")
+    ap.add_argument("--per-packing", action="store_true",
+                    help="run alone: wall time of the whole `python -m network.solve FILE` "
+                         "command on the --sizes bench packings (default 5000 20000 here) and "
+                         "the bundled scene, --stokes and default, --repeats runs each (default "
+                         "7 here) after a warm-up, against issue 18's targets and YADE's 0.84 s")
     ap.add_argument("--one", default=None, help=argparse.SUPPRESS)
     ap.add_argument("--no-trace", action="store_true", help=argparse.SUPPRESS)
     args = ap.parse_args(argv)
@@ -117,6 +124,12 @@ def main(argv=None) -> int:
     if args.references_only:
         args.skip_policies = True
         args.sizes = []
+    if args.sizes is None:
+        args.sizes = [5000, 20000] if args.per_packing else [5000, 20000, 100000]
+    if args.repeats is None:
+        args.repeats = 7 if args.per_packing else 2
+    if args.repeats < 1:
+        ap.error(f"--repeats must be >= 1, got {args.repeats}")
 
     if args.one:  # child process of the scaling part
         row = run_one(Path(args.one), args.policy, args.db, args.repeats, trace=not args.no_trace,
@@ -142,6 +155,16 @@ def main(argv=None) -> int:
     workdir = Path(args.workdir or Path.home() / ".cache" / "grainflow" / "bench")
     workdir.mkdir(parents=True, exist_ok=True)
     report = {"machine_start": machine()}
+    if args.per_packing:
+        print(f"per packing: python -m network.solve FILE, wall time ({args.repeats} runs "
+              "after a warm-up):", flush=True)
+        report["per_packing"] = per_packing(args.sizes, workdir, args.seed,
+                                            repeats=args.repeats)
+        report["machine_end"] = machine()
+        with open(args.json_out, "w") as f:
+            json.dump(report, f, indent=2, default=str)
+        print(f"load average {report['machine_end']['loadavg']}; wrote {args.json_out}")
+        return 0
     if not args.skip_policies:
         print(f"policies on a {args.policy_spheres}-sphere packing:", flush=True)
         pol = policies(args.policy_spheres, args.policies, args.db, args.seed, args.workers,

@@ -116,7 +116,9 @@ def section_estimate(rho, sides):
 
 def _section_radii(radii, h):
     """Disk radii (N, m, 3) of the sections at heights h (N, m)."""
-    return np.sqrt(np.maximum(radii[:, None, :] ** 2 - h[..., None] ** 2, 0.0))
+    out = np.square(radii)[:, None, :] - np.square(h)[..., None]     # same bits as r**2 - h**2
+    np.maximum(out, 0.0, out=out)
+    return np.sqrt(out, out=out)
 
 
 def _colmax(a):
