@@ -19,7 +19,7 @@ SIZES = (300, 600)
 ROW_KEYS = {"wall_s", "read_s", "stages_s", "iterations", "n_unknowns", "solver_setup_s",
             "solver_solve_s", "n_pores", "n_throats", "permeability_m2", "mass_balance_ok",
             "qstar_sources", "traced_peak_mb", "max_rss_mb", "n_spheres", "policy",
-            "conductance_model", "repeats", "subprocess_s", "loadavg_1min_before",
+            "conductance_model", "repeats", "threads", "subprocess_s", "loadavg_1min_before",
              "us_per_sphere", "kb_per_sphere"}
 
 
@@ -76,3 +76,22 @@ def test_exponent_needs_two_sizes():
     slope, lo, hi = scaling_exponent([{"n_spheres": 1000, "wall_s": 1.0},
                                       {"n_spheres": 8000, "wall_s": 8.0}])
     assert slope == pytest.approx(1.0) and (lo, hi) == (1000, 8000)
+
+
+def test_per_packing_rows(run):
+    """``--per-packing``: the whole network.solve command timed per packing and mode, each row
+    with ordered min <= median <= max over its runs, the target and YADE's time where issue 18
+    gives them, the bundled scene last; the packing files of the scaling part are reused."""
+    tmp, _ = run
+    out = tmp / "per_packing.json"
+    rc = bench.main(["--per-packing", "--sizes", str(SIZES[0]), "--repeats", "2",
+                     "--workdir", str(tmp), "--json", str(out)])
+    assert rc == 0
+    rows = json.loads(out.read_text())["per_packing"]
+    assert [(r["n_spheres"], r["mode"]) for r in rows] == [
+        (SIZES[0], "stokes"), (SIZES[0], "default"), (None, "stokes"), (None, "default")]
+    for r in rows:
+        assert r["runs"] == 2 and len(r["times_s"]) == 2
+        assert 0 < r["min_s"] <= r["median_s"] <= r["max_s"] < 60
+        assert r["target_s"] is None and r["yade_s"] is None    # no target for these sizes
+    assert rows[0]["packing"] == str(packing_file(SIZES[0], tmp, 1))

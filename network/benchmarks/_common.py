@@ -19,3 +19,4 @@ def machine() -> dict:
 def qstar_sources(stats: dict) -> dict:
     """Q* sources of a run (the conduit model nests the lookup statistics one level down)."""
     return stats.get("sources") or stats.get("qstar_stats", {}).get("sources", {})
+

@@ -21,6 +21,7 @@ import numpy as np
 
 from ..flow import solve_network
 from ..packing import Packing, periodic_copies, random_packing, read_packing, write_packing_csv
+from .._cli import available_cores
 from ._common import qstar_sources
 
 __all__ = ["DIRECT_MAX", "packing_file", "run_one", "scaling", "scaling_exponent"]
@@ -69,7 +70,7 @@ def run_one(path: Path, policy: str, db, repeats: int, trace: bool = True,
         t0 = time.perf_counter()
         pk = read_packing(path)
         t_read = time.perf_counter() - t0
-        res = solve_network(pk, axis="z", policy=policy, db=db,
+        res = solve_network(pk, axis="z", policy=policy, db=db, threads=available_cores(),
                             trace_memory=False, conductance_model=model)
         wall = time.perf_counter() - t0
         if best is None or wall < best["wall_s"]:
@@ -83,7 +84,7 @@ def run_one(path: Path, policy: str, db, repeats: int, trace: bool = True,
     # one more pass with tracemalloc for per-stage traced peaks (slower; not timed)
     if trace:
         pk = read_packing(path)
-        res = solve_network(pk, axis="z", policy=policy, db=db,
+        res = solve_network(pk, axis="z", policy=policy, db=db, threads=available_cores(),
                             trace_memory=True, conductance_model=model)
         best["traced_peak_mb"] = res.timings_s.get("peak_memory_mb", {})
     best["max_rss_mb"] = max(walls_rss, resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024.0)
@@ -91,6 +92,7 @@ def run_one(path: Path, policy: str, db, repeats: int, trace: bool = True,
     best["policy"] = policy
     best["conductance_model"] = model
     best["repeats"] = repeats
+    best["threads"] = available_cores()
     return best
 
 

@@ -4,7 +4,8 @@
 thesis model (:func:`thesis_conductance`); both give a :class:`ConductanceResult`.
 """
 
-from ._conduit import SECTION_MODES, conduit_conductance, section_estimate, side_resistance
+from ._conduit import SECTION_MODES, conduit_conductance
+from ._sections import section_estimate, side_resistance
 from ._inertial import (ONSET_SLOPE, contraction_coefficient, expansion_coefficient,
                         inertial_coefficients, onset_scales, turning_cosines)
 from ._models import MODELS, check_model, throat_conductance

@@ -1,0 +1,78 @@
+"""Per packing (issue 18 item 2): the whole ``python -m network.solve FILE`` command, wall time.
+
+What a user waits for: a fresh interpreter, the imports, reading the file, every stage,
+printing, exit. Each command runs ``repeats`` times after one warm-up run (which writes the
+bytecode caches and the Q* table's derived arrays, as a user's first run does); the bench
+packings of the scaling part and the bundled scene, ``--stokes`` (file to permeability, the
+target) and the default command (with inertia). The child's environment drops
+``PYTHONDONTWRITEBYTECODE`` so that Python caches bytecode as it does by default.
+
+YADE's FlowEngine on the 5 000-sphere packing (its own triangulation and Cholesky solve):
+0.84 s, the figure quoted in issue 18; the targets are 0.8 s (5 000) and 2 s (20 000).
+"""
+
+from __future__ import annotations
+
+import os
+import statistics
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+from ..packing import default_packing_path
+from ._scaling import packing_file
+
+#: Wall-time targets of issue 18 (s) and YADE FlowEngine's time where the issue quotes one.
+TARGETS_S = {5000: 0.8, 20000: 2.0}
+YADE_S = {5000: 0.84}
+MODES = {"stokes": ["--stokes"], "default": []}
+
+
+def per_packing(sizes, workdir: Path, seed: int, repeats: int = 7,
+                bundled: bool = True) -> list[dict]:
+    """Wall times of ``python -m network.solve`` on the bench packings of ``sizes`` (and the
+    bundled scene): one row per packing and mode with min, median and max over ``repeats``."""
+    env = dict(os.environ)
+    env.pop("PYTHONDONTWRITEBYTECODE", None)
+    cases = [(n, packing_file(n, workdir, seed)) for n in sizes]
+    if bundled:
+        cases.append((None, default_packing_path()))
+    rows = []
+    for n, path in cases:
+        for mode, extra in MODES.items():
+            cmd = [sys.executable, "-m", "network.solve", str(path), "--quiet", *extra]
+            times = []
+            for i in range(repeats + 1):
+                t0 = time.perf_counter()
+                out = subprocess.run(cmd, env=env, capture_output=True, text=True, check=False)
+                dt = time.perf_counter() - t0
+                if out.returncode != 0:
+                    raise RuntimeError(f"{' '.join(cmd)} exited {out.returncode}: "
+                                       f"{out.stderr.strip()[-200:]}")
+                if i:                                   # the first run is the warm-up
+                    times.append(dt)
+            row = {"packing": str(path), "n_spheres": n, "mode": mode, "runs": repeats,
+                   "min_s": min(times), "median_s": statistics.median(times),
+                   "max_s": max(times), "times_s": times,
+                   "target_s": TARGETS_S.get(n) if mode == "stokes" else None,
+                   "yade_s": YADE_S.get(n) if mode == "stokes" else None,
+                   "loadavg_after": os.getloadavg()[0]}
+            if row["target_s"] is not None:
+                row["met"] = row["median_s"] <= row["target_s"]
+            rows.append(row)
+            print("  " + per_packing_line(row), flush=True)
+    return rows
+
+
+def per_packing_line(row: dict) -> str:
+    """One printed line of a :func:`per_packing` row."""
+    name = f"{row['n_spheres']} spheres" if row["n_spheres"] else "bundled scene"
+    tail = ""
+    if row.get("target_s") is not None:
+        tail = f"; target {row['target_s']:.1f} s: {'met' if row['met'] else 'MISSED'}"
+        if row.get("yade_s"):
+            tail += f" (YADE {row['yade_s']:.2f} s)"
+    return (f"{name:>16s} {row['mode']:>8s}: median {row['median_s']:.3f} s, min "
+            f"{row['min_s']:.3f}, max {row['max_s']:.3f} over {row['runs']} runs (load "
+            f"{row['loadavg_after']:.2f}){tail}")
