@@ -357,12 +357,12 @@ def _settle(r, s, rows, q, err, src, msg, stats, *, db, policy, rtol, workers, p
     rows = rows[ok]
     if not len(rows):
         return
-    keys = shape_keys(signature(r[rows], s[rows]))
     path = Path(db) if db is not None else default_db_path()
     need_store = policy != "table-only" or (path.exists() and path.stat().st_size > 0)
     if not need_store:
         _shape_factor_rows(r, s, rows, q, err, src)
         return
+    keys = shape_keys(signature(r[rows], s[rows]))
     with open_store(path, create=policy != "table-only") as store:
         found = _exact(store, keys, rtol, solver_version)
         hit = found["found"]
