@@ -249,13 +249,6 @@ def solve_network(packing: Packing, *, axis="z", region: Region | None = None,
     with stage("permeability"):
         k_whole = darcy_permeability(q1, 1.0, sample.length_m, sample.area_m2,
                                      viscosity_pa_s=viscosity_pa_s)
-        core_job = None
-        if threads > 1 and core_margin_m is None:
-            # the core estimate beside the inset one (both read the solved network only)
-            side = ThreadPoolExecutor(1)
-            core_job = side.submit(_core_estimate, sample, g, p, reg, packing.grain_diameter,
-                                   viscosity_pa_s)
-            side.shutdown(wait=False)
         k_inset = _inset_estimate(sample, g, p, reg, packing.grain_diameter, viscosity_pa_s,
                                   tess)
         k = k_whole if k_inset is None else k_inset
@@ -270,9 +263,7 @@ def solve_network(packing: Packing, *, axis="z", region: Region | None = None,
                    "converged": info.converged, "residual": info.residual,
                    "setup_s": info.setup_s, "solve_s": info.solve_s}
     chk = {k2: v for k2, v in check.items() if k2 != "throat_flow"}
-    if core_job is not None:
-        k_core, core_margin = core_job.result()
-    elif core_margin_m is None:
+    if core_margin_m is None:
         k_core, core_margin = _core_estimate(sample, g, p, reg, packing.grain_diameter,
                                              viscosity_pa_s)
     else:
