@@ -66,3 +66,33 @@ def test_lens_of_two_overlapping_disks():
     lens = 2 * np.arccos(0.5) - 0.5 * np.sqrt(3)
     union = 2 * 0.5 * theta - 0.5 * lens
     np.testing.assert_allclose(a[0], tri - union - 0.5 * apex * 1e-6, rtol=1e-12)
+
+
+def test_first_calls_from_several_threads_at_once():
+    """A fresh process whose first exact-area calls come from four threads at once (the
+    network's conductance blocks): the kernel is compiled once, every thread gets the serial
+    answer (before the lock, a second thread re-jitted the jitted helper: TypeError)."""
+    import subprocess
+    import sys
+    code = """
+import threading, numpy as np
+from throats._area import exact_area_perimeter
+rng = np.random.default_rng(0)
+r = rng.uniform(0.5, 1.5, (500, 3)); s = np.tile([2.0, 2.2, 2.4], (500, 1))
+gate, out, err = threading.Barrier(4), [None] * 4, []
+def work(i):
+    gate.wait()
+    try:
+        out[i] = exact_area_perimeter(r, s)
+    except Exception as exc:
+        err.append(repr(exc))
+ts = [threading.Thread(target=work, args=(i,)) for i in range(4)]
+[t.start() for t in ts]; [t.join() for t in ts]
+assert not err, err
+ref = exact_area_perimeter(r, s)
+assert all(np.array_equal(o[0], ref[0]) and np.array_equal(o[1], ref[1]) for o in out)
+print("ok")
+"""
+    res = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
+                         timeout=300)
+    assert res.returncode == 0 and res.stdout.strip() == "ok", res.stderr[-2000:]

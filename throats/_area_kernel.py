@@ -20,11 +20,15 @@ with the numpy engine: ``tests/test_throats_area_kernel.py``.
 
 from __future__ import annotations
 
+import threading
+
 import numpy as np
 
 __all__ = ["area_perimeter_rows"]
 
 _COMPILED = []
+# one compiler at a time: threads (network's conductance blocks) may call in together first
+_COMPILE_LOCK = threading.Lock()
 
 
 def area_perimeter_rows(verts, radii, tol=1e-11):
@@ -34,12 +38,15 @@ def area_perimeter_rows(verts, radii, tol=1e-11):
     ``tol`` the boundary engine's geometric tolerance (:data:`throats._boundary.TOL`).
     """
     if not _COMPILED:
-        import numba  # a dependency, loaded only when some row needs the exact engine
+        with _COMPILE_LOCK:
+            if not _COMPILED:
+                import numba  # a dependency, loaded only when some row needs the exact engine
 
-        jit = numba.njit(cache=True, error_model="numpy")
-        globals()["_sort"] = jit(_sort)   # the compiled loop calls the compiled helpers
-        globals()["_line_circle"] = jit(_line_circle)
-        _COMPILED.append(jit(_rows))
+                jit = numba.njit(cache=True, error_model="numpy")
+                # the compiled loop calls the compiled helpers
+                globals()["_sort"] = jit(_sort)
+                globals()["_line_circle"] = jit(_line_circle)
+                _COMPILED.append(jit(_rows))
     v = np.ascontiguousarray(verts, dtype=np.float64)
     r = np.ascontiguousarray(radii, dtype=np.float64)
     area = np.empty(v.shape[0])
