@@ -42,7 +42,7 @@ from ._report_system import (AIRFLOW_UNITS, bulk_density, curve_range, dense_sys
 from .curve import DEFAULT_VELOCITIES, parse_velocities
 from .flow import DEFAULT_DEPTH_M, asabe_d272_gradient, ergun_gradient, fit_curve, solve_network
 from .packing import UNITS, read_container
-from .pores import sample_region
+from .pores import region_porosity, sample_region
 
 #: below this porosity difference the packing's own porosity is the report's (no move)
 SAME_POROSITY = 5e-4
@@ -221,8 +221,11 @@ def build_report(args, opts, path, packing) -> dict:
     box, margin = sample_box_m(args)
     container = None if box else read_container(path)
     us = list(opts["velocities"])
-    rz = _solve(args, packing, container, box, margin, "z", us)
-    e_p, d32 = rz.porosity, rz.sauter_diameter_m
+    # the vertical sample's porosity first (what solve_network would measure): the airflow's
+    # velocity needs the bulk density, so the curve is then solved once with it
+    region_z = sample_region(packing, box=box, margin=margin, container=container, axis="z")
+    eps_z = region_porosity(packing, region_z, 2, n_points=200_000)   # solve_network's default
+    e_p = eps_z[0]
     e, why = opts["porosity"], opts["porosity_source"]
     if e is None:
         e = e_p
@@ -242,8 +245,8 @@ def build_report(args, opts, path, packing) -> dict:
                                       bulk_density_kg_m3=rho_b)
         if all(abs(u_air - u) > 1e-12 * u for u in us):
             us.append(u_air)
-            rz = _solve(args, packing, container, box, margin, "z", us,
-                        (rz.porosity, rz.porosity_std))
+    rz = _solve(args, packing, container, box, margin, "z", us, eps_z)
+    d32 = rz.sauter_diameter_m
     rx = _solve(args, packing, container, box, margin, "x", us)
     pts, pts_x = _points(rz), _points(rx)
     band = None
