@@ -44,6 +44,10 @@ TEMPLATE_GRAINS = ("soybean", "wheat", "shelled_corn", "barley", "canola")
 #: dem.pack --porosity's tolerance (its default --porosity-tol): a request this close to the
 #: bundled bed's own porosity is that bed
 PACK_TOL = 0.005
+#: dem.pack's step cap per stage for the report's beds (dem.pack's own default for grains is
+#: 60 000): shelled corn in the 0.08 m cube reached equilibrium only after 119 400 steps
+#: (docs/report.md); the cap only bounds a bed that never settles, a settled one stops earlier
+PACK_MAX_STEPS = 240_000
 #: the project root that holds ``dem/`` beside ``network/`` (the subprocess's PYTHONPATH)
 _ROOT = Path(__file__).resolve().parent.parent
 
@@ -191,7 +195,8 @@ def pack_command(plan: dict, out, *, quiet: bool = False) -> list[str]:
     lx, ly, h = plan["box"]
     cmd = [sys.executable, "-m", "dem.pack", "--scene", "box", "--size", f"{lx:g}", f"{ly:g}",
            "--height", f"{h:g}", "--grain", plan["grain"], "--porosity", repr(plan["porosity"]),
-           "--porosity-tol", repr(PACK_TOL), "--seed", str(plan["seed"]), "--out", str(out)]
+           "--porosity-tol", repr(PACK_TOL), "--max-steps", str(PACK_MAX_STEPS),
+           "--seed", str(plan["seed"]), "--out", str(out)]
     return cmd + (["--quiet"] if quiet else [])
 
 

@@ -19,7 +19,7 @@ from pathlib import Path
 import pytest
 
 from dem import TEMPLATE_GRAINS as DEM_TEMPLATES
-from network._report_bed import PACK_TOL, TEMPLATE_GRAINS
+from network._report_bed import PACK_MAX_STEPS, PACK_TOL, TEMPLATE_GRAINS, pack_command
 from network.report import main
 
 ROOT = Path(__file__).resolve().parent.parent
@@ -30,6 +30,15 @@ SMALL = ["--grain", "soybean", "--bed-box", "0.04", "0.04", "0.04"] + FAST
 def test_template_grains_are_dems():
     """network keeps a copy of dem.templates.TEMPLATE_GRAINS (it may not import dem)."""
     assert TEMPLATE_GRAINS == DEM_TEMPLATES and PACK_TOL == 0.005
+
+
+def test_pack_command_lets_slow_grains_settle(tmp_path):
+    """The report's dem.pack command carries a step cap of 240 000 (shelled corn in the 0.08 m
+    cube settled after 119 400 steps; dem.pack's own grain default, 60 000, stopped it short)."""
+    plan = {"box": (0.08, 0.08, 0.08), "grain": "shelled_corn", "porosity": 0.418, "seed": 1}
+    cmd = pack_command(plan, tmp_path / "bed.csv")
+    assert cmd[cmd.index("--max-steps") + 1] == str(PACK_MAX_STEPS) == "240000"
+    assert cmd[cmd.index("--grain") + 1] == "shelled_corn"
 
 
 def test_packs_a_new_bed_then_reuses_it(tmp_path, monkeypatch):
