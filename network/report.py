@@ -192,8 +192,8 @@ def _check(args) -> dict:
 
 
 def _solve(args, packing, container, box, margin, axis, us, porosity=None):
-    region = sample_region(packing, box=box, margin=margin, container=container, axis=axis)
-    us = sorted(us)
+    region, us = sample_region(packing, box=box, margin=margin, container=container,
+                               axis=axis), sorted(us)
     return solve_network(packing, axis=axis, region=region, viscosity_pa_s=args.viscosity,
                          velocity_m_s=us[0], depth_m=args.depth, inertia=True,
                          density_kg_m3=args.density, curve_velocities_m_s=us[1:],
@@ -221,14 +221,12 @@ def build_report(args, opts, path, packing) -> dict:
     box, margin = sample_box_m(args)
     container = None if box else read_container(path)
     us = list(opts["velocities"])
-    # the vertical sample's porosity first (what solve_network would measure): the airflow's
-    # velocity needs the bulk density, so the curve is then solved once with it
-    region_z = sample_region(packing, box=box, margin=margin, container=container, axis="z")
-    eps_z = region_porosity(packing, region_z, 2, n_points=200_000)   # solve_network's default
-    e_p = eps_z[0]
-    e, why = opts["porosity"], opts["porosity_source"]
-    if e is None:
-        e = e_p
+    # the porosity first (solve_network's): the airflow's velocity needs the bulk density
+    eps_z = region_porosity(packing, sample_region(packing, box=box, margin=margin,
+                                                   container=container, axis="z"), 2,
+                            n_points=200_000)
+    e_p, why = eps_z[0], opts["porosity_source"]
+    e = e_p if opts["porosity"] is None else opts["porosity"]
     try:
         check_reachable(e, e_p, opts["reachable"], opts["grain"])
     except ValueError as exc:
@@ -246,8 +244,7 @@ def build_report(args, opts, path, packing) -> dict:
         if all(abs(u_air - u) > 1e-12 * u for u in us):
             us.append(u_air)
     rz = _solve(args, packing, container, box, margin, "z", us, eps_z)
-    d32 = rz.sauter_diameter_m
-    rx = _solve(args, packing, container, box, margin, "x", us)
+    rx, d32 = _solve(args, packing, container, box, margin, "x", us), rz.sauter_diameter_m
     pts, pts_x = _points(rz), _points(rx)
     band = None
     if not args.no_band and packing.n_grains < packing.n and not args.sphere_band:
