@@ -36,13 +36,22 @@ import throats
 
 from .._air import MU_AIR_PA_S, RHO_AIR_KG_M3, check_density, check_viscosity
 
-__all__ = ["ONSET_SLOPE", "PROFILES", "contraction_coefficient", "expansion_coefficient",
+__all__ = ["ONSET_SLOPE", "PORE_ONSET_SLOPE", "PORE_RECOVERY", "PROFILES", "contraction_coefficient", "expansion_coefficient",
            "inertial_coefficients", "onset_scales", "turning_cosines"]
 
 #: Low-Re slope of a single sphere-ring constriction's excess loss coefficient,
 #: :math:`dk/dRe_w = c_1 h/a`: axisymmetric Navier-Stokes of six constrictions
 #: (``docs/inertial-flow.md``); not fitted to bed data.
 ONSET_SLOPE = 0.0235
+
+#: The same slope and the recovered share of the jet's cross momentum of a 3-D pore body:
+#: steady Navier-Stokes through a regular tetrahedral pore (``docs/scripts/
+#: inertial_pore_ns.py``, mesh h 0.10; ``docs/inertial-flow.md``, "A law from the 3-D pore").
+#: Its body loss k(Re_w) = k_peak t/sqrt(1+t^2), t = Re_w/Re_c, has Re_c = 13.5 (from
+#: Re_w 5 and 10), k_peak = 0.585 at h/a = 0.454: c_1 = 0.585/(13.5 * 0.454) = 0.0955, and
+#: f = 0.47 recovers the peak in the turning balance. Not fitted to bed data.
+PORE_ONSET_SLOPE = 0.0955
+PORE_RECOVERY = 0.47
 
 
 def contraction_coefficient(sigma):
@@ -149,14 +158,16 @@ def _window_and_ratios(tessellation, throats_idx, h_m):
 
 
 def onset_scales(tessellation, throats_idx, h_m, K, *,
-                 density_kg_m3: float = RHO_AIR_KG_M3, viscosity_pa_s: float = MU_AIR_PA_S):
+                 density_kg_m3: float = RHO_AIR_KG_M3, viscosity_pa_s: float = MU_AIR_PA_S,
+                 slope: float = ONSET_SLOPE):
     r"""Onset scale c of M conduits for both flow directions, s/m³: :math:`c|q| = Re_w/Re_c`.
 
     A single sphere-ring constriction (axisymmetric Navier-Stokes, ``docs/inertial-flow.md``)
     loses :math:`k(Re_w)\,\rho u_w^2/2` over its Stokes drop with
     :math:`k = k_\infty\,t/\sqrt{1+t^2}`, :math:`t = Re_w/Re_c`,
     :math:`Re_c = k_\infty/(c_1 h/a)`: the low-Re slope :math:`dk/dRe_w = c_1 h/a`
-    (:data:`ONSET_SLOPE`, h the window-to-body height, a the sphere radius) and the
+    (``slope``, default :data:`ONSET_SLOPE`; :data:`PORE_ONSET_SLOPE` for the 3-D pore body;
+    h the window-to-body height, a the sphere radius) and the
     asymptote :math:`k_\infty`. Here :math:`k_\infty = 2A_w^2 K/\rho` is the conduit's own
     loss coefficient (``K`` from :func:`inertial_coefficients`, same columns),
     :math:`Re_w = \rho (|q|/A_w) D_w/\mu`, :math:`D_w = 2\sqrt{A_w/\pi}`, h of the side the
@@ -168,6 +179,9 @@ def onset_scales(tessellation, throats_idx, h_m, K, *,
     """
     rho = check_density(density_kg_m3)
     mu = check_viscosity(viscosity_pa_s)
+    c1 = float(slope)
+    if not (np.isfinite(c1) and c1 > 0):
+        raise ValueError(f"slope must be a finite number > 0, got {slope!r}")
     a_w, _, a = _window_and_ratios(tessellation, throats_idx, h_m)
     K = np.asarray(K, dtype=float)
     if K.shape != (a_w.size, 2):
@@ -176,7 +190,7 @@ def onset_scales(tessellation, throats_idx, h_m, K, *,
     with np.errstate(divide="ignore", invalid="ignore"):
         re_per_q = 2.0 * rho / (mu * np.sqrt(np.pi * a_w))
         k_inf = 2.0 * a_w[:, None] ** 2 * K / rho
-        c = re_per_q[:, None] * ONSET_SLOPE * h / (a[:, None] * k_inf)
+        c = re_per_q[:, None] * c1 * h / (a[:, None] * k_inf)
     return np.where(np.isfinite(c) & (K > 0), c, 0.0)
 
 

@@ -33,20 +33,25 @@ from pathlib import Path
 import numpy as np
 from scipy.spatial import cKDTree
 
-from ..conductance import (inertial_coefficients, onset_scales, throat_conductance,
-                           turning_cosines)
+from ..conductance import (ONSET_SLOPE, PORE_ONSET_SLOPE, PORE_RECOVERY, inertial_coefficients,
+                           onset_scales, throat_conductance, turning_cosines)
 from ..flow import AMGSolver, darcy_permeability, solve_fixed_pressure, solve_inertial
 from ..packing import Packing, lattice_packing, periodic_copies, random_packing, read_packing
 from ..pores import Region, merge_pores, prune_disconnected, select_sample, tessellate
 from ._drag_laws import DRAG_LAWS, drag_ratio
 
-__all__ = ["DERIVED_LAW", "FINNEY_PATH", "InertialCase", "finney_inertial_case",
+__all__ = ["DERIVED_LAW", "FINNEY_PATH", "PORE_LAW", "InertialCase", "finney_inertial_case",
            "lattice_inertial_case", "random_inertial_case", "solve_sample_curve"]
 
 #: Conduit law from single-constriction Navier-Stokes + the turning momentum balance
 #: (``docs/inertial-flow.md``): keyword options of :func:`solve_sample_curve` and the cases.
 DERIVED_LAW = {"profile": "uniform", "contraction": "smooth", "turning": True,
                "onset": "throat"}
+
+#: The same form with the onset slope and the cross-momentum recovery of a resolved 3-D pore
+#: body (regular tetrahedral pore, steady Navier-Stokes; ``docs/inertial-flow.md``, "A law
+#: from the 3-D pore") instead of the axisymmetric constriction's slope and no recovery.
+PORE_LAW = {**DERIVED_LAW, "recovery": PORE_RECOVERY, "onset_slope": PORE_ONSET_SLOPE}
 
 #: Finney's packing, central subset (radius 1, lengths in sphere radii).
 FINNEY_PATH = Path("/work/shared/data/finney/finney_subset_4021.csv")
@@ -87,7 +92,8 @@ class InertialCase:
 def solve_sample_curve(packing, region, velocities_m_s, *, axis=0, policy="table-only",
                        db=None, viscosity_pa_s=1.0, density_kg_m3=1.0, crossover=None,
                        profile="uniform", onset=None, turning=False,
-                       contraction="sharp", recovery=0.0, workers: int = 1):
+                       contraction="sharp", recovery=0.0, onset_slope=ONSET_SLOPE,
+                       workers: int = 1):
     """The inertial pipeline of :func:`network.solve_network` (conduit model, bodies merged;
     one AMG hierarchy, built for the Stokes solve and reused by every Newton step):
     ``(permeability_m2, length_m, points, seconds)``, ``seconds`` a dict by stage.
@@ -96,10 +102,12 @@ def solve_sample_curve(packing, region, velocities_m_s, *, axis=0, policy="table
     :func:`network.flow.solve_inertial`) or ``onset="throat"`` (window-Reynolds onset,
     :func:`network.conductance.onset_scales`); the expansion ``profile``, ``contraction``
     ('sharp' | 'smooth') and ``turning`` (expansion against each body's Stokes outflow
-    direction, :func:`network.conductance.turning_cosines`) of
+    direction, :func:`network.conductance.turning_cosines`, with ``recovery``) of
     :func:`network.conductance.inertial_coefficients`; ``workers`` continuation chains
-    (:func:`network.flow.solve_inertial`). :data:`DERIVED_LAW` is the law
-    derived from single-constriction Navier-Stokes (``docs/inertial-flow.md``)."""
+    (:func:`network.flow.solve_inertial`); ``onset_slope`` the c_1 of
+    :func:`network.conductance.onset_scales`. :data:`DERIVED_LAW` is the law derived from
+    single-constriction Navier-Stokes, :data:`PORE_LAW` the one from the 3-D pore body
+    (``docs/inertial-flow.md``)."""
     if onset not in (None, "throat"):
         raise ValueError(f"onset must be None or 'throat', got {onset!r}")
     t = {}
@@ -142,7 +150,8 @@ def solve_sample_curve(packing, region, velocities_m_s, *, axis=0, policy="table
     c_on = None
     if onset == "throat":
         c_on = onset_scales(tess, sample.throats, cres.h_m[keep], K,
-                            density_kg_m3=density_kg_m3, viscosity_pa_s=viscosity_pa_s)
+                            density_kg_m3=density_kg_m3, viscosity_pa_s=viscosity_pa_s,
+                            slope=onset_slope)
     pts = solve_inertial(sample.n_pores, sample.conns, g, K, sample.inlet, sample.outlet,
                          np.asarray(velocities_m_s, dtype=float) * sample.area_m2,
                          crossover=crossover, onset_scale=c_on, amg=held.get("amg"),
