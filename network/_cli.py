@@ -200,8 +200,8 @@ def add_air(ap, *, density: bool = True) -> None:
                         help="air density for the inertial losses, kg/m^3, > 0")
         ap.add_argument("--inertial-law", default="onset", choices=tuple(INERTIAL_LAWS),
                         help="per-conduit inertial loss: onset = laminar-jet expansion with the "
-                             "Re^2 onset, quadratic = flat-profile K q|q| from the start "
-                             "(docs/inertial-flow.md)")
+                             "Re^2 onset, quadratic = flat-profile K q|q| from the start, pore = "
+                             "the law from a resolved 3-D pore body (docs/inertial-flow.md)")
 
 
 # ------------------------------------------------------------------ checks

@@ -36,7 +36,8 @@ import throats
 
 from .._air import MU_AIR_PA_S, RHO_AIR_KG_M3, check_density, check_viscosity
 
-__all__ = ["ONSET_SLOPE", "PORE_ONSET_SLOPE", "PORE_RECOVERY", "PROFILES", "contraction_coefficient", "expansion_coefficient",
+__all__ = ["ONSET_SLOPE", "PORE_ONSET_SLOPE", "PORE_RECOVERY", "PROFILES", "conduit_law",
+           "contraction_coefficient", "expansion_coefficient",
            "inertial_coefficients", "onset_scales", "turning_cosines"]
 
 #: Low-Re slope of a single sphere-ring constriction's excess loss coefficient,
@@ -225,3 +226,38 @@ def turning_cosines(centers_m, throat_vertices, pore_xyz_m, conns, flow_m3_s, ax
     cos = np.clip(np.column_stack([np.einsum("ij,ij->i", n, M[c[:, 1]]),
                                    -np.einsum("ij,ij->i", n, M[c[:, 0]])]), -1.0, 1.0)
     return cos + f * (1.0 - cos)
+
+
+def conduit_law(tessellation, throats_idx, h_m, *, internal=None, pore_xyz_m=None, conns=None,
+                stokes_flow_m3_s=None, axis: int = 0, density_kg_m3: float = RHO_AIR_KG_M3,
+                viscosity_pa_s: float = MU_AIR_PA_S, profile: str = "uniform",
+                contraction: str = "sharp", turning: bool = False, recovery: float = 0.0,
+                onset=None, onset_slope: float = ONSET_SLOPE, crossover=None):
+    r"""The per-conduit inertial law of a sample's conduits: ``(K, onset_scale, crossover)``.
+
+    ``K`` (M, 2), Pa s² m⁻⁶, from :func:`inertial_coefficients` (``profile``,
+    ``contraction``; with ``turning`` the expansion against each body's outflow direction of
+    the Stokes flows ``stokes_flow_m3_s`` through :func:`turning_cosines` with ``recovery``,
+    which needs ``pore_xyz_m``, ``conns`` and ``axis``). ``onset='throat'``: the
+    window-Reynolds onset scales of :func:`onset_scales` (slope ``onset_slope``), else None;
+    ``crossover`` is passed through (the X/(X_c+X) onset of
+    :func:`network.flow.conduit_flow`). The law of a conduit is then
+    :math:`\Delta p = q/g + K q|q|\,\phi`, φ the onset factor.
+    """
+    cos = None
+    if turning:
+        if stokes_flow_m3_s is None or pore_xyz_m is None or conns is None:
+            raise ValueError("turning needs the Stokes flows, pore positions and conns")
+        cos = turning_cosines(tessellation.packing.centers,
+                              np.asarray(tessellation.throat_vertices)[throats_idx], pore_xyz_m,
+                              conns, stokes_flow_m3_s, axis, recovery=recovery)
+    K = inertial_coefficients(tessellation, throats_idx, h_m, internal=internal,
+                              density_kg_m3=density_kg_m3, profile=profile, cos_theta=cos,
+                              contraction=contraction)
+    if onset not in (None, "throat"):
+        raise ValueError(f"onset must be None or 'throat', got {onset!r}")
+    c = None if onset is None else onset_scales(tessellation, throats_idx, h_m, K,
+                                                 density_kg_m3=density_kg_m3,
+                                                 viscosity_pa_s=viscosity_pa_s,
+                                                 slope=onset_slope)
+    return K, c, crossover

@@ -23,8 +23,8 @@ from typing import Callable
 import numpy as np
 
 from .._air import MU_AIR_PA_S, RHO_AIR_KG_M3, check_density, check_positive, check_viscosity
-from ..conductance import (check_model, check_policy, has_grid, inertial_coefficients,
-                           throat_conductance)
+from ..conductance import (PORE_ONSET_SLOPE, PORE_RECOVERY, check_model, check_policy,
+                           conduit_law, has_grid, throat_conductance)
 from ..packing import Packing
 from ..pores import (Region, Tessellation, axis_index, default_region, merge_pores,
                      prune_disconnected, region_porosity, select_sample, tessellate, tie_groups)
@@ -119,10 +119,11 @@ def solve_network(packing: Packing, *, axis="z", region: Region | None = None,
         ρ of the inertial loss (default 1.20 kg/m³).
     curve_velocities_m_s : sequence of float, optional
         More superficial velocities (m/s, > 0) for the resistance curve.
-    inertial_law : {'onset', 'quadratic'}
+    inertial_law : {'onset', 'quadratic', 'pore'}
         Per-conduit inertial loss (:data:`INERTIAL_LAWS`): 'onset' (default) the expansion
         with the laminar jet profile and the Re² onset (crossover 1); 'quadratic' the
-        flat-profile loss K q|q| from the start (``docs/inertial-flow.md`` compares them).
+        flat-profile loss K q|q| from the start; 'pore' the law from a resolved 3-D pore body
+        (``docs/inertial-flow.md`` compares them).
     inertial_workers : int
         Processes for the nonlinear solves (``workers`` of
         :func:`network.flow.solve_inertial`: parallel continuation chains of at least 4
@@ -221,14 +222,17 @@ def solve_network(packing: Packing, *, axis="z", region: Region | None = None,
     inertial = None
     if inertia:
         with stage("inertial"):
-            profile, crossover = INERTIAL_LAWS[inertial_law]
-            K = inertial_coefficients(tess, throats_before, cres.h_m, internal=cres.internal,
-                                      density_kg_m3=density_kg_m3, profile=profile)
-            K = K[np.searchsorted(throats_before, sample.throats)]
+            keep = np.searchsorted(throats_before, sample.throats)
+            K, c_on, crossover = conduit_law(
+                tess, sample.throats, cres.h_m[keep], internal=np.asarray(cres.internal)[keep],
+                pore_xyz_m=sample.pore_xyz, conns=sample.conns,
+                stokes_flow_m3_s=check["throat_flow"], axis=ax, density_kg_m3=density_kg_m3,
+                viscosity_pa_s=viscosity_pa_s, **INERTIAL_LAWS[inertial_law])
             us = [velocity_m_s] + curve_u
             pts = solve_inertial(sample.n_pores, sample.conns, g, K, sample.inlet,
                                  sample.outlet, np.asarray(us) * sample.area_m2,
-                                 crossover=crossover, amg=info.amg, workers=inertial_workers)
+                                 crossover=crossover, onset_scale=c_on, amg=info.amg,
+                                 workers=inertial_workers)
             inertial = {"density_kg_m3": density_kg_m3, "velocities_m_s": us, "points": pts,
                         "law": inertial_law}
     times["assemble"] = info.assemble_s
@@ -299,8 +303,14 @@ def _beside_qhull(packing, reg, ax, porosity_points, db):
         else None
 
 
-#: Per-conduit inertial laws: (velocity profile of the expansion, crossover X_c of the onset).
-INERTIAL_LAWS = {"onset": ("laminar", 1.0), "quadratic": ("uniform", None)}
+#: Per-conduit inertial laws: options of :func:`network.conductance.conduit_law`
+#: (``docs/inertial-flow.md``). 'pore': smooth contraction, flat-profile expansion against the
+#: body's Stokes outflow direction with the 3-D pore's recovery and window-Re onset slope.
+INERTIAL_LAWS = {"onset": {"profile": "laminar", "crossover": 1.0},
+                 "quadratic": {"profile": "uniform"},
+                 "pore": {"profile": "uniform", "contraction": "smooth", "turning": True,
+                          "recovery": PORE_RECOVERY, "onset": "throat",
+                          "onset_slope": PORE_ONSET_SLOPE}}
 
 #: Core margin of :func:`_core_estimate`, in mean sphere diameters.
 CORE_MARGIN_DIAMETERS = 2.0

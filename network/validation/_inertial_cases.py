@@ -33,8 +33,8 @@ from pathlib import Path
 import numpy as np
 from scipy.spatial import cKDTree
 
-from ..conductance import (ONSET_SLOPE, PORE_ONSET_SLOPE, PORE_RECOVERY, inertial_coefficients,
-                           onset_scales, throat_conductance, turning_cosines)
+from ..conductance import (ONSET_SLOPE, PORE_ONSET_SLOPE, PORE_RECOVERY, conduit_law,
+                           throat_conductance)
 from ..flow import AMGSolver, darcy_permeability, solve_fixed_pressure, solve_inertial
 from ..packing import Packing, lattice_packing, periodic_copies, random_packing, read_packing
 from ..pores import Region, merge_pores, prune_disconnected, select_sample, tessellate
@@ -108,8 +108,6 @@ def solve_sample_curve(packing, region, velocities_m_s, *, axis=0, policy="table
     :func:`network.conductance.onset_scales`. :data:`DERIVED_LAW` is the law derived from
     single-constriction Navier-Stokes, :data:`PORE_LAW` the one from the 3-D pore body
     (``docs/inertial-flow.md``)."""
-    if onset not in (None, "throat"):
-        raise ValueError(f"onset must be None or 'throat', got {onset!r}")
     t = {}
     t0 = time.perf_counter()
     tess = tessellate(packing)
@@ -122,9 +120,6 @@ def solve_sample_curve(packing, region, velocities_m_s, *, axis=0, policy="table
     before = sample.throats
     sample, g = prune_disconnected(sample, tess, cres.g)
     keep = np.searchsorted(before, sample.throats)
-    K = inertial_coefficients(tess, before, cres.h_m, internal=cres.internal,
-                              density_kg_m3=density_kg_m3, profile=profile,
-                              contraction=contraction)[keep]
     t["conductance"] = time.perf_counter() - t0
     t0 = time.perf_counter()
     held = {}
@@ -139,19 +134,12 @@ def solve_sample_curve(packing, region, velocities_m_s, *, axis=0, policy="table
                            viscosity_pa_s=viscosity_pa_s)
     t["stokes"] = time.perf_counter() - t0
     t0 = time.perf_counter()
-    if turning:         # expansion into each body against its Stokes outflow direction
-        cos = turning_cosines(packing.centers, tess.throat_vertices[sample.throats],
-                              sample.pore_xyz, sample.conns, check["throat_flow"], axis,
-                              recovery=recovery)
-        K = inertial_coefficients(tess, sample.throats, cres.h_m[keep],
-                                  internal=np.asarray(cres.internal)[keep],
-                                  density_kg_m3=density_kg_m3, profile=profile, cos_theta=cos,
-                                  contraction=contraction)
-    c_on = None
-    if onset == "throat":
-        c_on = onset_scales(tess, sample.throats, cres.h_m[keep], K,
-                            density_kg_m3=density_kg_m3, viscosity_pa_s=viscosity_pa_s,
-                            slope=onset_slope)
+    K, c_on, crossover = conduit_law(
+        tess, sample.throats, cres.h_m[keep], internal=np.asarray(cres.internal)[keep],
+        pore_xyz_m=sample.pore_xyz, conns=sample.conns, stokes_flow_m3_s=check["throat_flow"],
+        axis=axis, density_kg_m3=density_kg_m3, viscosity_pa_s=viscosity_pa_s,
+        profile=profile, contraction=contraction, turning=turning, recovery=recovery,
+        onset=onset, onset_slope=onset_slope, crossover=crossover)
     pts = solve_inertial(sample.n_pores, sample.conns, g, K, sample.inlet, sample.outlet,
                          np.asarray(velocities_m_s, dtype=float) * sample.area_m2,
                          crossover=crossover, onset_scale=c_on, amg=held.get("amg"),
