@@ -42,8 +42,9 @@ def test_pack_command_lets_slow_grains_settle(tmp_path):
 
 
 def test_packs_a_new_bed_then_reuses_it(tmp_path, monkeypatch):
-    """--porosity 0.40 --seed 1: dem.pack packs the bed (two packings, lever -1 gives 0.3417
-    and +1 0.3969, within 0.005 of 0.40), the report is for that bed's own porosity; the same
+    """--porosity 0.40 --seed 1: dem.pack packs the bed (reached within 0.005 of 0.40: 0.3969
+    on the session-4 host, 0.4020 on an AMD EPYC host; the DEM's host-compiled steps differ in
+    last bits and a packing is chaotic), the report is for that bed's own porosity; the same
     command again reuses the bed (no packing: the CSV untouched, the numbers the same)."""
     monkeypatch.chdir(tmp_path)
     beds, out = tmp_path / "beds", tmp_path / "r.json"
@@ -56,14 +57,16 @@ def test_packs_a_new_bed_then_reuses_it(tmp_path, monkeypatch):
     assert bed["how"] == "packed anew" and bed["path"] == str(csv) == r["packing"]
     assert bed["seed"] == 1 and bed["porosity_requested"] == 0.40 and bed["reused"] is False
     assert bed["pack_seconds"] > 1 and "dem.pack" in bed["command"]
-    assert r["porosity_source"].startswith("packed anew with seed 1: dem.pack --porosity 0.4 "
-                                           "reached 0.3969")
+    reached = re.match(r"packed anew with seed 1: dem.pack --porosity 0.4 reached (\d\.\d{4}) ",
+                       r["porosity_source"])
+    assert reached, r["porosity_source"]
     meta = json.loads(csv.with_suffix(".json").read_text())
     assert meta["seed"] == 1 and meta["template"] == "soybean"
     assert meta["container"] == {"kind": "box", "size_m": [0.04, 0.04], "fill_height_m": 0.04}
     assert abs(meta["porosity_network_region"] - 0.40) <= PACK_TOL
-    assert meta["porosity_network_region"] == pytest.approx(0.3969, abs=1e-4)
-    assert r["n_grains"] == meta["n_grains"] == 258 and r["n_spheres"] == 6 * 258
+    assert meta["porosity_network_region"] == pytest.approx(float(reached.group(1)), abs=1e-4)
+    assert r["n_grains"] == meta["n_grains"] and r["n_spheres"] == 6 * r["n_grains"]
+    assert 240 <= r["n_grains"] <= 280                   # 258 on the session-4 host
     # the report's porosity is the new bed's own (network's Monte Carlo), not moved
     assert r["porosity"] == r["porosity_packing"]
     assert abs(r["porosity"] - 0.40) <= PACK_TOL + 3 * r["porosity_packing_std"]
@@ -79,13 +82,16 @@ def test_packs_a_new_bed_then_reuses_it(tmp_path, monkeypatch):
     assert "(reused: already in" in again["porosity_source"]
     assert csv.stat().st_mtime_ns == stamp
     assert [p["pressure_gradient_pa_per_m"] for p in again["points"]] == pytest.approx(
-        [p["pressure_gradient_pa_per_m"] for p in r["points"]], rel=1e-9)     # 4.295, 57.45 Pa/m
-    assert [round(p["pressure_gradient_pa_per_m"], 2) for p in r["points"]] == [4.30, 57.45]
+        [p["pressure_gradient_pa_per_m"] for p in r["points"]], rel=1e-9)
+    # soybean at porosity 0.40: 4.30 and 57.45 Pa/m on the session-4 host's bed
+    g = [p["pressure_gradient_pa_per_m"] for p in r["points"]]
+    assert 3.0 < g[0] < 6.0 and 40.0 < g[1] < 80.0 and g[1] / g[0] > 10.0
 
 
 def test_a_porosity_dem_pack_cannot_reach_exits_2(tmp_path, monkeypatch, capsys):
     """dem.pack's own refusal (exit 2, the range its two end packings reach: 0.3753-0.4074 for
-    the grain count of 0.45) is the report's one error line; nothing written."""
+    the grain count of 0.45 on the session-4 host, 0.3880-0.4029 on an AMD EPYC host: chaotic
+    packings of host-compiled steps) is the report's one error line; nothing written."""
     monkeypatch.chdir(tmp_path)
     beds, out = tmp_path / "a" / "beds", tmp_path / "r.json"
     assert main(SMALL + ["--porosity", "0.45", "--bed-dir", str(beds), "--json", str(out)]) == 2
@@ -93,7 +99,7 @@ def test_a_porosity_dem_pack_cannot_reach_exits_2(tmp_path, monkeypatch, capsys)
     assert len(err) == 1 and err[0].startswith("error: dem.pack"), err
     lo, hi = map(float, re.search(r"reaches for soybean in this container: "
                                   r"(\d\.\d{4})-(\d\.\d{4})", err[0]).groups())
-    assert (lo, hi) == (0.3753, 0.4074) and hi + PACK_TOL < 0.45
+    assert 0.36 < lo < hi < 0.42 and hi + PACK_TOL < 0.45
     assert not out.exists() and not (tmp_path / "a").exists()
 
 

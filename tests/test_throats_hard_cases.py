@@ -64,10 +64,11 @@ def test_csv_exits_0_when_every_row_has_an_answer(tmp_path):
 
 def test_ordinary_throats_keep_their_numbers():
     # Q* of the first six of network.sample_throats(500, rng=1) before this change (all 500
-    # were compared bit for bit when it was made)
+    # were compared bit for bit when it was made); rtol 1e-10: the last bits of gmsh's mesh
+    # and the sparse solve move with the host CPU (2.5e-12 on an AMD EPYC host)
     r, s = network.sample_throats(500, rng=1)
     sol = throats.solve_fem(r[:6], s[:6])
     np.testing.assert_allclose(sol.qstar, [0.01802273340709571, 0.0024131950863339807,
                                            0.005935162017756895, 0.00922221395079946,
                                            0.007085161350289585, 0.009949641855307953],
-                               rtol=1e-12)
+                               rtol=1e-10)
