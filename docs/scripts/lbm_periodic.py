@@ -176,51 +176,6 @@ def _velocity_x(f, index, nf, gx, out):
         out[n] = (jx + 0.5 * rho * gx) / rho
 
 
-@njit(parallel=True, cache=True)
-def _moments(f, index, nf, gx, omp, out):
-    """Per fluid node of the post-collision state (one pull, as the kernel sees it): velocity
-    u (3) and strain rate S (xx, yy, zz, xy, xz, yz) from the non-equilibrium second moment,
-    S = -(3 omega+ / 2 rho) [Pi_neq + (u F + F u)/2] (Guo forcing, F = rho g x), lattice units."""
-    for n in prange(nf):
-        rho = 0.0
-        jx = 0.0
-        jy = 0.0
-        jz = 0.0
-        pxx = 0.0
-        pyy = 0.0
-        pzz = 0.0
-        pxy = 0.0
-        pxz = 0.0
-        pyz = 0.0
-        for i in range(19):
-            v = f[index[i * nf + n]]
-            rho += v
-            jx += CX[i] * v
-            jy += CY[i] * v
-            jz += CZ[i] * v
-            pxx += CX[i] * CX[i] * v
-            pyy += CY[i] * CY[i] * v
-            pzz += CZ[i] * CZ[i] * v
-            pxy += CX[i] * CY[i] * v
-            pxz += CX[i] * CZ[i] * v
-            pyz += CY[i] * CZ[i] * v
-        fx = rho * gx
-        ux = (jx + 0.5 * fx) / rho
-        uy = jy / rho
-        uz = jz / rho
-        cs2 = 1.0 / 3.0
-        k = -1.5 * omp / rho
-        out[n, 0] = ux
-        out[n, 1] = uy
-        out[n, 2] = uz
-        out[n, 3] = k * (pxx - rho * (cs2 + ux * ux) + ux * fx)
-        out[n, 4] = k * (pyy - rho * (cs2 + uy * uy))
-        out[n, 5] = k * (pzz - rho * (cs2 + uz * uz))
-        out[n, 6] = k * (pxy - rho * ux * uy + 0.5 * uy * fx)
-        out[n, 7] = k * (pxz - rho * ux * uz + 0.5 * uz * fx)
-        out[n, 8] = k * (pyz - rho * uy * uz)
-
-
 def omegas(tau):
     """(omega+, omega-) of the TRT collision at relaxation time ``tau`` and Lambda = 3/16."""
     omp = 1.0 / tau
@@ -239,13 +194,6 @@ class Lattice:
         self.g = np.empty(19 * self.nf)
         self.ux = np.zeros(self.nf)
         _equilibrium(self.f, self.nf, self.ux)
-
-    def moments(self, tau, gx):
-        """(n_fluid, 9): u_x, u_y, u_z, S_xx, S_yy, S_zz, S_xy, S_xz, S_yz of the current state
-        (:func:`_moments`), lattice units."""
-        out = np.empty((self.nf, 9))
-        _moments(self.f, self.index, self.nf, gx, omegas(tau)[0], out)
-        return out
 
     def start_from(self, ux):
         self.ux = np.asarray(ux, float).copy()
