@@ -198,10 +198,11 @@ def add_air(ap, *, density: bool = True) -> None:
     if density:
         ap.add_argument("--density", type=float, default=RHO_AIR_KG_M3,
                         help="air density for the inertial losses, kg/m^3, > 0")
-        ap.add_argument("--inertial-law", default="onset", choices=tuple(INERTIAL_LAWS),
-                        help="per-conduit inertial loss: onset = laminar-jet expansion with the "
-                             "Re^2 onset, quadratic = flat-profile K q|q| from the start, pore = "
-                             "the law from a resolved 3-D pore body (docs/inertial-flow.md)")
+        ap.add_argument("--inertial-law", default="pore", choices=tuple(INERTIAL_LAWS),
+                        help="per-conduit inertial loss: pore = the law from a resolved 3-D "
+                             "pore body (default), onset = laminar-jet expansion with X/(1+X) "
+                             "onset (before session 7), quadratic = flat-profile K q|q| from the "
+                             "start (docs/inertial-flow.md)")
 
 
 # ------------------------------------------------------------------ checks

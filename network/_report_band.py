@@ -108,7 +108,7 @@ def slope_at(velocity_m_s, velocities_m_s, slopes) -> float:
 
 def pack_band(packing: Packing, porosity: float, *, velocities_m_s, axis: str = "z",
               seeds=(1, 2), viscosity_pa_s: float, density_kg_m3: float,
-              inertial_law: str = "onset", db=None) -> dict:
+              inertial_law: str = "pore", db=None) -> dict:
     """Pack and solve the band's beds; the fitted slope at each velocity (see the module).
 
     The packings have ``packing``'s grain count, its (volume-equivalent) diameter range and its
