@@ -6,7 +6,7 @@ solid_fraction=0.60)``, as the scaling part makes it; the sample is the default 
 tessellation, conductances, the Stokes solve and the Newton curve each timed, with Newton
 iterations per velocity and the 1-minute load average. :func:`inertial_validation` runs the
 drag-law cases of :mod:`network.validation` (Finney's packing and periodic random packings)
-for the conduit laws of :data:`INERTIAL_LAWS` (quadratic, onset, derived),
+for the conduit laws of :data:`INERTIAL_LAWS` (quadratic, onset, derived, pore),
 and :func:`inertial_lines` prints both. Measurements: ``docs/inertial-flow.md``.
 """
 
@@ -41,10 +41,10 @@ def _cpu_s() -> float:
 
 
 def inertial_speed(n_spheres: int = 20_000, *, seed: int = 1, n_points: int = 12,
-                   policy: str = "table-only", db=None, law: str = "onset",
+                   policy: str = "table-only", db=None, law: str = "pore",
                    workers: int | None = None) -> dict:
     """Stage times (s) of a ``n_points`` curve 0.005-0.3 m/s on the benchmark packing, with
-    the conduit ``law`` of :data:`INERTIAL_LAWS` (default 'onset', ``network.solve``'s), its
+    the conduit ``law`` of :data:`INERTIAL_LAWS` (default 'pore', ``network.solve``'s), its
     Newton solves in ``workers`` continuation chains (default: the usable cores); the
     process CPU time of the whole curve beside the wall times."""
     if workers is None:
@@ -99,7 +99,7 @@ def inertial_lines(speed: dict | None, rows: list[dict]) -> list[str]:
     """The printed table of part 4."""
     out = []
     if speed:
-        out.append(f"inertial curve ({speed.get('law', 'onset')} law), {speed['n_spheres']} "
+        out.append(f"inertial curve ({speed.get('law', 'pore')} law), {speed['n_spheres']} "
                    f"spheres: tessellate {speed['tessellate_s']:.2f} s, conductance "
                    f"{speed['conductance_s']:.2f} s, "
                    f"Stokes solve {speed['stokes_s']:.2f} s, Newton {speed['inertial_s']:.2f} s: "

@@ -124,8 +124,15 @@ def inertial_coefficients(tessellation, throats_idx, h_m, *, internal=None,
         Column 0 for flow from side 0 (``throat_pores[:, 0]``) to side 1, column 1 the
         reverse; 0 for closed windows and internal throats.
     """
+    return _coefficients(_window_and_ratios(tessellation, throats_idx, h_m), internal=internal,
+                         density_kg_m3=density_kg_m3, profile=profile, cos_theta=cos_theta,
+                         contraction=contraction)
+
+
+def _coefficients(window, *, internal, density_kg_m3, profile, cos_theta, contraction):
+    """:func:`inertial_coefficients` from ``_window_and_ratios``'s (A_w, sigma, a)."""
     rho = check_density(density_kg_m3)
-    a_w, sigma, _ = _window_and_ratios(tessellation, throats_idx, h_m)
+    a_w, sigma, _ = window
     ct = np.ones((sigma.shape[0], 2)) if cos_theta is None else np.asarray(cos_theta, float)
     if contraction not in ("sharp", "smooth"):
         raise ValueError(f"contraction must be 'sharp' or 'smooth', got {contraction!r}")
@@ -178,12 +185,18 @@ def onset_scales(tessellation, throats_idx, h_m, K, *,
     -------
     c : (M, 2) ndarray
     """
+    return _onset(_window_and_ratios(tessellation, throats_idx, h_m), h_m, K,
+                  density_kg_m3=density_kg_m3, viscosity_pa_s=viscosity_pa_s, slope=slope)
+
+
+def _onset(window, h_m, K, *, density_kg_m3, viscosity_pa_s, slope):
+    """:func:`onset_scales` from ``_window_and_ratios``'s (A_w, sigma, a)."""
     rho = check_density(density_kg_m3)
     mu = check_viscosity(viscosity_pa_s)
     c1 = float(slope)
     if not (np.isfinite(c1) and c1 > 0):
         raise ValueError(f"slope must be a finite number > 0, got {slope!r}")
-    a_w, _, a = _window_and_ratios(tessellation, throats_idx, h_m)
+    a_w, _, a = window
     K = np.asarray(K, dtype=float)
     if K.shape != (a_w.size, 2):
         raise ValueError(f"K must have shape ({a_w.size}, 2), got {K.shape}")
@@ -251,13 +264,11 @@ def conduit_law(tessellation, throats_idx, h_m, *, internal=None, pore_xyz_m=Non
         cos = turning_cosines(tessellation.packing.centers,
                               np.asarray(tessellation.throat_vertices)[throats_idx], pore_xyz_m,
                               conns, stokes_flow_m3_s, axis, recovery=recovery)
-    K = inertial_coefficients(tessellation, throats_idx, h_m, internal=internal,
-                              density_kg_m3=density_kg_m3, profile=profile, cos_theta=cos,
-                              contraction=contraction)
     if onset not in (None, "throat"):
         raise ValueError(f"onset must be None or 'throat', got {onset!r}")
-    c = None if onset is None else onset_scales(tessellation, throats_idx, h_m, K,
-                                                 density_kg_m3=density_kg_m3,
-                                                 viscosity_pa_s=viscosity_pa_s,
-                                                 slope=onset_slope)
+    win = _window_and_ratios(tessellation, throats_idx, h_m)       # once for K and the onset
+    K = _coefficients(win, internal=internal, density_kg_m3=density_kg_m3, profile=profile,
+                      cos_theta=cos, contraction=contraction)
+    c = None if onset is None else _onset(win, h_m, K, density_kg_m3=density_kg_m3,
+                                          viscosity_pa_s=viscosity_pa_s, slope=onset_slope)
     return K, c, crossover
