@@ -64,6 +64,12 @@ def test_throat_onset_conduit_flow():
                                rtol=1e-12)
     q2, _ = conduit_flow(dp * (1 + 1e-7), g, K, onset_scale=c)
     np.testing.assert_allclose((q2 - q) / (dp * 1e-7), w, rtol=1e-5)
+    # warm start from any flows of either sign, above or below the root: the same root (the
+    # residual is convex and increasing; from below the first step overshoots it)
+    start = q * 10 ** rng.uniform(-2, 2, n) * rng.choice([-1.0, 1.0], n, p=[0.1, 0.9])
+    q3, w3 = conduit_flow(dp, g, K, onset_scale=c, q_start=start)
+    np.testing.assert_allclose(q3, q, rtol=1e-13)
+    np.testing.assert_allclose(w3, w, rtol=1e-12)
     # Re^2 onset: excess / viscous drop = K g c q^2 at small flow; K q|q| at large flow
     q, _ = conduit_flow(np.array([1e-6]), np.ones(1), np.ones(1), onset_scale=np.ones(1))
     assert (1e-6 - q[0]) / q[0] == pytest.approx(q[0] ** 2, rel=1e-5)

@@ -15,7 +15,7 @@ from network.flow import solve_network
 from network.packing import default_packing_path, read_packing
 from network.conductance import (PORE_ONSET_SLOPE, PORE_RECOVERY, conduit_law,
                                  expansion_coefficient, inertial_coefficients)
-from network.flow import INERTIAL_LAWS, conduit_flow
+from network.flow import INERTIAL_LAWS
 from network.packing import random_packing
 from network.pores import tessellate
 from network.validation import DERIVED_LAW, PORE_LAW, random_inertial_case
@@ -100,17 +100,3 @@ def test_solve_network_pore_law_stokes_limit_mass_balance_monotone():
     # recorded at the commit that added this test (bundled scene, z, whole sample)
     np.testing.assert_allclose(ratio[2:], [1.1331, 2.4308], rtol=2e-3)
 
-
-def test_warm_started_conduit_flow_finds_the_same_root():
-    # any start of either sign, above or below the root: the same flows to 1e-14 as the
-    # upper-bound start (convex increasing residual; from below the first step overshoots)
-    rng = np.random.default_rng(5)
-    n = 20000
-    g, K = 10 ** rng.uniform(-3, 3, n), 10 ** rng.uniform(-3, 3, (n, 2))
-    c = 10 ** rng.uniform(-3, 3, (n, 2))
-    dp = 10 ** rng.uniform(-7, 7, n) * rng.choice([-1.0, 1.0], n)
-    q, w = conduit_flow(dp, g, K, onset_scale=c)
-    start = q * 10 ** rng.uniform(-2, 2, n) * rng.choice([-1.0, 1.0], n, p=[0.1, 0.9])
-    q2, w2 = conduit_flow(dp, g, K, onset_scale=c, q_start=start)
-    np.testing.assert_allclose(q2, q, rtol=1e-13)
-    np.testing.assert_allclose(w2, w, rtol=1e-12)
