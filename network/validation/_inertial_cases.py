@@ -33,9 +33,9 @@ from pathlib import Path
 import numpy as np
 from scipy.spatial import cKDTree
 
-from ..conductance import (ONSET_SLOPE, PORE_ONSET_SLOPE, PORE_RECOVERY, conduit_law,
-                           throat_conductance)
-from ..flow import AMGSolver, darcy_permeability, solve_fixed_pressure, solve_inertial
+from ..conductance import ONSET_SLOPE, conduit_law, throat_conductance
+from ..flow import (INERTIAL_LAWS, AMGSolver, darcy_permeability, solve_fixed_pressure,
+                    solve_inertial)
 from ..packing import Packing, lattice_packing, periodic_copies, random_packing, read_packing
 from ..pores import Region, merge_pores, prune_disconnected, select_sample, tessellate
 from ._drag_laws import DRAG_LAWS, drag_ratio
@@ -50,8 +50,9 @@ DERIVED_LAW = {"profile": "uniform", "contraction": "smooth", "turning": True,
 
 #: The same form with the onset slope and the cross-momentum recovery of a resolved 3-D pore
 #: body (regular tetrahedral pore, steady Navier-Stokes; ``docs/inertial-flow.md``, "A law
-#: from the 3-D pore") instead of the axisymmetric constriction's slope and no recovery.
-PORE_LAW = {**DERIVED_LAW, "recovery": PORE_RECOVERY, "onset_slope": PORE_ONSET_SLOPE}
+#: from the 3-D pore") instead of the axisymmetric constriction's slope and no recovery:
+#: ``network.solve``'s default law 'pore'.
+PORE_LAW = dict(INERTIAL_LAWS["pore"])
 
 #: Finney's packing, central subset (radius 1, lengths in sphere radii).
 FINNEY_PATH = Path("/work/shared/data/finney/finney_subset_4021.csv")
