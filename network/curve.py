@@ -206,6 +206,7 @@ def _main(args) -> int:
     print(f"total {total:.2f} s")
     out = {"packing": str(path), "units": args.units, "n_spheres": packing.n, "axis": args.axis,
            "grain": args.grain, "workers": args.workers, "density_kg_m3": args.density,
+           "inertial_law": args.inertial_law,
            "viscosity_pa_s": args.viscosity,
            "porosity": res.porosity, "sauter_diameter_m": res.sauter_diameter_m,
            "permeability_stokes_m2": res.permeability_m2, "points": pts} | fits | {

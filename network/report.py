@@ -289,7 +289,7 @@ def build_report(args, opts, path, packing) -> dict:
     sg = [p["pressure_gradient_pa_per_m"] for p in ok]
     system = system_rows(su, sg, depth_m=args.depth, area_m2=area, bulk_density_kg_m3=rho_b)
     out = {"grain": opts["grain"], "packing": str(path), "n_spheres": packing.n,
-           "n_grains": packing.n_grains, "porosity": e,
+           "n_grains": packing.n_grains, "porosity": e, "inertial_law": args.inertial_law,
            "porosity_source": f"{opts['bed']['label']}; {why}", "bed": bed_json(opts["bed"], path),
            "porosity_packing": e_p, "porosity_packing_std": rz.porosity_std,
            "porosity_reachable": opts["reachable"],

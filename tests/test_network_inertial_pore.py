@@ -102,3 +102,18 @@ def test_solve_network_pore_law_stokes_limit_mass_balance_monotone():
     # recorded at the commit that added this test (bundled scene, z, whole sample)
     np.testing.assert_allclose(ratio[2:], [1.1277, 2.4000], rtol=2e-3)
 
+
+
+def test_cli_json_names_the_law(tmp_path):
+    # the default law changed in session 7 ('onset' -> 'pore'): every JSON says which it used
+    import json
+
+    from network import curve, solve
+
+    for law, args in (("pore", []), ("onset", ["--inertial-law", "onset"])):
+        out = tmp_path / f"s_{law}.json"
+        assert solve.main(["-q", "--json", str(out)] + args) == 0
+        assert json.loads(out.read_text())["inertial_law"] == law
+    out = tmp_path / "c.json"
+    assert curve.main(["-q", "--velocities", "0.01,0.1", "--json", str(out)]) == 0
+    assert json.loads(out.read_text())["inertial_law"] == "pore"

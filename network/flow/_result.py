@@ -211,6 +211,7 @@ class FlowResult:
                 "reynolds_particle": self.reynolds_particle(self.velocity_m_s,
                                                             self.inertial["density_kg_m3"]),
                 "density_kg_m3": self.inertial["density_kg_m3"],
+                "inertial_law": self.inertial.get("law"),
                 "inertial_solver": {"converged": pt.converged, "newton_iterations": pt.iterations,
                                     "cg_iterations": pt.cg_iterations, "residual": pt.residual,
                                     "seconds": pt.seconds}}
