@@ -160,7 +160,7 @@ def _throat_onset_flow(dp, a, g, inv_g, k, c, q_start=None):
         step = f / kqt
         qa -= step
         np.maximum(qa, 0.0, out=qa)
-        done = np.abs(step) <= 1e-14 * qa
+        done = np.abs(step) <= 1e-9 * qa              # quadratic: the error left is ~step^2
         if done.any():
             q[act[done]] = qa[done]
             keep = ~done
