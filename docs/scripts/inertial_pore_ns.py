@@ -9,7 +9,9 @@ outlets). Taylor-Hood P2/P1 on a gmsh mesh of characteristic length h, Newton wi
 continuation in Re, scikit-fem. Printed per window Reynolds number
 Re_w = rho u_w D_w/mu (u_w = Q/A_w, D_w = 2 sqrt(A_w/pi)): the excess viscous dissipation over
 Stokes at the same flow, per rho u_w^2 Q/2, in the whole domain (k_pore), in the tetrahedron
-(k_body) and in the inlet prism (k_prism; plug development and the contraction).
+(k_body) and in the inlet prism (k_prism; plug development and the contraction), and k_out,
+the kinetic energy the outflow carries through the three outlet windows over a flat profile at
+each window's open area (per rho u_w^2 Q/2): the loss a chain's next body would take.
 
 Any tetrahedron: ``pore(..., V=(4, 3) vertices, r=radii, e=prism length)``, face (0, 1, 2)
 the inlet. The first row (Re_w 0) gives the conduit model's sigma of the inlet window (open
@@ -178,6 +180,22 @@ def pore(reynolds, *, h=0.1, V=None, r=0.9, e=0.5):
     a_b = float(throats.open_area(np.sqrt(np.maximum(r[None, :3] ** 2 - hc**2, 1e-24)),
                                   sides)[0])
     q_out = np.array([through(mk) for mk in outlets])
+    ke_flux = Functional(lambda w: 0.5 * dot(w["u"], w["u"]) * dot(w["u"], w.n))
+
+    def ke_excess(U):
+        """Kinetic-energy flux out through the outlet windows over that of a flat profile at
+        each window's open area (per rho): what a chain's next body would dissipate."""
+        out = 0.0
+        for mk, f in zip(outlets, out_faces):
+            fb = FacetBasis(m, ElementVector(ElementTetP2()), facets=bf[mk], intorder=4)
+            uu = fb.interpolate(U[:nu])
+            qg = flux.assemble(fb, u=uu)
+            sf = np.array([[np.linalg.norm(V[f[1]] - V[f[2]]), np.linalg.norm(V[f[0]] - V[f[2]]),
+                            np.linalg.norm(V[f[0]] - V[f[1]])]])
+            ag = float(throats.open_area(r[None, list(f)], sf)[0])
+            out += ke_flux.assemble(fb, u=uu) - 0.5 * qg**3 / ag**2
+        return out
+
     M = sum(qg * inward_normal(V, f) * -1 for qg, f in zip(q_out, out_faces)) / q_out.sum()
     u_w, d_w = Q / a_w, 2 * np.sqrt(a_w / np.pi)
     rows = [{"Re_w": 0, "sigma": a_w / a_b, "cos_theta": float(n_in @ M), "A_w": a_w,
@@ -188,8 +206,10 @@ def pore(reynolds, *, h=0.1, V=None, r=0.9, e=0.5):
                           convection=convection, convection_jacobian=convection_jacobian,
                           rtol=1e-8, maxiter=30)
         k = (split(U) - stokes_d) / (0.5 * rho * u_w**2 * Q)
+        k_out = ke_excess(U) / (0.5 * u_w**2 * Q)
         rows.append({"h": h, "n_tets": int(m.t.shape[1]), "Re_w": re, "newton": steps,
-                     "k_pore": float(k[0]), "k_body": float(k[1]), "k_prism": float(k[2])})
+                     "k_pore": float(k[0]), "k_body": float(k[1]), "k_prism": float(k[2]),
+                     "k_out": float(k_out)})
     return rows
 
 
