@@ -23,8 +23,10 @@ onset is the solver's (:func:`network.flow.conduit_flow`, ``crossover``).
 The law derived from single-constriction Navier-Stokes (``network.validation.DERIVED_LAW``)
 uses ``contraction='smooth'`` (no vena contracta at a sphere-rounded window), the expansion
 against the downstream body's outflow direction (``cos_theta`` from :func:`turning_cosines`)
-and the window-Reynolds onset of :func:`onset_scales`. No coefficient is fitted to bed-scale
-data. Derivations, the Navier-Stokes table and the validation against the LBM drag laws:
+and the window-Reynolds onset of :func:`onset_scales`; ``network.solve``'s default law
+'pore' (``PORE_LAW``) takes the onset slope and the cross-momentum recovery of a resolved 3-D
+pore body instead (:data:`PORE_ONSET_SLOPE`, :data:`PORE_RECOVERY`); :func:`conduit_law`
+assembles either. No coefficient is fitted to bed-scale data. Derivations, the Navier-Stokes table and the validation against the LBM drag laws:
 ``docs/inertial-flow.md``.
 """
 
