@@ -174,8 +174,8 @@ def _throat_onset_flow(dp, a, g, inv_g, k, c, q_start=None):
 
 def solve_inertial(n_pores, conns, g, K, inlet, outlet, flows_m3_s, *, tol: float = 1e-10,
                    maxiter: int = 30, amg: AMGSolver | None = None,
-                   crossover: float | None = None, onset_scale=None, workers: int = 1
-                   ) -> list[InertialPoint]:
+                   crossover: float | None = None, onset_scale=None, workers: int = 1,
+                   stokes=None) -> list[InertialPoint]:
     """Solve the nonlinear network at every total flow (ascending), reusing one hierarchy.
 
     Parameters
@@ -204,6 +204,10 @@ def solve_inertial(n_pores, conns, g, K, inlet, outlet, flows_m3_s, *, tol: floa
         Processes (default 1): the sorted flows are dealt into ``workers`` interleaved
         continuation chains (at least 4 flows each), solved side by side in forked
         processes; each chain converges every flow to ``tol`` as one chain would.
+    stokes : (pressures (Np,), flow), optional
+        A Stokes solution of the same network (pressures in Pa, outlet 0, and its total flow
+        in m³/s): the first flow of each chain starts from it scaled to that flow instead
+        of from rest (whose first Newton step is that Stokes solution, solved loosely).
 
     Returns
     -------
@@ -298,6 +302,8 @@ def solve_inertial(n_pores, conns, g, K, inlet, outlet, flows_m3_s, *, tol: floa
                 p = p2 * (Q / q2) ** np.clip(expo, 1.0, 2.0)
             elif hist:
                 p = p * (Q / hist[-1][0])
+            elif stokes is not None:
+                p = np.asarray(stokes[0], dtype=float) * (Q / float(stokes[1]))
             r, q, w = residual(p, Q)
             rel = np.abs(r).max() / Q
             it = cg_it = 0

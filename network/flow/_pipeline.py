@@ -232,7 +232,7 @@ def solve_network(packing: Packing, *, axis="z", region: Region | None = None,
             pts = solve_inertial(sample.n_pores, sample.conns, g, K, sample.inlet,
                                  sample.outlet, np.asarray(us) * sample.area_m2,
                                  crossover=crossover, onset_scale=c_on, amg=info.amg,
-                                 workers=inertial_workers)
+                                 workers=inertial_workers, stokes=(p, check["q_in"]))
             inertial = {"density_kg_m3": density_kg_m3, "velocities_m_s": us, "points": pts,
                         "law": inertial_law}
     times["assemble"] = info.assemble_s

@@ -129,8 +129,8 @@ def solve_sample_curve(packing, region, velocities_m_s, *, axis=0, policy="table
         held["amg"] = AMGSolver(A, smoother="forward-backward")
         return held["amg"].solve(b, tol=1e-10)[0]
 
-    _, _, check = solve_fixed_pressure(sample.n_pores, sample.conns, g, sample.inlet,
-                                       sample.outlet, p_in=1.0, p_out=0.0, solver=amg_solve)
+    p0, _, check = solve_fixed_pressure(sample.n_pores, sample.conns, g, sample.inlet,
+                                        sample.outlet, p_in=1.0, p_out=0.0, solver=amg_solve)
     k = darcy_permeability(check["q_in"], 1.0, sample.length_m, sample.area_m2,
                            viscosity_pa_s=viscosity_pa_s)
     t["stokes"] = time.perf_counter() - t0
@@ -144,7 +144,7 @@ def solve_sample_curve(packing, region, velocities_m_s, *, axis=0, policy="table
     pts = solve_inertial(sample.n_pores, sample.conns, g, K, sample.inlet, sample.outlet,
                          np.asarray(velocities_m_s, dtype=float) * sample.area_m2,
                          crossover=crossover, onset_scale=c_on, amg=held.get("amg"),
-                         workers=workers)
+                         workers=workers, stokes=(p0, check["q_in"]))
     t["inertial"] = time.perf_counter() - t0
     return k, sample.length_m, pts, t
 
