@@ -21,7 +21,7 @@ from .._cli import available_cores
 from ..packing import random_packing
 from ..pores import default_region
 from ..flow import INERTIAL_LAWS as FLOW_LAWS
-from ..validation import (DERIVED_LAW, PORE_LAW, finney_inertial_case, random_inertial_case,
+from ..validation import (DERIVED_LAW, finney_inertial_case, random_inertial_case,
                           solve_sample_curve)
 
 __all__ = ["INERTIAL_LAWS", "INERTIAL_REYNOLDS", "inertial_lines", "inertial_speed",
@@ -75,10 +75,11 @@ def inertial_speed(n_spheres: int = 20_000, *, seed: int = 1, n_points: int = 12
 
 #: Laws of the validation table: name -> keyword options of the validation cases
 #: (``docs/inertial-flow.md``): 'quadratic' flat-profile K q|q|; 'onset' laminar profile +
-#: X_c = 1 (``network.solve``'s default); 'derived' the single-constriction Navier-Stokes law;
-#: 'pore' the same form with the 3-D pore body's onset slope and recovery.
-INERTIAL_LAWS = {"quadratic": {}, "onset": FLOW_LAWS["onset"], "derived": DERIVED_LAW,
-                 "pore": PORE_LAW}
+#: X_c = 1 (``network.solve``'s default until session 7); 'derived' the single-constriction
+#: Navier-Stokes law; 'pore' the same form with the 3-D pore body's onset slope and recovery
+#: (``network.solve``'s default).
+INERTIAL_LAWS = {"quadratic": FLOW_LAWS["quadratic"], "onset": FLOW_LAWS["onset"],
+                 "derived": DERIVED_LAW, "pore": FLOW_LAWS["pore"]}
 
 
 def inertial_validation(*, reynolds=INERTIAL_REYNOLDS, solid_fractions=(0.55, 0.60, 0.64),

@@ -15,8 +15,9 @@ from ._result import ConductanceResult
 from ._table import default_table, has_grid, table_totals
 from ._thesis import thesis_conductance
 
-__all__ = ["MODELS", "ONSET_SLOPE", "PORE_ONSET_SLOPE", "PORE_RECOVERY", "POLICIES", "SECTION_MODES", "ConductanceResult",
-           "QstarResult", "check_model", "check_policy", "conduit_conductance", "conduit_law",
+__all__ = ["MODELS", "ONSET_SLOPE", "PORE_ONSET_SLOPE", "PORE_RECOVERY", "POLICIES",
+           "SECTION_MODES", "ConductanceResult", "QstarResult", "check_model", "check_policy",
+           "conduit_conductance", "conduit_law",
            "contraction_coefficient", "default_table", "expansion_coefficient", "has_grid",
            "inertial_coefficients", "onset_scales", "qstar_from_function", "section_estimate",
            "side_resistance", "table_totals", "thesis_conductance", "throat_conductance",

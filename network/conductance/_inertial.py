@@ -26,8 +26,8 @@ against the downstream body's outflow direction (``cos_theta`` from :func:`turni
 and the window-Reynolds onset of :func:`onset_scales`; ``network.solve``'s default law
 'pore' (``PORE_LAW``) takes the onset slope and the cross-momentum recovery of a resolved 3-D
 pore body instead (:data:`PORE_ONSET_SLOPE`, :data:`PORE_RECOVERY`); :func:`conduit_law`
-assembles either. No coefficient is fitted to bed-scale data. Derivations, the Navier-Stokes table and the validation against the LBM drag laws:
-``docs/inertial-flow.md``.
+assembles either. No coefficient is fitted to bed-scale data. Derivations, the Navier-Stokes
+table and the validation against the LBM drag laws: ``docs/inertial-flow.md``.
 """
 
 from __future__ import annotations
@@ -259,6 +259,8 @@ def conduit_law(tessellation, throats_idx, h_m, *, internal=None, pore_xyz_m=Non
     :func:`network.flow.conduit_flow`). The law of a conduit is then
     :math:`\Delta p = q/g + K q|q|\,\phi`, φ the onset factor.
     """
+    if onset not in (None, "throat"):
+        raise ValueError(f"onset must be None or 'throat', got {onset!r}")
     cos = None
     if turning:
         if stokes_flow_m3_s is None or pore_xyz_m is None or conns is None:
@@ -266,8 +268,6 @@ def conduit_law(tessellation, throats_idx, h_m, *, internal=None, pore_xyz_m=Non
         cos = turning_cosines(tessellation.packing.centers,
                               np.asarray(tessellation.throat_vertices)[throats_idx], pore_xyz_m,
                               conns, stokes_flow_m3_s, axis, recovery=recovery)
-    if onset not in (None, "throat"):
-        raise ValueError(f"onset must be None or 'throat', got {onset!r}")
     win = _window_and_ratios(tessellation, throats_idx, h_m)       # once for K and the onset
     K = _coefficients(win, internal=internal, density_kg_m3=density_kg_m3, profile=profile,
                       cos_theta=cos, contraction=contraction)

@@ -94,7 +94,6 @@ def conduit_flow(dp, g, K, *, crossover: float | None = None, onset_scale=None, 
     k = np.where(dp >= 0, K[:, 0], K[:, 1]) if K.ndim == 2 else K
     a = np.abs(dp)
     inv_g = 1.0 / g
-    q = 2.0 * a / (inv_g + np.sqrt(inv_g**2 + 4.0 * k * a))
     if onset_scale is not None:
         if crossover is not None:
             raise ValueError("give crossover or onset_scale, not both")
@@ -102,6 +101,7 @@ def conduit_flow(dp, g, K, *, crossover: float | None = None, onset_scale=None, 
         c = np.where(dp >= 0, c[:, 0], c[:, 1]) if c.ndim == 2 else c
         return _throat_onset_flow(dp, a, g, inv_g, k, c, q_start)
     if crossover is None:
+        q = 2.0 * a / (inv_g + np.sqrt(inv_g**2 + 4.0 * k * a))
         w = 1.0 / (inv_g + 2.0 * k * q)
         return np.sign(dp) * q, w
     c = k * g / float(crossover)            # X / X_c = c |q|

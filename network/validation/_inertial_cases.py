@@ -109,6 +109,8 @@ def solve_sample_curve(packing, region, velocities_m_s, *, axis=0, policy="table
     :func:`network.conductance.onset_scales`. :data:`DERIVED_LAW` is the law derived from
     single-constriction Navier-Stokes, :data:`PORE_LAW` the one from the 3-D pore body
     (``docs/inertial-flow.md``)."""
+    if onset not in (None, "throat"):
+        raise ValueError(f"onset must be None or 'throat', got {onset!r}")
     t = {}
     t0 = time.perf_counter()
     tess = tessellate(packing)
