@@ -173,27 +173,29 @@ def pore(reynolds, *, h=0.1, V=None, r=0.9, e=0.5):
 
     Q = -through(inlet)
     # conduit-model quantities of the inlet window (throats.open_area, centroid height)
-    sides = np.array([[np.linalg.norm(V[1] - V[2]), np.linalg.norm(V[0] - V[2]),
-                       np.linalg.norm(V[0] - V[1])]])
+    def face_sides(f):
+        """(1, 3) side lengths of face f, side k opposite its vertex k (throats' convention)."""
+        a, b, c = V[list(f)]
+        return np.array([[np.linalg.norm(b - c), np.linalg.norm(a - c), np.linalg.norm(a - b)]])
+
+    sides = face_sides((0, 1, 2))
     a_w = float(throats.open_area(r[None, :3], sides)[0])
     hc = float((V.mean(axis=0) - V[0]) @ n_in)
     a_b = float(throats.open_area(np.sqrt(np.maximum(r[None, :3] ** 2 - hc**2, 1e-24)),
                                   sides)[0])
     q_out = np.array([through(mk) for mk in outlets])
     ke_flux = Functional(lambda w: 0.5 * dot(w["u"], w["u"]) * dot(w["u"], w.n))
+    out_bases = [FacetBasis(m, ElementVector(ElementTetP2()), facets=bf[mk], intorder=4)
+                 for mk in outlets]
+    out_areas = [float(throats.open_area(r[None, list(f)], face_sides(f))[0]) for f in out_faces]
 
     def ke_excess(U):
         """Kinetic-energy flux out through the outlet windows over that of a flat profile at
         each window's open area (per rho): what a chain's next body would dissipate."""
         out = 0.0
-        for mk, f in zip(outlets, out_faces):
-            fb = FacetBasis(m, ElementVector(ElementTetP2()), facets=bf[mk], intorder=4)
+        for fb, ag in zip(out_bases, out_areas):
             uu = fb.interpolate(U[:nu])
-            qg = flux.assemble(fb, u=uu)
-            sf = np.array([[np.linalg.norm(V[f[1]] - V[f[2]]), np.linalg.norm(V[f[0]] - V[f[2]]),
-                            np.linalg.norm(V[f[0]] - V[f[1]])]])
-            ag = float(throats.open_area(r[None, list(f)], sf)[0])
-            out += ke_flux.assemble(fb, u=uu) - 0.5 * qg**3 / ag**2
+            out += ke_flux.assemble(fb, u=uu) - 0.5 * flux.assemble(fb, u=uu) ** 3 / ag**2
         return out
 
     M = sum(qg * inward_normal(V, f) * -1 for qg, f in zip(q_out, out_faces)) / q_out.sum()

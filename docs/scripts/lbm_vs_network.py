@@ -3,9 +3,10 @@ and the network model on the same packings.
 
 For each LBM JSON: the packing (phi, n, seed) is rebuilt by ``random_inertial_case`` (copied
 3 x 3 x 3, the middle two periods as the sample) and the network's k/k_app is solved at the
-Reynolds numbers the LBM obtained, with the CLI law (``onset``: laminar jet, X_c = 1),
-``DERIVED_LAW`` and ``PORE_LAW``. Printed per row: LBM, Beetstra, HKL, both network laws, and the relative
-differences in % of the pressure gradient. ``--json`` writes the rows.
+Reynolds numbers the LBM obtained, with the laws ``onset`` (the CLI's until session 7),
+``DERIVED_LAW`` and ``PORE_LAW`` (the CLI's since). Printed per row: LBM, Beetstra, HKL, the
+three network laws, and the relative differences in % of the pressure gradient. ``--json``
+writes the rows.
 
     python docs/scripts/lbm_vs_network.py /tmp/lbm/ens_*.json --json rows.json
 """
@@ -18,17 +19,17 @@ import sys
 
 import numpy as np
 
-LAWS = {"onset": {"profile": "laminar", "crossover": 1.0}}
-
 
 def compare(path):
-    from network.validation import DERIVED_LAW, PORE_LAW, random_inertial_case
+    from network.flow import INERTIAL_LAWS
+    from network.validation import DERIVED_LAW, random_inertial_case
 
     res = json.load(open(path))["result"]
     rows = [r for r in res["rows"] if r["re"] > 0.5]
     re = np.array([r["re"] for r in rows])
     net = {}
-    for name, law in {**LAWS, "derived": DERIVED_LAW, "pore": PORE_LAW}.items():
+    laws = {"onset": INERTIAL_LAWS["onset"], "derived": DERIVED_LAW, "pore": INERTIAL_LAWS["pore"]}
+    for name, law in laws.items():
         case = random_inertial_case(res["phi"], re, n_spheres=res["n"], rng=res["seed"], **law)
         net[name] = case.k_ratio
     out = []
