@@ -57,7 +57,14 @@ import sys
 import time
 
 import numpy as np
-from numba import njit, prange
+
+try:
+    from numba import njit, prange
+except ImportError:     # a machine without numba can still run --backend cuda
+    prange = range
+
+    def njit(*args, **kwargs):
+        return (lambda f: f) if not args or not callable(args[0]) else args[0]
 
 # --- D3Q19: rest, then 9 directions, then their opposites (i and i + 9 are opposite) -------
 _C9 = np.array([[1, 0, 0], [0, 1, 0], [0, 0, 1],
@@ -183,6 +190,177 @@ def omegas(tau):
     return omp, omm
 
 
+
+# --------------------------------------------------------------------------- CUDA backend ---
+_CUDA_SRC = r"""
+__constant__ double CXd[19] = {0,1,0,0,1,1,1,1,0,0,-1,0,0,-1,-1,-1,-1,0,0};
+__constant__ double CYd[19] = {0,0,1,0,1,-1,0,0,1,1,0,-1,0,-1,1,0,0,-1,-1};
+__constant__ double CZd[19] = {0,0,0,1,0,0,1,-1,1,-1,0,0,-1,0,0,-1,1,-1,1};
+__constant__ double Wd[19] = {1.0/3, 1.0/18, 1.0/18, 1.0/18, 1.0/36, 1.0/36, 1.0/36, 1.0/36,
+                              1.0/36, 1.0/36, 1.0/18, 1.0/18, 1.0/18, 1.0/36, 1.0/36, 1.0/36,
+                              1.0/36, 1.0/36, 1.0/36};
+extern "C" __global__ void lbm_step(const double* __restrict__ fin, double* __restrict__ fout,
+                                    const int* __restrict__ index, const long long nf,
+                                    const double omp, const double omm, const double gx,
+                                    double* __restrict__ usum)
+{
+    long long n = (long long)blockIdx.x * blockDim.x + threadIdx.x;
+    double uxl = 0.0;
+    if (n < nf) {
+        double v[19];
+        double rho = 0.0, jx = 0.0, jy = 0.0, jz = 0.0;
+        #pragma unroll
+        for (int i = 0; i < 19; ++i) {
+            v[i] = fin[index[i * nf + n]];
+            rho += v[i]; jx += CXd[i] * v[i]; jy += CYd[i] * v[i]; jz += CZd[i] * v[i];
+        }
+        double fx = rho * gx;
+        double ux = (jx + 0.5 * fx) / rho, uy = jy / rho, uz = jz / rho;
+        double usq = 1.5 * (ux * ux + uy * uy + uz * uz);
+        double ufx = ux * fx;
+        uxl = ux;
+        double e0 = Wd[0] * rho * (1.0 - usq);
+        double s0 = Wd[0] * (-3.0 * ufx);
+        fout[n] = v[0] - omp * (v[0] - e0) + (1.0 - 0.5 * omp) * s0;
+        #pragma unroll
+        for (int p = 1; p < 10; ++p) {
+            int q = p + 9;
+            double a = v[p], b = v[q];
+            double cu = CXd[p] * ux + CYd[p] * uy + CZd[p] * uz;
+            double cf = CXd[p] * fx;
+            double ep = Wd[p] * rho * (1.0 + 4.5 * cu * cu - usq);
+            double em = Wd[p] * rho * 3.0 * cu;
+            double sp = Wd[p] * (9.0 * cu * cf - 3.0 * ufx);
+            double sm = Wd[p] * 3.0 * cf;
+            double fp = 0.5 * (a + b), fm = 0.5 * (a - b);
+            double cp = -omp * (fp - ep) + (1.0 - 0.5 * omp) * sp;
+            double cm = -omm * (fm - em) + (1.0 - 0.5 * omm) * sm;
+            fout[p * nf + n] = a + cp + cm;
+            fout[q * nf + n] = b + cp - cm;
+        }
+    }
+    // block sum of u_x -> one atomic add per block
+    for (int off = 16; off > 0; off >>= 1) uxl += __shfl_down_sync(0xffffffff, uxl, off);
+    __shared__ double part[32];
+    int lane = threadIdx.x & 31, warp = threadIdx.x >> 5;
+    if (lane == 0) part[warp] = uxl;
+    __syncthreads();
+    if (warp == 0) {
+        uxl = (lane < (blockDim.x >> 5)) ? part[lane] : 0.0;
+        for (int off = 16; off > 0; off >>= 1) uxl += __shfl_down_sync(0xffffffff, uxl, off);
+        if (lane == 0) atomicAdd(usum, uxl);
+    }
+}
+"""
+
+
+class CudaLattice:
+    """The :class:`Lattice` on an NVIDIA GPU through CuPy: the same pull stream + TRT/Guo
+    collide, one thread per fluid node (``_CUDA_SRC``), the populations in device memory.
+    Same interface (``start_from``, ``run``, ``ux`` as a device array)."""
+
+    BLOCK = 256
+
+    def __init__(self, solid):
+        import cupy as cp
+
+        self.cp = cp
+        self.shape = solid.shape
+        self.n_nodes = int(solid.size)
+        index, self.nf = gather_index(solid)
+        self.index = cp.asarray(index)
+        self.f = cp.empty(19 * self.nf)
+        self.g = cp.empty(19 * self.nf)
+        self.usum = cp.zeros(1)
+        self.kernel = cp.RawKernel(_CUDA_SRC, "lbm_step")
+        self.start_from(cp.zeros(self.nf))
+
+    def start_from(self, ux):
+        cp = self.cp
+        self.ux = cp.asarray(ux, dtype=cp.float64).copy()
+        usq = 1.5 * self.ux * self.ux
+        for i in range(19):
+            cu = CX[i] * self.ux
+            self.f[i * self.nf:(i + 1) * self.nf] = W[i] * (1.0 + 3.0 * cu + 4.5 * cu * cu - usq)
+
+    def steps(self, count, omp, omm, gx):
+        """``count`` steps; returns the sum over them of sum_nodes u_x (host float)."""
+        cp = self.cp
+        grid = ((self.nf + self.BLOCK - 1) // self.BLOCK,)
+        self.usum[...] = 0.0
+        args_tail = (np.int64(self.nf), np.float64(omp), np.float64(omm), np.float64(gx),
+                     self.usum)
+        for _ in range(count):
+            self.kernel(grid, (self.BLOCK,), (self.f, self.g, self.index) + args_tail)
+            self.f, self.g = self.g, self.f
+        return float(self.usum.get()[0])
+
+    def velocity_x(self, gx):
+        cp = self.cp
+        rho = cp.zeros(self.nf)
+        jx = cp.zeros(self.nf)
+        for i in range(19):
+            v = self.f[self.index[i * self.nf:(i + 1) * self.nf]]
+            rho += v
+            jx += CX[i] * v
+        return (jx + 0.5 * rho * gx) / rho
+
+    def run(self, tau, gx, *, tol=1e-6, check=1000, max_steps=30000):
+        """As :meth:`Lattice.run`."""
+        omp, omm = omegas(tau)
+        self.cp.cuda.Device().synchronize()
+        t0 = time.perf_counter()
+        u_prev = None
+        steps = 0
+        converged = False
+        history = []
+        while steps < max_steps:
+            acc = self.steps(check, omp, omm, gx)
+            steps += check
+            u = acc / check / self.n_nodes
+            history.append(u)
+            if not np.isfinite(u):
+                break
+            if u_prev is not None and abs(u - u_prev) < tol * abs(u):
+                converged = True
+                break
+            u_prev = u
+        self.ux = self.velocity_x(gx)
+        if converged:
+            u_sup = float(self.ux.sum()) / self.n_nodes
+            spread = 0.0
+        else:
+            tail = np.array(history[-5:])
+            u_sup = float(tail.mean())
+            spread = float((tail.max() - tail.min()) / abs(u_sup))
+        rel = abs(history[-1] - history[-2]) / abs(history[-1]) if len(history) > 1 else np.nan
+        sec = time.perf_counter() - t0
+        return {"U": u_sup, "steps": steps, "converged": converged,
+                "last_rel_change": float(rel), "spread_last5": spread, "seconds": sec,
+                "mlups": self.nf * steps / sec / 1e6, "history": [float(h) for h in history]}
+
+
+def check_cuda_against_numba(solid, steps=200, tau=0.6, gx=2e-5, log=print):
+    """Run both kernels ``steps`` steps from the same non-trivial state; returns the largest
+    |f_cuda - f_numba| over all populations (both float64; only summation order differs)."""
+    cpu = Lattice(solid)
+    gpu = CudaLattice(solid)
+    rng = np.random.default_rng(0)
+    ux0 = 0.01 * rng.random(cpu.nf)
+    cpu.start_from(ux0)
+    gpu.start_from(ux0)
+    omp, omm = omegas(tau)
+    s_cpu = 0.0
+    for _ in range(steps):
+        s_cpu += _step(cpu.f, cpu.g, cpu.index, cpu.nf, omp, omm, gx)
+        cpu.f, cpu.g = cpu.g, cpu.f
+    s_gpu = gpu.steps(steps, omp, omm, gx)
+    diff = float(np.abs(gpu.f.get() - cpu.f).max())
+    log(f"# CUDA vs numba after {steps} steps ({cpu.nf} fluid nodes): max |df| {diff:.2e}, "
+        f"sum u_x {s_gpu:.12e} vs {s_cpu:.12e}")
+    return diff, s_gpu, s_cpu
+
+
 class Lattice:
     """Fluid nodes of one voxelised periodic box, the gather index and two population arrays."""
 
@@ -264,28 +442,61 @@ def plan(re, d_lu, *, u_max=0.02, tau_stokes=1.0, tau_min=0.51):
     return tau, u_max
 
 
-def packing_curve(phi, n, seed, resolution, reynolds, *, u_max=0.02, tau_stokes=1.0,
-                  max_steps=30000, log=print):
-    from network.validation import beetstra_permeability, drag_ratio
+def _laws():
+    """(beetstra_permeability, drag_ratio) of network.validation, or None where the package
+    cannot be imported (a bare GPU machine): the run then starts from a Kozeny-Carman guess and
+    leaves the laws' columns empty, to be filled where the package is installed."""
+    try:
+        from network.validation import beetstra_permeability, drag_ratio
+    except ImportError:
+        return None
+    return beetstra_permeability, drag_ratio
 
-    centers, radii, side = packing_box(phi, n, seed)
+
+def load_packing(path):
+    """(centers, radii, side, phi, n, seed) of a packing written by ``--export-packing``."""
+    z = np.load(path)
+    return (np.asarray(z["centers"], float), np.asarray(z["radii"], float), float(z["side"]),
+            float(z["phi"]), int(z["n"]), int(z["seed"]))
+
+
+def packing_curve(phi, n, seed, resolution, reynolds, *, u_max=0.02, tau_stokes=1.0,
+                  max_steps=30000, backend="numba", packing=None, time_budget=None,
+                  on_update=None, log=print):
+    """k/k_app(Re) of one periodic packing (module notes). ``packing``: (centers, radii, side)
+    instead of generating it; ``time_budget`` (s): no new Re is started after it; ``on_update``
+    is called with the result so far after every Re (incremental JSON)."""
+    laws = _laws()
+    if packing is None:
+        centers, radii, side = packing_box(phi, n, seed)
+    else:
+        centers, radii, side = packing
     nn = int(round(side * resolution))
     d_lu = nn / side
     t0 = time.perf_counter()
     solid = voxelise(centers, radii, side, nn)
-    lat = Lattice(solid)
+    lat = (CudaLattice if backend == "cuda" else Lattice)(solid)
     phi_vox = float(solid.mean())
     log(f"# packing phi={phi} n={n} seed={seed}: L = {side:.4f} d, grid {nn}^3, "
         f"D_eff = {d_lu:.3f} lu/d, voxel solid fraction {phi_vox:.4f}, "
-        f"{lat.nf} fluid nodes, setup {time.perf_counter() - t0:.1f} s")
+        f"{lat.nf} fluid nodes, setup {time.perf_counter() - t0:.1f} s, backend {backend}")
     rows = []
     k_stokes = None
-    k_guess = float(beetstra_permeability(phi, d_lu))
+    eps = 1.0 - phi
+    k_guess = (float(laws[0](phi, d_lu)) if laws else
+               d_lu**2 * eps**3 / (180.0 * (1.0 - eps)**2))
+    res = {"phi": phi, "n": n, "seed": seed, "resolution": resolution, "side_d": side,
+           "grid": nn, "d_lu": d_lu, "phi_voxel": phi_vox, "n_fluid": lat.nf,
+           "backend": backend, "k_stokes_d2": None,
+           "k_beetstra_d2": float(laws[0](phi, 1.0)) if laws else None, "rows": rows}
     for re in sorted(reynolds):
+        if time_budget is not None and time.perf_counter() - t0 > time_budget:
+            log(f"# time budget {time_budget:.0f} s spent: Re {re} and above not run")
+            break
         tau, u_t = plan(re, d_lu, u_max=u_max, tau_stokes=tau_stokes)
         nu = (tau - 0.5) / 3.0
         k_use = k_stokes if k_stokes is not None else k_guess
-        ratio_guess = float(drag_ratio("beetstra", phi, re))
+        ratio_guess = float(laws[1]("beetstra", phi, re)) if laws else 1.0 + 0.01 * re
         gx = nu * u_t / k_use * ratio_guess
         if rows:   # warm start: previous field scaled to the expected superficial velocity
             lat.start_from(lat.ux * (u_t / rows[-1]["U_lu"]))
@@ -297,24 +508,25 @@ def packing_curve(phi, n, seed, resolution, reynolds, *, u_max=0.02, tau_stokes=
             if re_got > 0.1 * 1.05:
                 raise ValueError(f"first run must be Stokes (Re <= 0.1), got {re_got:.3g}")
             k_stokes = k_app
+            res["k_stokes_d2"] = k_stokes / d_lu**2
         row = {"re_target": re, "re": re_got, "tau": tau, "nu": nu, "g": gx, "U_lu": u,
                "k_app_lu2": k_app, "k_ratio": k_stokes / k_app,
-               "beetstra": float(drag_ratio("beetstra", phi, re_got)),
-               "hill_koch_ladd": float(drag_ratio("hill_koch_ladd", phi, re_got)),
+               "beetstra": float(laws[1]("beetstra", phi, re_got)) if laws else None,
+               "hill_koch_ladd": float(laws[1]("hill_koch_ladd", phi, re_got)) if laws else None,
                "steps": r["steps"], "converged": r["converged"],
                "last_rel_change": r["last_rel_change"], "spread_last5": r["spread_last5"],
                "seconds": r["seconds"],
                "mlups": r["mlups"], "history_every_1000": r["history"]}
         rows.append(row)
+        laws_txt = (f"Beetstra {row['beetstra']:.4f}  HKL {row['hill_koch_ladd']:.4f}  "
+                    if laws else "")
         log(f"Re {re_got:8.4f}  tau {tau:.4f}  U {u:.3e}  k/k_app {row['k_ratio']:.4f}  "
-            f"Beetstra {row['beetstra']:.4f}  HKL {row['hill_koch_ladd']:.4f}  "
-            f"steps {r['steps']} ({'converged' if r['converged'] else 'step cap'}, "
-            f"last change {r['last_rel_change']:.1e}, spread {r['spread_last5']:.1e})  {r['seconds']:.0f} s, "
-            f"{r['mlups']:.1f} MLUPS")
-    return {"phi": phi, "n": n, "seed": seed, "resolution": resolution, "side_d": side,
-            "grid": nn, "d_lu": d_lu, "phi_voxel": phi_vox, "n_fluid": lat.nf,
-            "k_stokes_d2": k_stokes / d_lu**2,
-            "k_beetstra_d2": float(beetstra_permeability(phi, 1.0)), "rows": rows}
+            f"{laws_txt}steps {r['steps']} ({'converged' if r['converged'] else 'step cap'}, "
+            f"last change {r['last_rel_change']:.1e}, spread {r['spread_last5']:.1e})  "
+            f"{r['seconds']:.0f} s, {r['mlups']:.1f} MLUPS")
+        if on_update is not None:
+            on_update(res)
+    return res
 
 
 def validate_sc(phi, resolution, taus=(1.0,), max_steps=30000, log=print):
@@ -363,22 +575,54 @@ def main(argv=None):
                    help="Zick-Homsy simple-cubic check at this solid fraction instead")
     p.add_argument("--taus", type=float, nargs="+", default=[1.0])
     p.add_argument("--json", default=None)
+    p.add_argument("--backend", choices=("numba", "cuda"), default="numba",
+                   help="numba on the CPU cores (default) or CUDA through CuPy")
+    p.add_argument("--packing", default=None, metavar="NPZ",
+                   help="run this packing (written by --export-packing) instead of generating")
+    p.add_argument("--export-packing", default=None, metavar="NPZ",
+                   help="write the packing of --phi/--n/--seed to NPZ and stop")
+    p.add_argument("--time-budget", type=float, default=None, metavar="S",
+                   help="start no new Reynolds number after S seconds")
+    p.add_argument("--check-cuda", type=int, default=0, metavar="STEPS",
+                   help="first compare the CUDA and numba kernels over STEPS steps")
     a = p.parse_args(argv)
+
+    def write(res):
+        if a.json:
+            out = {"threads": int(os.environ.get("NUMBA_NUM_THREADS", 0)) or None,
+                   "result": res}
+            with open(a.json, "w") as fh:
+                json.dump(out, fh, indent=1)
+
+    if a.export_packing:
+        c, r, side = packing_box(a.phi, a.n, a.seed)
+        np.savez(a.export_packing, centers=c, radii=r, side=side, phi=a.phi, n=a.n, seed=a.seed)
+        print(f"wrote {a.export_packing}: {a.n} spheres, phi {a.phi}, seed {a.seed}, L {side:.4f}")
+        return 0
+    packing = None
+    if a.packing:
+        c, r, side, a.phi, a.n, a.seed = load_packing(a.packing)
+        packing = (c, r, side)
     if a.validate_sc is not None:
         res = validate_sc(a.validate_sc, a.resolution, taus=a.taus, max_steps=a.max_steps)
     else:
+        if a.check_cuda and njit.__module__ != __name__:
+            c, r, side = packing if packing else packing_box(a.phi, a.n, a.seed)
+            check_cuda_against_numba(voxelise(c, r, side, int(round(side * 16))),
+                                     steps=a.check_cuda)
         res = packing_curve(a.phi, a.n, a.seed, a.resolution, a.reynolds, u_max=a.u_max,
-                            tau_stokes=a.tau_stokes, max_steps=a.max_steps)
-        print(f"Stokes k/d^2 = {res['k_stokes_d2']:.6f} (van der Hoef et al. 2005 law: "
-              f"{res['k_beetstra_d2']:.6f}, ratio {res['k_stokes_d2'] / res['k_beetstra_d2']:.3f})")
-        print(f"{'Re':>8} {'LBM':>8} {'Beetstra':>9} {'HKL':>8} {'LBM/B-1 %':>10}")
-        for r in res["rows"]:
-            print(f"{r['re']:8.3f} {r['k_ratio']:8.4f} {r['beetstra']:9.4f} "
-                  f"{r['hill_koch_ladd']:8.4f} {100 * (r['k_ratio'] / r['beetstra'] - 1):+10.2f}")
-    res = {"threads": int(os.environ.get("NUMBA_NUM_THREADS", 0)) or None, "result": res}
-    if a.json:
-        with open(a.json, "w") as fh:
-            json.dump(res, fh, indent=1)
+                            tau_stokes=a.tau_stokes, max_steps=a.max_steps, backend=a.backend,
+                            packing=packing, time_budget=a.time_budget, on_update=write)
+        if res["k_beetstra_d2"]:
+            print(f"Stokes k/d^2 = {res['k_stokes_d2']:.6f} (van der Hoef et al. 2005 law: "
+                  f"{res['k_beetstra_d2']:.6f}, "
+                  f"ratio {res['k_stokes_d2'] / res['k_beetstra_d2']:.3f})")
+            print(f"{'Re':>8} {'LBM':>8} {'Beetstra':>9} {'HKL':>8} {'LBM/B-1 %':>10}")
+            for r in res["rows"]:
+                print(f"{r['re']:8.3f} {r['k_ratio']:8.4f} {r['beetstra']:9.4f} "
+                      f"{r['hill_koch_ladd']:8.4f} "
+                      f"{100 * (r['k_ratio'] / r['beetstra'] - 1):+10.2f}")
+    write(res)
     return 0
 
 
