@@ -509,23 +509,28 @@ def packing_curve(phi, n, seed, resolution, reynolds, *, u_max=0.02, tau_stokes=
                 raise ValueError(f"first run must be Stokes (Re <= 0.1), got {re_got:.3g}")
             k_stokes = k_app
             res["k_stokes_d2"] = k_stokes / d_lu**2
+        ok = bool(np.isfinite(re_got))
         row = {"re_target": re, "re": re_got, "tau": tau, "nu": nu, "g": gx, "U_lu": u,
                "k_app_lu2": k_app, "k_ratio": k_stokes / k_app,
-               "beetstra": float(laws[1]("beetstra", phi, re_got)) if laws else None,
-               "hill_koch_ladd": float(laws[1]("hill_koch_ladd", phi, re_got)) if laws else None,
+               "beetstra": float(laws[1]("beetstra", phi, re_got)) if laws and ok else None,
+               "hill_koch_ladd": (float(laws[1]("hill_koch_ladd", phi, re_got))
+                                  if laws and ok else None),
                "steps": r["steps"], "converged": r["converged"],
                "last_rel_change": r["last_rel_change"], "spread_last5": r["spread_last5"],
                "seconds": r["seconds"],
                "mlups": r["mlups"], "history_every_1000": r["history"]}
         rows.append(row)
         laws_txt = (f"Beetstra {row['beetstra']:.4f}  HKL {row['hill_koch_ladd']:.4f}  "
-                    if laws else "")
+                    if laws and ok else "")
         log(f"Re {re_got:8.4f}  tau {tau:.4f}  U {u:.3e}  k/k_app {row['k_ratio']:.4f}  "
             f"{laws_txt}steps {r['steps']} ({'converged' if r['converged'] else 'step cap'}, "
             f"last change {r['last_rel_change']:.1e}, spread {r['spread_last5']:.1e})  "
             f"{r['seconds']:.0f} s, {r['mlups']:.1f} MLUPS")
         if on_update is not None:
             on_update(res)
+        if not np.isfinite(u):
+            log(f"# Re {re}: the lattice went unstable (tau {tau:.4f}); higher Re not run")
+            break
     return res
 
 
@@ -619,6 +624,8 @@ def main(argv=None):
                   f"ratio {res['k_stokes_d2'] / res['k_beetstra_d2']:.3f})")
             print(f"{'Re':>8} {'LBM':>8} {'Beetstra':>9} {'HKL':>8} {'LBM/B-1 %':>10}")
             for r in res["rows"]:
+                if r["beetstra"] is None:
+                    continue
                 print(f"{r['re']:8.3f} {r['k_ratio']:8.4f} {r['beetstra']:9.4f} "
                       f"{r['hill_koch_ladd']:8.4f} "
                       f"{100 * (r['k_ratio'] / r['beetstra'] - 1):+10.2f}")
