@@ -27,7 +27,7 @@ from pathlib import Path
 
 from ._air import MU_AIR_PA_S, RHO_AIR_KG_M3, check_positive
 from .packing import UNITS, default_packing_path, read_container, read_packing, scale_warning
-from .flow import INERTIAL_LAWS
+from .flow import DEFAULT_INERTIAL_LAW, INERTIAL_LAWS
 
 __all__ = ["EXIT_OK", "EXIT_FAILED", "EXIT_BAD_INPUT", "CliError", "CliParser", "bad_input",
            "computing", "run", "add_packing", "add_sample", "add_air", "check_outputs",
@@ -198,9 +198,11 @@ def add_air(ap, *, density: bool = True) -> None:
     if density:
         ap.add_argument("--density", type=float, default=RHO_AIR_KG_M3,
                         help="air density for the inertial losses, kg/m^3, > 0")
-        ap.add_argument("--inertial-law", default="pore", choices=tuple(INERTIAL_LAWS),
-                        help="per-conduit inertial loss: pore = the law from a resolved 3-D "
-                             "pore body (default), onset = laminar-jet expansion with X/(1+X) "
+        ap.add_argument("--inertial-law", default=DEFAULT_INERTIAL_LAW,
+                        choices=tuple(INERTIAL_LAWS),
+                        help="per-conduit inertial loss: chain = the law from a resolved 3-D "
+                             "pore body in a chain (default), pore = the same body alone "
+                             "(session 7's default), onset = laminar-jet expansion with X/(1+X) "
                              "onset (before session 7), quadratic = flat-profile K q|q| from the "
                              "start (docs/inertial-flow.md)")
 

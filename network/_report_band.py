@@ -24,7 +24,7 @@ from pathlib import Path
 
 import numpy as np
 
-from .flow import solve_network
+from .flow import DEFAULT_INERTIAL_LAW, solve_network
 from .packing import Packing, random_packing
 
 __all__ = ["BAND_OFFSETS", "fit_log_slope", "band_gradients", "slope_at", "pack_band",
@@ -108,7 +108,7 @@ def slope_at(velocity_m_s, velocities_m_s, slopes) -> float:
 
 def pack_band(packing: Packing, porosity: float, *, velocities_m_s, axis: str = "z",
               seeds=(1, 2), viscosity_pa_s: float, density_kg_m3: float,
-              inertial_law: str = "pore", db=None) -> dict:
+              inertial_law: str = DEFAULT_INERTIAL_LAW, db=None) -> dict:
     """Pack and solve the band's beds; the fitted slope at each velocity (see the module).
 
     The packings have ``packing``'s grain count, its (volume-equivalent) diameter range and its

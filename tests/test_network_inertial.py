@@ -54,11 +54,11 @@ def test_stokes_limit_mass_balance_and_iterations(scene):
         fixed[inl] = True
         fixed[pt.pressure_pa == 0] = True
         assert np.max(np.abs(net[~fixed])) <= 1e-10 * Q
-    # resistance grows with Re; the default law ('pore' since session 7): k/k_app recorded at
-    # the commit that made it the default (onset law before: 1.09 and 1.91)
+    # resistance grows with Re; the default law ('chain' since session 8): k/k_app recorded at
+    # the commit that made it the default ('pore' before: 1.1277 and 2.4000; onset: 1.09, 1.91)
     ratio = [scene.permeability_m2 / r["apparent_permeability_m2"] for r in rows]
     assert ratio[0] == pytest.approx(1.0, abs=1e-6) and 1.0 < ratio[2] < ratio[3]
-    np.testing.assert_allclose(ratio[2:], [1.1277, 2.4000], rtol=2e-3)
+    np.testing.assert_allclose(ratio[2:], [1.1474, 2.7733], rtol=2e-3)
 
 
 def test_parallel_chains_give_the_serial_curve():
@@ -74,8 +74,11 @@ def test_parallel_chains_give_the_serial_curve():
     p2 = [p.dp_pa for p in two.inertial["points"]]
     assert p2 == pytest.approx(p1, rel=1e-9)
     assert all(p.converged and p.residual <= 1e-10 for p in two.inertial["points"])
-    # the chains really are interleaved: the second velocity starts its own chain cold
-    assert two.inertial["points"][1].iterations > one.inertial["points"][1].iterations
+    # the chains really are interleaved: the second velocity starts its own chain from the
+    # Stokes pressures, not from the first velocity's flows, so its Newton path differs (one
+    # chain is deterministic: the same counts every run)
+    a, b = one.inertial["points"][1], two.inertial["points"][1]
+    assert (b.iterations, b.cg_iterations) != (a.iterations, a.cg_iterations)
     with pytest.raises(ValueError, match="workers"):
         solve_inertial(3, [[0, 1], [1, 2]], [1.0, 1.0], np.zeros(2), [0], [2], [1.0],
                        workers=0)

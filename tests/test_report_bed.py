@@ -146,7 +146,10 @@ def test_ctrl_c_while_packing(tmp_path):
     cmd = [sys.executable, "-m", "network.report"] + SMALL[:-1] + [
         "--porosity", "0.40", "--seed", "2", "--bed-dir", "beds"]
     proc = subprocess.Popen(cmd, cwd=tmp_path, env=env, stdout=subprocess.DEVNULL,
-                            stderr=subprocess.PIPE, text=True, start_new_session=True)
+                            stderr=subprocess.PIPE, text=True, start_new_session=True,
+                            # Ctrl-C acts even when pytest runs as a background job (a
+                            # non-interactive shell starts those with SIGINT ignored)
+                            preexec_fn=lambda: signal.signal(signal.SIGINT, signal.SIG_DFL))
     seen = []
     for line in proc.stderr:
         seen.append(line)

@@ -428,6 +428,17 @@ def packing_box(phi, n, seed):
     return c, np.asarray(pk.radii, float), side
 
 
+def array_box(kind, phi):
+    """(centers, radii, side) of one cubic cell of a simple-cubic or FCC array of unit spheres
+    at solid fraction ``phi``; flow along a cube axis (x), as ``lattice_inertial_case``."""
+    per_cell = {"sc": 1, "fcc": 4}[kind]
+    side = (per_cell * math.pi / (6.0 * phi)) ** (1.0 / 3.0)
+    base = {"sc": [[0.5, 0.5, 0.5]],
+            "fcc": [[0.25, 0.25, 0.25], [0.25, 0.75, 0.75], [0.75, 0.25, 0.75],
+                    [0.75, 0.75, 0.25]]}[kind]
+    return np.array(base) * side, np.full(per_cell, 0.5), side
+
+
 def plan(re, d_lu, *, u_max=0.02, tau_stokes=1.0, tau_min=0.51):
     """(tau, target superficial U) for a run at particle Reynolds number ``re``: the Stokes
     tau while U = Re nu/d <= u_max, else U = u_max and nu = U d/Re (tau >= tau_min)."""
@@ -588,6 +599,8 @@ def main(argv=None):
                    help="write the packing of --phi/--n/--seed to NPZ and stop")
     p.add_argument("--time-budget", type=float, default=None, metavar="S",
                    help="start no new Reynolds number after S seconds")
+    p.add_argument("--array", choices=("sc", "fcc"), default=None,
+                   help="a simple-cubic or FCC array's unit cell at --phi instead of a packing")
     p.add_argument("--check-cuda", type=int, default=0, metavar="STEPS",
                    help="first compare the CUDA and numba kernels over STEPS steps")
     a = p.parse_args(argv)
@@ -605,6 +618,9 @@ def main(argv=None):
         print(f"wrote {a.export_packing}: {a.n} spheres, phi {a.phi}, seed {a.seed}, L {side:.4f}")
         return 0
     packing = None
+    if a.array:
+        packing = array_box(a.array, a.phi)
+        a.n, a.seed = len(packing[1]), 0
     if a.packing:
         c, r, side, a.phi, a.n, a.seed = load_packing(a.packing)
         packing = (c, r, side)

@@ -6,7 +6,7 @@ solid_fraction=0.60)``, as the scaling part makes it; the sample is the default 
 tessellation, conductances, the Stokes solve and the Newton curve each timed, with Newton
 iterations per velocity and the 1-minute load average. :func:`inertial_validation` runs the
 drag-law cases of :mod:`network.validation` (Finney's packing and periodic random packings)
-for the conduit laws of :data:`INERTIAL_LAWS` (quadratic, onset, derived, pore),
+for the conduit laws of :data:`INERTIAL_LAWS` (quadratic, onset, derived, pore, chain),
 and :func:`inertial_lines` prints both. Measurements: ``docs/inertial-flow.md``.
 """
 
@@ -20,7 +20,7 @@ import numpy as np
 from .._cli import available_cores
 from ..packing import random_packing
 from ..pores import default_region
-from ..flow import INERTIAL_LAWS as FLOW_LAWS
+from ..flow import DEFAULT_INERTIAL_LAW, INERTIAL_LAWS as FLOW_LAWS
 from ..validation import (DERIVED_LAW, finney_inertial_case, random_inertial_case,
                           solve_sample_curve)
 
@@ -42,10 +42,10 @@ def _cpu_s() -> float:
 
 
 def inertial_speed(n_spheres: int = 20_000, *, seed: int = 1, n_points: int = 12,
-                   policy: str = "table-only", db=None, law: str = "pore",
+                   policy: str = "table-only", db=None, law: str = DEFAULT_INERTIAL_LAW,
                    workers: int | None = None) -> dict:
     """Stage times (s) of a ``n_points`` curve 0.005-0.3 m/s on the benchmark packing, with
-    the conduit ``law`` of :data:`INERTIAL_LAWS` (default 'pore', ``network.solve``'s), its
+    the conduit ``law`` of :data:`INERTIAL_LAWS` (default 'chain', ``network.solve``'s), its
     Newton solves in ``workers`` continuation chains (default: the usable cores); the
     process CPU time of the whole curve beside the wall times."""
     if workers is None:
@@ -77,9 +77,9 @@ def inertial_speed(n_spheres: int = 20_000, *, seed: int = 1, n_points: int = 12
 #: (``docs/inertial-flow.md``): 'quadratic' flat-profile K q|q|; 'onset' laminar profile +
 #: X_c = 1 (``network.solve``'s default until session 7); 'derived' the single-constriction
 #: Navier-Stokes law; 'pore' the same form with the 3-D pore body's onset slope and recovery
-#: (``network.solve``'s default).
+#: (``network.solve``'s default in session 7); 'chain' that body's in a chain (the default).
 INERTIAL_LAWS = {"quadratic": FLOW_LAWS["quadratic"], "onset": FLOW_LAWS["onset"],
-                 "derived": DERIVED_LAW, "pore": FLOW_LAWS["pore"]}
+                 "derived": DERIVED_LAW, "pore": FLOW_LAWS["pore"], "chain": FLOW_LAWS["chain"]}
 
 
 def inertial_validation(*, reynolds=INERTIAL_REYNOLDS, solid_fractions=(0.55, 0.60, 0.64),
@@ -101,7 +101,7 @@ def inertial_lines(speed: dict | None, rows: list[dict]) -> list[str]:
     """The printed table of part 4."""
     out = []
     if speed:
-        out.append(f"inertial curve ({speed.get('law', 'pore')} law), {speed['n_spheres']} "
+        out.append(f"inertial curve ({speed.get('law', DEFAULT_INERTIAL_LAW)} law), {speed['n_spheres']} "
                    f"spheres: tessellate {speed['tessellate_s']:.2f} s, conductance "
                    f"{speed['conductance_s']:.2f} s, "
                    f"Stokes solve {speed['stokes_s']:.2f} s, Newton {speed['inertial_s']:.2f} s: "

@@ -6,7 +6,8 @@ thesis model (:func:`thesis_conductance`); both give a :class:`ConductanceResult
 
 from ._conduit import SECTION_MODES, conduit_conductance
 from ._sections import section_estimate, side_resistance
-from ._inertial import (ONSET_SLOPE, PORE_ONSET_SLOPE, PORE_RECOVERY, conduit_law,
+from ._inertial import (CHAIN_ONSET_SLOPE, CHAIN_RECOVERY, ONSET_SLOPE, PORE_ONSET_SLOPE,
+                        PORE_RECOVERY, conduit_law,
                         contraction_coefficient, expansion_coefficient,
                         inertial_coefficients, onset_scales, turning_cosines)
 from ._models import MODELS, check_model, throat_conductance
@@ -15,7 +16,7 @@ from ._result import ConductanceResult
 from ._table import default_table, has_grid, table_totals
 from ._thesis import thesis_conductance
 
-__all__ = ["MODELS", "ONSET_SLOPE", "PORE_ONSET_SLOPE", "PORE_RECOVERY", "POLICIES",
+__all__ = ["CHAIN_ONSET_SLOPE", "CHAIN_RECOVERY", "MODELS", "ONSET_SLOPE", "PORE_ONSET_SLOPE", "PORE_RECOVERY", "POLICIES",
            "SECTION_MODES", "ConductanceResult", "QstarResult", "check_model", "check_policy",
            "conduit_conductance", "conduit_law",
            "contraction_coefficient", "default_table", "expansion_coefficient", "has_grid",

@@ -24,9 +24,10 @@ The law derived from single-constriction Navier-Stokes (``network.validation.DER
 uses ``contraction='smooth'`` (no vena contracta at a sphere-rounded window), the expansion
 against the downstream body's outflow direction (``cos_theta`` from :func:`turning_cosines`)
 and the window-Reynolds onset of :func:`onset_scales`; ``network.solve``'s default law
-'pore' (``PORE_LAW``) takes the onset slope and the cross-momentum recovery of a resolved 3-D
-pore body instead (:data:`PORE_ONSET_SLOPE`, :data:`PORE_RECOVERY`); :func:`conduit_law`
-assembles either. No coefficient is fitted to bed-scale data. Derivations, the Navier-Stokes
+'chain' (``CHAIN_LAW``) takes the onset slope and the cross-momentum recovery of a resolved 3-D
+pore body in a chain (:data:`CHAIN_ONSET_SLOPE`, :data:`CHAIN_RECOVERY`), 'pore' those of the
+same body alone (:data:`PORE_ONSET_SLOPE`, :data:`PORE_RECOVERY`); :func:`conduit_law`
+assembles any of them. No coefficient is fitted to bed-scale data. Derivations, the Navier-Stokes
 table and the validation against the LBM drag laws: ``docs/inertial-flow.md``.
 """
 
@@ -38,7 +39,8 @@ import throats
 
 from .._air import MU_AIR_PA_S, RHO_AIR_KG_M3, check_density, check_viscosity
 
-__all__ = ["ONSET_SLOPE", "PORE_ONSET_SLOPE", "PORE_RECOVERY", "PROFILES", "conduit_law",
+__all__ = ["CHAIN_ONSET_SLOPE", "CHAIN_RECOVERY", "ONSET_SLOPE", "PORE_ONSET_SLOPE",
+           "PORE_RECOVERY", "PROFILES", "conduit_law",
            "contraction_coefficient", "expansion_coefficient",
            "inertial_coefficients", "onset_scales", "turning_cosines"]
 
@@ -55,6 +57,17 @@ ONSET_SLOPE = 0.0235
 #: 0.0863, and f = 0.488 recovers the peak in the turning balance. Not fitted to bed data.
 PORE_ONSET_SLOPE = 0.0863
 PORE_RECOVERY = 0.488
+
+#: The same pore body in a chain (``network.solve``'s default law 'chain'): the loss a body
+#: causes is its own excess dissipation k_body plus the kinetic energy its jets carry out
+#: through the three outlet windows beyond what they carry at Re_w 5 (k_out - k_out(5); a
+#: do-nothing outlet does not charge it, the next body of a bed dissipates it). From the same
+#: h 0.08 run: k_chain(Re_w) = k_body + k_out - k_out(5) rises to k_peak = 0.765 at Re_w 200,
+#: Re_c = 21.19 from Re_w 5 and 10, c_1 = 0.765/(21.19 * 0.4536) = 0.0796, and f = 0.254
+#: recovers k_peak in the turning balance. Not fitted to bed data (``docs/inertial-flow.md``,
+#: "The chained pore").
+CHAIN_ONSET_SLOPE = 0.0796
+CHAIN_RECOVERY = 0.254
 
 
 def contraction_coefficient(sigma):

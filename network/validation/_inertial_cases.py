@@ -40,7 +40,7 @@ from ..packing import Packing, lattice_packing, periodic_copies, random_packing,
 from ..pores import Region, merge_pores, prune_disconnected, select_sample, tessellate
 from ._drag_laws import DRAG_LAWS, drag_ratio
 
-__all__ = ["DERIVED_LAW", "FINNEY_PATH", "PORE_LAW", "InertialCase", "finney_inertial_case",
+__all__ = ["CHAIN_LAW", "DERIVED_LAW", "FINNEY_PATH", "PORE_LAW", "InertialCase", "finney_inertial_case",
            "lattice_inertial_case", "random_inertial_case", "solve_sample_curve"]
 
 #: Conduit law from single-constriction Navier-Stokes + the turning momentum balance
@@ -51,8 +51,13 @@ DERIVED_LAW = {"profile": "uniform", "contraction": "smooth", "turning": True,
 #: The same form with the onset slope and the cross-momentum recovery of a resolved 3-D pore
 #: body (regular tetrahedral pore, steady Navier-Stokes; ``docs/inertial-flow.md``, "A law
 #: from the 3-D pore") instead of the axisymmetric constriction's slope and no recovery:
-#: ``network.solve``'s default law 'pore'.
+#: ``network.solve``'s default law in session 7.
 PORE_LAW = dict(INERTIAL_LAWS["pore"])
+
+#: The same form with the slope and recovery of that pore body in a chain (the kinetic energy
+#: its jets carry out is the next body's loss; ``docs/inertial-flow.md``, "The chained pore"):
+#: ``network.solve``'s default law 'chain'.
+CHAIN_LAW = dict(INERTIAL_LAWS["chain"])
 
 #: Finney's packing, central subset (radius 1, lengths in sphere radii).
 FINNEY_PATH = Path("/work/shared/data/finney/finney_subset_4021.csv")
