@@ -21,7 +21,8 @@ from network.conductance import (CHAIN_ONSET_SLOPE, CHAIN_RECOVERY, PORE_ONSET_S
 from network.flow import INERTIAL_LAWS
 from network.packing import random_packing
 from network.pores import tessellate
-from network.validation import CHAIN_LAW, DERIVED_LAW, PORE_LAW, random_inertial_case
+from network.validation import (CHAIN_LAW, DERIVED_LAW, PORE_LAW, lattice_inertial_case,
+                                random_inertial_case)
 
 PORE_RE = np.array([1, 5, 10, 20, 50, 100, 200], dtype=float)
 PORE_K_BODY = np.array([0.07815, 0.18844, 0.31764, 0.49007, 0.56636, 0.46750, 0.32431])
@@ -92,6 +93,20 @@ def test_chain_law_follows_the_lbm_of_the_n800_packing():
     # the single pore ('pore', session 7's default) is 13 % low at Re_p 50
     old = random_inertial_case(0.60, LBM800_RE[3:], n_spheres=800, rng=1, **PORE_LAW)
     assert old.k_ratio[0] / LBM800_RATIO[3] - 1 == pytest.approx(-0.131, abs=0.005)
+
+
+#: LBM k/k_app of the FCC array, phi 0.60, flow along a cube axis (D 56, GPU, session 8)
+FCC_RE = np.array([5.0148, 10.2163, 21.2117, 57.7158])
+FCC_RATIO = np.array([1.0195, 1.0654, 1.1834, 1.4826])
+
+
+def test_chain_law_follows_the_lbm_of_the_fcc_array():
+    case = lattice_inertial_case("fcc", 0.60, FCC_RE, **CHAIN_LAW)
+    assert case.converged
+    np.testing.assert_allclose(case.k_ratio, [1.01339, 1.04608, 1.13189, 1.41840], rtol=2e-4)
+    err = case.k_ratio / FCC_RATIO - 1
+    assert np.all(np.abs(err[:2]) < 0.02)         # 2 % to Re_p 10 (-0.6, -1.8 %)
+    assert np.all(np.abs(err[2:]) < 0.05)         # 5 % to Re_p 58 (-4.3, -4.3 %)
 
 
 def test_pore_law_follows_the_lbm_of_the_same_packing():

@@ -101,7 +101,8 @@ def inertial_lines(speed: dict | None, rows: list[dict]) -> list[str]:
     """The printed table of part 4."""
     out = []
     if speed:
-        out.append(f"inertial curve ({speed.get('law', DEFAULT_INERTIAL_LAW)} law), {speed['n_spheres']} "
+        law = speed.get("law", DEFAULT_INERTIAL_LAW)
+        out.append(f"inertial curve ({law} law), {speed['n_spheres']} "
                    f"spheres: tessellate {speed['tessellate_s']:.2f} s, conductance "
                    f"{speed['conductance_s']:.2f} s, "
                    f"Stokes solve {speed['stokes_s']:.2f} s, Newton {speed['inertial_s']:.2f} s: "

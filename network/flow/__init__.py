@@ -20,7 +20,8 @@ from ._result import FlowResult, combined_summary
 from ._vtk import read_vtu_arrays, write_network_vtu
 
 __all__ = ["AMGSolver", "ASABE_SOYBEAN_A", "ASABE_SOYBEAN_B", "CORE_MARGIN_DIAMETERS",
-           "CORE_MIN_DIAMETERS", "DEFAULT_DEPTH_M", "DEFAULT_INERTIAL_LAW", "DEFAULT_VELOCITY_M_S", "FlowResult",
+           "CORE_MIN_DIAMETERS", "DEFAULT_DEPTH_M", "DEFAULT_INERTIAL_LAW",
+           "DEFAULT_VELOCITY_M_S", "FlowResult",
            "GRAINS", "INERTIAL_LAWS", "InertialPoint", "SolveInfo", "apply_pressure_bc",
            "asabe_d272_gradient", "assemble_laplacian", "boundary_flows", "combined_summary",
            "conduit_flow", "core_permeability", "darcy_permeability", "ergun_gradient",

@@ -309,13 +309,12 @@ def _beside_qhull(packing, reg, ax, porosity_points, db):
 #: (``docs/inertial-flow.md``). 'pore': smooth contraction, flat-profile expansion against the
 #: body's Stokes outflow direction with the 3-D pore's recovery and window-Re onset slope;
 #: 'chain' (the default, :data:`DEFAULT_INERTIAL_LAW`): the same with the chained pore's.
+_PORE_FORM = {"profile": "uniform", "contraction": "smooth", "turning": True, "onset": "throat"}
 INERTIAL_LAWS = {"onset": {"profile": "laminar", "crossover": 1.0},
                  "quadratic": {"profile": "uniform"},
-                 "pore": {"profile": "uniform", "contraction": "smooth", "turning": True,
-                          "recovery": PORE_RECOVERY, "onset": "throat",
+                 "pore": {**_PORE_FORM, "recovery": PORE_RECOVERY,
                           "onset_slope": PORE_ONSET_SLOPE},
-                 "chain": {"profile": "uniform", "contraction": "smooth", "turning": True,
-                           "recovery": CHAIN_RECOVERY, "onset": "throat",
+                 "chain": {**_PORE_FORM, "recovery": CHAIN_RECOVERY,
                            "onset_slope": CHAIN_ONSET_SLOPE}}
 DEFAULT_INERTIAL_LAW = "chain"
 
