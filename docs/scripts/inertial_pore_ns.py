@@ -30,10 +30,10 @@ import gmsh
 import numpy as np
 import throats
 from skfem import (Basis, BilinearForm, ElementTetP1, ElementTetP2, ElementVector, FacetBasis,
-                   Functional, LinearForm, MeshTet, asm, bmat, condense, solve)
+                   Functional, LinearForm, MeshTet, asm, bmat)
 from skfem.helpers import ddot, div, dot, grad
 
-from _ns_newton import newton      # this folder's Newton loop, shared by both scripts
+from _ns_newton import linear_solve, newton     # this folder's Newton loop and solver
 
 
 def regular(L=2.0):
@@ -157,7 +157,7 @@ def pore(reynolds, *, h=0.1, V=None, r=0.9, e=0.5):
         comp = np.zeros(nu, bool)
         comp[bu.dofs.nodal_dofs[k]] = comp[bu.dofs.edge_dofs[k]] = True
         x[np.setdiff1d(d_in[comp[d_in]], d_wall)] = n_in[k]
-    U = solve(*condense(stokes, np.zeros_like(x), x=x, D=D))
+    U = linear_solve(stokes, np.zeros_like(x), x=x, D=D)
     in_body = m.p[2, m.t].mean(axis=0) > 0
 
     def split(U):
