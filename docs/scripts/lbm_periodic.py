@@ -190,6 +190,74 @@ def omegas(tau):
     return omp, omm
 
 
+# --------------------------------------------------------------------------- lattice ------
+class Lattice:
+    """Fluid nodes of one voxelised periodic box, the gather index and two population arrays."""
+
+    def __init__(self, solid):
+        self.shape = solid.shape
+        self.n_nodes = int(solid.size)
+        self.index, self.nf = gather_index(solid)
+        self.f = np.empty(19 * self.nf)
+        self.g = np.empty(19 * self.nf)
+        self.ux = np.zeros(self.nf)
+        _equilibrium(self.f, self.nf, self.ux)
+
+    def start_from(self, ux):
+        self.ux = np.asarray(ux, float).copy()
+        _equilibrium(self.f, self.nf, self.ux)
+
+    def steps(self, count, omp, omm, gx):
+        """``count`` steps; returns the sum over them of sum_nodes u_x."""
+        acc = 0.0
+        for _ in range(count):
+            acc += _step(self.f, self.g, self.index, self.nf, omp, omm, gx)
+            self.f, self.g = self.g, self.f
+        return acc
+
+    def velocity_x(self, gx):
+        """u_x per fluid node of the current state."""
+        _velocity_x(self.f, self.index, self.nf, gx, self.ux)
+        return self.ux
+
+    def _sync(self):
+        pass
+
+    def run(self, tau, gx, *, tol=1e-6, check=1000, max_steps=30000):
+        """Steps to steady state. Returns dict(U superficial, steps, converged, seconds)."""
+        omp, omm = omegas(tau)
+        self._sync()
+        t0 = time.perf_counter()
+        u_prev = None
+        steps = 0
+        converged = False
+        history = []
+        while steps < max_steps:
+            acc = self.steps(check, omp, omm, gx)
+            steps += check
+            u = acc / check / self.n_nodes       # superficial velocity, mean over the window
+            history.append(u)
+            if not np.isfinite(u):
+                break
+            if u_prev is not None and abs(u - u_prev) < tol * abs(u):
+                converged = True
+                break
+            u_prev = u
+        self.ux = self.velocity_x(gx)
+        if converged:
+            u_sup = float(self.ux.sum()) / self.n_nodes
+            spread = 0.0
+        else:   # step cap: mean of the last 5 window means, their range as the spread
+            tail = np.array(history[-5:])
+            u_sup = float(tail.mean())
+            spread = float((tail.max() - tail.min()) / abs(u_sup))
+        rel = abs(history[-1] - history[-2]) / abs(history[-1]) if len(history) > 1 else np.nan
+        return {"U": u_sup, "steps": steps, "converged": converged,
+                "last_rel_change": float(rel), "spread_last5": spread,
+                "seconds": time.perf_counter() - t0,
+                "mlups": self.nf * steps / (time.perf_counter() - t0) / 1e6,
+                "history": [float(h) for h in history]}
+
 
 # --------------------------------------------------------------------------- CUDA backend ---
 _CUDA_SRC = r"""
@@ -254,10 +322,10 @@ extern "C" __global__ void lbm_step(const double* __restrict__ fin, double* __re
 """
 
 
-class CudaLattice:
+class CudaLattice(Lattice):
     """The :class:`Lattice` on an NVIDIA GPU through CuPy: the same pull stream + TRT/Guo
-    collide, one thread per fluid node (``_CUDA_SRC``), the populations in device memory.
-    Same interface (``start_from``, ``run``, ``ux`` as a device array)."""
+    collide, one thread per fluid node (``_CUDA_SRC``), the populations in device memory;
+    :meth:`Lattice.run` drives it (``ux`` is a device array)."""
 
     BLOCK = 256
 
@@ -305,39 +373,8 @@ class CudaLattice:
             jx += CX[i] * v
         return (jx + 0.5 * rho * gx) / rho
 
-    def run(self, tau, gx, *, tol=1e-6, check=1000, max_steps=30000):
-        """As :meth:`Lattice.run`."""
-        omp, omm = omegas(tau)
+    def _sync(self):
         self.cp.cuda.Device().synchronize()
-        t0 = time.perf_counter()
-        u_prev = None
-        steps = 0
-        converged = False
-        history = []
-        while steps < max_steps:
-            acc = self.steps(check, omp, omm, gx)
-            steps += check
-            u = acc / check / self.n_nodes
-            history.append(u)
-            if not np.isfinite(u):
-                break
-            if u_prev is not None and abs(u - u_prev) < tol * abs(u):
-                converged = True
-                break
-            u_prev = u
-        self.ux = self.velocity_x(gx)
-        if converged:
-            u_sup = float(self.ux.sum()) / self.n_nodes
-            spread = 0.0
-        else:
-            tail = np.array(history[-5:])
-            u_sup = float(tail.mean())
-            spread = float((tail.max() - tail.min()) / abs(u_sup))
-        rel = abs(history[-1] - history[-2]) / abs(history[-1]) if len(history) > 1 else np.nan
-        sec = time.perf_counter() - t0
-        return {"U": u_sup, "steps": steps, "converged": converged,
-                "last_rel_change": float(rel), "spread_last5": spread, "seconds": sec,
-                "mlups": self.nf * steps / sec / 1e6, "history": [float(h) for h in history]}
 
 
 def check_cuda_against_numba(solid, steps=200, tau=0.6, gx=2e-5, log=print):
@@ -350,69 +387,12 @@ def check_cuda_against_numba(solid, steps=200, tau=0.6, gx=2e-5, log=print):
     cpu.start_from(ux0)
     gpu.start_from(ux0)
     omp, omm = omegas(tau)
-    s_cpu = 0.0
-    for _ in range(steps):
-        s_cpu += _step(cpu.f, cpu.g, cpu.index, cpu.nf, omp, omm, gx)
-        cpu.f, cpu.g = cpu.g, cpu.f
+    s_cpu = cpu.steps(steps, omp, omm, gx)
     s_gpu = gpu.steps(steps, omp, omm, gx)
     diff = float(np.abs(gpu.f.get() - cpu.f).max())
     log(f"# CUDA vs numba after {steps} steps ({cpu.nf} fluid nodes): max |df| {diff:.2e}, "
         f"sum u_x {s_gpu:.12e} vs {s_cpu:.12e}")
     return diff, s_gpu, s_cpu
-
-
-class Lattice:
-    """Fluid nodes of one voxelised periodic box, the gather index and two population arrays."""
-
-    def __init__(self, solid):
-        self.shape = solid.shape
-        self.n_nodes = int(solid.size)
-        self.index, self.nf = gather_index(solid)
-        self.f = np.empty(19 * self.nf)
-        self.g = np.empty(19 * self.nf)
-        self.ux = np.zeros(self.nf)
-        _equilibrium(self.f, self.nf, self.ux)
-
-    def start_from(self, ux):
-        self.ux = np.asarray(ux, float).copy()
-        _equilibrium(self.f, self.nf, self.ux)
-
-    def run(self, tau, gx, *, tol=1e-6, check=1000, max_steps=30000):
-        """Steps to steady state. Returns dict(U superficial, steps, converged, seconds)."""
-        omp, omm = omegas(tau)
-        t0 = time.perf_counter()
-        u_prev = None
-        steps = 0
-        converged = False
-        history = []
-        while steps < max_steps:
-            acc = 0.0
-            for _ in range(check):
-                acc += _step(self.f, self.g, self.index, self.nf, omp, omm, gx)
-                self.f, self.g = self.g, self.f
-            steps += check
-            u = acc / check / self.n_nodes       # superficial velocity, mean over the window
-            history.append(u)
-            if not np.isfinite(u):
-                break
-            if u_prev is not None and abs(u - u_prev) < tol * abs(u):
-                converged = True
-                break
-            u_prev = u
-        _velocity_x(self.f, self.index, self.nf, gx, self.ux)
-        if converged:
-            u_sup = float(self.ux.sum() / self.n_nodes)
-            spread = 0.0
-        else:   # step cap: mean of the last 5 window means, their range as the spread
-            tail = np.array(history[-5:])
-            u_sup = float(tail.mean())
-            spread = float((tail.max() - tail.min()) / abs(u_sup))
-        rel = abs(history[-1] - history[-2]) / abs(history[-1]) if len(history) > 1 else np.nan
-        return {"U": u_sup, "steps": steps, "converged": converged,
-                "last_rel_change": float(rel), "spread_last5": spread,
-                "seconds": time.perf_counter() - t0,
-                "mlups": self.nf * steps / (time.perf_counter() - t0) / 1e6,
-                "history": [float(h) for h in history]}
 
 
 # --------------------------------------------------------------------------- drivers --------
