@@ -3,13 +3,15 @@ default: the same body in a chain; issue 14; docs/inertial-flow.md).
 
 Pore table: steady 3-D Navier-Stokes through a regular tetrahedral pore (spheres r 0.9 at the
 vertices of a tetrahedron of edge 2; ``docs/scripts/inertial_pore_ns.py``): the body's excess
-loss coefficient k_body at window Reynolds numbers 1-200, session 7's run at mesh h 0.08 (the
-finest made; h 0.10 and 0.15 in docs/inertial-flow.md). LBM reference:
+loss coefficient k_body at window Reynolds numbers 1-200, session 7's run at mesh h 0.08 for
+'pore', and k_body with the outflow's kinetic energy k_out at h 0.045 (the finest run, session
+8) for 'chain' (the mesh series: docs/inertial-flow.md). LBM reference:
 ``docs/scripts/lbm_periodic.py`` on the periodic packing phi 0.60, n 30, seed 1 at 28 lattice
 units per diameter (docs/inertial-lbm.md), an independent resolved computation of the very
 packing the network is built on; and the same script on a GPU for the n = 800 validation
-packings themselves (docs/data/lbm_n800_reference.json), which did not exist when the chained
-law's constants were taken from the pore table: an out-of-sample check.
+packings themselves and an FCC array (docs/data/lbm_n800_reference.json,
+lbm_arrays_reference.json), which did not exist when the chained law's recipe was written
+(docs/inertial-flow.md, "Order of work").
 """
 
 import numpy as np
