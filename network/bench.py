@@ -109,11 +109,16 @@ def main(argv=None) -> int:
                          "command on the --sizes bench packings (default 5000 20000 here) and "
                          "the bundled scene, --stokes and default, --repeats runs each (default "
                          "7 here) after a warm-up, against issue 18's targets and YADE's 0.84 s")
+    ap.add_argument("--yade", action="store_true",
+                    help="with --per-packing: also time YADE's FlowEngine on the same packings "
+                         "here (needs the yade program; docs/scripts/yade_flowengine.py)")
     ap.add_argument("--one", default=None, help=argparse.SUPPRESS)
     ap.add_argument("--no-trace", action="store_true", help=argparse.SUPPRESS)
     args = ap.parse_args(argv)
     if args.inertial_workers is not None and args.inertial_workers < 1:
         ap.error(f"--inertial-workers must be >= 1, got {args.inertial_workers}")
+    if args.yade and not args.per_packing:
+        ap.error("--yade goes with --per-packing")
     if args.references_only and args.skip_references:
         ap.error("--references-only and --skip-references exclude each other")
     if args.ref_repeats < 1 or args.ref_spheres < 1:
@@ -159,7 +164,7 @@ def main(argv=None) -> int:
         print(f"per packing: python -m network.solve FILE, wall time ({args.repeats} runs "
               "after a warm-up):", flush=True)
         report["per_packing"] = per_packing(args.sizes, workdir, args.seed,
-                                            repeats=args.repeats)
+                                            repeats=args.repeats, yade=args.yade)
         report["machine_end"] = machine()
         with open(args.json_out, "w") as f:
             json.dump(report, f, indent=2, default=str)

@@ -95,3 +95,30 @@ def test_per_packing_rows(run):
         assert 0 < r["min_s"] <= r["median_s"] <= r["max_s"] < 60
         assert r["target_s"] is None and r["yade_s"] is None    # no target for these sizes
     assert rows[0]["packing"] == str(packing_file(SIZES[0], tmp, 1))
+
+
+def test_per_packing_yade_where_installed(run, monkeypatch):
+    """``--per-packing --yade`` times YADE's FlowEngine on the same packing where the ``yade``
+    program is installed (FlowEngine's solve and the whole command, positive, the engine inside
+    the command); without it the row says so; ``--yade`` alone is bad input."""
+    import shutil
+
+    from network.benchmarks import _per_packing
+
+    tmp, _ = run
+    path = packing_file(SIZES[0], tmp, 1)
+    here = _per_packing.yade_times(path, 1)
+    if shutil.which("yade") is None:
+        assert here is None
+    else:
+        assert len(here["flowengine_s"]) == len(here["command_s"]) == 1
+        assert 0 < here["flowengine_median_s"] < here["command_median_s"] < 120
+    monkeypatch.setattr(_per_packing.shutil, "which", lambda name: None)
+    assert _per_packing.yade_times(path, 1) is None
+    rows = _per_packing.per_packing([SIZES[0]], tmp, 1, repeats=1, bundled=False, yade=True)
+    assert rows[0]["mode"] == "stokes" and rows[0]["yade_here"] is None
+    assert "YADE here: not installed" in _per_packing.per_packing_line(rows[0])
+    assert "yade_here" not in rows[1]                       # the default-mode row
+    with pytest.raises(SystemExit) as e:
+        bench.main(["--yade"])
+    assert e.value.code == 2

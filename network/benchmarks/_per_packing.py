@@ -8,12 +8,18 @@ target) and the default command (with inertia). The child's environment drops
 ``PYTHONDONTWRITEBYTECODE`` so that Python caches bytecode as it does by default.
 
 YADE's FlowEngine on the 5 000-sphere packing (its own triangulation and Cholesky solve):
-0.84 s, the figure quoted in issue 18; the targets are 0.8 s (5 000) and 2 s (20 000).
+0.84 s, the figure quoted in issue 18; the targets are 0.8 s (5 000) and 2 s (20 000). With
+``yade=True`` (``network.bench --per-packing --yade``) YADE itself runs on the same packings
+on this machine (``docs/scripts/yade_flowengine.py`` through ``yade -n -x``; Debian's ``yade``
+package): its first ``emulateAction`` (FlowEngine's triangulation, factorisation and solve,
+without YADE's start-up) and its whole command, beside the ``--stokes`` row.
 """
 
 from __future__ import annotations
 
 import os
+import re
+import shutil
 import statistics
 import subprocess
 import sys
@@ -29,10 +35,39 @@ YADE_S = {5000: 0.84}
 MODES = {"stokes": ["--stokes"], "default": []}
 
 
+#: YADE's FlowEngine script (a research script beside the docs; present in a source checkout).
+YADE_SCRIPT = Path(__file__).resolve().parents[2] / "docs" / "scripts" / "yade_flowengine.py"
+_YADE_FIRST = re.compile(r"first emulateAction ([0-9.]+) s")
+
+
+def yade_times(path: Path, repeats: int) -> dict | None:
+    """YADE on ``path``, ``repeats`` runs: FlowEngine's first solve and the whole command (s),
+    or None where ``yade`` or the script is missing."""
+    exe = shutil.which("yade")
+    if exe is None or not YADE_SCRIPT.is_file():
+        return None
+    engine, whole = [], []
+    for _ in range(repeats):
+        t0 = time.perf_counter()
+        out = subprocess.run([exe, "-n", "-x", str(YADE_SCRIPT), str(path)],
+                             capture_output=True, text=True, check=False)
+        dt = time.perf_counter() - t0
+        m = _YADE_FIRST.search(out.stdout + out.stderr)
+        if out.returncode != 0 or m is None:
+            raise RuntimeError(f"yade on {path} exited {out.returncode}: "
+                               f"{(out.stdout + out.stderr).strip()[-200:]}")
+        engine.append(float(m.group(1)))
+        whole.append(dt)
+    return {"flowengine_s": engine, "command_s": whole,
+            "flowengine_median_s": statistics.median(engine),
+            "command_median_s": statistics.median(whole)}
+
+
 def per_packing(sizes, workdir: Path, seed: int, repeats: int = 7,
-                bundled: bool = True) -> list[dict]:
+                bundled: bool = True, yade: bool = False) -> list[dict]:
     """Wall times of ``python -m network.solve`` on the bench packings of ``sizes`` (and the
-    bundled scene): one row per packing and mode with min, median and max over ``repeats``."""
+    bundled scene): one row per packing and mode with min, median and max over ``repeats``;
+    with ``yade`` the ``--stokes`` rows of the bench packings carry :func:`yade_times` too."""
     env = dict(os.environ)
     env.pop("PYTHONDONTWRITEBYTECODE", None)
     cases = [(n, packing_file(n, workdir, seed)) for n in sizes]
@@ -60,6 +95,8 @@ def per_packing(sizes, workdir: Path, seed: int, repeats: int = 7,
                    "loadavg_after": os.getloadavg()[0]}
             if row["target_s"] is not None:
                 row["met"] = row["median_s"] <= row["target_s"]
+            if yade and mode == "stokes" and n is not None:
+                row["yade_here"] = yade_times(path, max(1, min(repeats, 3)))
             rows.append(row)
             print("  " + per_packing_line(row), flush=True)
     return rows
@@ -73,6 +110,12 @@ def per_packing_line(row: dict) -> str:
         tail = f"; target {row['target_s']:.1f} s: {'met' if row['met'] else 'MISSED'}"
         if row.get("yade_s"):
             tail += f" (YADE {row['yade_s']:.2f} s)"
+    here = row.get("yade_here")
+    if here:
+        tail += (f"; YADE here: FlowEngine {here['flowengine_median_s']:.2f} s, whole command "
+                 f"{here['command_median_s']:.2f} s (median of {len(here['command_s'])})")
+    elif "yade_here" in row:
+        tail += "; YADE here: not installed"
     return (f"{name:>16s} {row['mode']:>8s}: median {row['median_s']:.3f} s, min "
             f"{row['min_s']:.3f}, max {row['max_s']:.3f} over {row['runs']} runs (load "
             f"{row['loadavg_after']:.2f}){tail}")
