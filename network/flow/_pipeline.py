@@ -45,6 +45,22 @@ DEFAULT_VELOCITY_M_S = 0.013
 DEFAULT_DEPTH_M = 0.25
 
 
+#: Per-conduit inertial laws: options of :func:`network.conductance.conduit_law`
+#: (``docs/inertial-flow.md``). 'pore': smooth contraction, flat-profile expansion against the
+#: body's Stokes outflow direction with the 3-D pore's recovery and window-Re onset slope;
+#: 'chain' (the default, :data:`DEFAULT_INERTIAL_LAW`): the same with the chained pore's.
+#: :data:`DERIVED_LAW` is that form with the single-constriction slope and no recovery
+#: (``network.validation`` and the bench compare it; not a CLI choice).
+DERIVED_LAW = {"profile": "uniform", "contraction": "smooth", "turning": True, "onset": "throat"}
+INERTIAL_LAWS = {"onset": {"profile": "laminar", "crossover": 1.0},
+                 "quadratic": {"profile": "uniform"},
+                 "pore": {**DERIVED_LAW, "recovery": PORE_RECOVERY,
+                          "onset_slope": PORE_ONSET_SLOPE},
+                 "chain": {**DERIVED_LAW, "recovery": CHAIN_RECOVERY,
+                           "onset_slope": CHAIN_ONSET_SLOPE}}
+DEFAULT_INERTIAL_LAW = "chain"
+
+
 def solve_network(packing: Packing, *, axis="z", region: Region | None = None,
                   margin: float | None = None, cylinder: bool = False,
                   conductance_model: str = "conduit", policy: str = "table-only",
@@ -58,7 +74,7 @@ def solve_network(packing: Packing, *, axis="z", region: Region | None = None,
                   qstar_fn: Callable | None = None, model_options: dict | None = None,
                   core_margin_m: float | None = None, inertia: bool = False,
                   density_kg_m3: float = RHO_AIR_KG_M3,
-                  curve_velocities_m_s=None, inertial_law: str = "chain",
+                  curve_velocities_m_s=None, inertial_law: str = DEFAULT_INERTIAL_LAW,
                   inertial_workers: int = 1, threads: int = 1) -> FlowResult:
     """Permeability and pressure drop of a packing by the Delaunay network model.
 
@@ -303,20 +319,6 @@ def _beside_qhull(packing, reg, ax, porosity_points, db):
     import pyamg  # noqa: F401 - imported here, beside Qhull, instead of in the solve stage
     return region_porosity(packing, reg, ax, n_points=porosity_points) if porosity_points \
         else None
-
-
-#: Per-conduit inertial laws: options of :func:`network.conductance.conduit_law`
-#: (``docs/inertial-flow.md``). 'pore': smooth contraction, flat-profile expansion against the
-#: body's Stokes outflow direction with the 3-D pore's recovery and window-Re onset slope;
-#: 'chain' (the default, :data:`DEFAULT_INERTIAL_LAW`): the same with the chained pore's.
-_PORE_FORM = {"profile": "uniform", "contraction": "smooth", "turning": True, "onset": "throat"}
-INERTIAL_LAWS = {"onset": {"profile": "laminar", "crossover": 1.0},
-                 "quadratic": {"profile": "uniform"},
-                 "pore": {**_PORE_FORM, "recovery": PORE_RECOVERY,
-                          "onset_slope": PORE_ONSET_SLOPE},
-                 "chain": {**_PORE_FORM, "recovery": CHAIN_RECOVERY,
-                           "onset_slope": CHAIN_ONSET_SLOPE}}
-DEFAULT_INERTIAL_LAW = "chain"
 
 
 #: Core margin of :func:`_core_estimate`, in mean sphere diameters.

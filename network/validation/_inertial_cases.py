@@ -34,19 +34,21 @@ import numpy as np
 from scipy.spatial import cKDTree
 
 from ..conductance import ONSET_SLOPE, conduit_law, throat_conductance
+from ..flow import DERIVED_LAW as FLOW_DERIVED_LAW
 from ..flow import (INERTIAL_LAWS, AMGSolver, darcy_permeability, solve_fixed_pressure,
                     solve_inertial)
 from ..packing import Packing, lattice_packing, periodic_copies, random_packing, read_packing
 from ..pores import Region, merge_pores, prune_disconnected, select_sample, tessellate
 from ._drag_laws import DRAG_LAWS, drag_ratio
 
-__all__ = ["CHAIN_LAW", "DERIVED_LAW", "FINNEY_PATH", "PORE_LAW", "InertialCase", "finney_inertial_case",
-           "lattice_inertial_case", "random_inertial_case", "solve_sample_curve"]
+__all__ = ["CHAIN_LAW", "DERIVED_LAW", "FINNEY_PATH", "PORE_LAW", "InertialCase",
+           "finney_inertial_case", "lattice_inertial_case", "random_inertial_case",
+           "solve_sample_curve"]
 
 #: Conduit law from single-constriction Navier-Stokes + the turning momentum balance
-#: (``docs/inertial-flow.md``): keyword options of :func:`solve_sample_curve` and the cases.
-DERIVED_LAW = {"profile": "uniform", "contraction": "smooth", "turning": True,
-               "onset": "throat"}
+#: (``docs/inertial-flow.md``): keyword options of :func:`solve_sample_curve` and the cases;
+#: the form of the CLI's 'pore' and 'chain' laws (:data:`network.flow.DERIVED_LAW`).
+DERIVED_LAW = dict(FLOW_DERIVED_LAW)
 
 #: The same form with the onset slope and the cross-momentum recovery of a resolved 3-D pore
 #: body (regular tetrahedral pore, steady Navier-Stokes; ``docs/inertial-flow.md``, "A law
