@@ -20,7 +20,8 @@ split (inlet normal against the flow-weighted outflow normal) and that split.
 
 Not part of the package (network never imports scikit-fem or gmsh): run by hand,
 ``python docs/scripts/inertial_pore_ns.py 0.1`` (h; about 4 min on one core at h 0.1), or
-``... 0.05 '[[x,y,z], ...]' 0.5`` for another tetrahedron (prism length stays 0.5).
+``... 0.05 '[[x,y,z], ...]' 0.5`` for another tetrahedron (prism length stays 0.5);
+``--across 5`` grades the mesh to 5 elements across the gaps between spheres (:func:`build`).
 """
 
 import json
@@ -51,9 +52,13 @@ def inward_normal(V, face):
     return n if n @ (other - a) > 0 else -n
 
 
-def build(V, r, e=0.5, h=0.1):
+def build(V, r, e=0.5, h=0.1, across=None):
     """Tetrahedron V (4, 3) (shared edges) + a prism of length e extruded outward from face
-    (0, 1, 2), minus the spheres of radii r at the vertices: MeshTet."""
+    (0, 1, 2), minus the spheres of radii r at the vertices: MeshTet. ``across``: graded
+    mesh, element size min(h, w/across) with w the local width between the two nearest
+    sphere surfaces (sum of the distances to them), so that the narrow gaps between spheres
+    (L - r_a - r_b, 0.2 in the regular pore) get ``across`` elements (never below h/10);
+    None: h everywhere."""
     r = np.broadcast_to(np.asarray(r, float), (4,))
     gmsh.initialize()
     gmsh.option.setNumber("General.Verbosity", 0)
@@ -81,6 +86,15 @@ def build(V, r, e=0.5, h=0.1):
     occ.synchronize()
     gmsh.option.setNumber("Mesh.CharacteristicLengthMax", h)
     gmsh.option.setNumber("Mesh.CharacteristicLengthMin", h / 2)
+    if across is not None:
+        centres, radii = np.asarray(V, float), r
+
+        def size(dim, tag, x, y, z, lc):
+            s = np.sort(np.linalg.norm(centres - (x, y, z), axis=1) - radii)
+            return float(min(lc, h, max((s[0] + s[1]) / across, h / 10)))
+
+        gmsh.model.mesh.setSizeCallback(size)
+        gmsh.option.setNumber("Mesh.CharacteristicLengthMin", 0.0)
     gmsh.option.setNumber("Mesh.MeshSizeFromCurvature", 12)
     gmsh.model.mesh.generate(3)
     tags, xyz, _ = gmsh.model.mesh.getNodes()
@@ -124,13 +138,13 @@ def dissipation(w):
     return ddot(grad(w["u"]), grad(w["u"]))
 
 
-def pore(reynolds, *, h=0.1, V=None, r=0.9, e=0.5):
+def pore(reynolds, *, h=0.1, V=None, r=0.9, e=0.5, across=None):
     """Rows (dict) per window Reynolds number, as in the module docstring; the first row
     (Re_w 0) gives the conduit-model sigma of the inlet window, the turning cosine of the
     Stokes outflow split and the open window area."""
     V = regular() if V is None else np.asarray(V, float)
     r = np.broadcast_to(np.asarray(r, float), (4,))
-    m = build(V, r, e, h)
+    m = build(V, r, e, h, across)
     bu = Basis(m, ElementVector(ElementTetP2()), intorder=4)
     bp = Basis(m, ElementTetP1(), intorder=4)
     A, B = asm(viscous, bu), asm(divergence, bu, bp)
@@ -209,14 +223,18 @@ def pore(reynolds, *, h=0.1, V=None, r=0.9, e=0.5):
                           rtol=1e-8, maxiter=30)
         k = (split(U) - stokes_d) / (0.5 * rho * u_w**2 * Q)
         k_out = ke_excess(U) / (0.5 * u_w**2 * Q)
-        rows.append({"h": h, "n_tets": int(m.t.shape[1]), "Re_w": re, "newton": steps,
+        rows.append({"h": h, "across": across, "n_tets": int(m.t.shape[1]), "Re_w": re,
+                     "newton": steps,
                      "k_pore": float(k[0]), "k_body": float(k[1]), "k_prism": float(k[2]),
                      "k_out": float(k_out)})
     return rows
 
 
 if __name__ == "__main__":
-    for row in pore([1, 5, 10, 20, 50, 100, 200], h=float(sys.argv[1]) if sys.argv[1:] else 0.1,
-                    V=json.loads(sys.argv[2]) if sys.argv[2:] else None,
-                    r=float(sys.argv[3]) if sys.argv[3:] else 0.9):
+    args = sys.argv[1:]
+    across = float(args.pop(args.index("--across") + 1)) if "--across" in args else None
+    args = [a for a in args if a != "--across"]
+    for row in pore([1, 5, 10, 20, 50, 100, 200], h=float(args[0]) if args else 0.1,
+                    V=json.loads(args[1]) if args[1:] else None,
+                    r=float(args[2]) if args[2:] else 0.9, across=across):
         print(json.dumps(row), flush=True)
