@@ -152,9 +152,11 @@ def pore(reynolds, *, h=0.1, V=None, r=0.9, e=0.5, across=None):
     stokes = bmat([[A, B.T], [B, None]], "csr")
     bf = m.boundary_facets()
     fc = m.p[:, m.facets[:, bf]].mean(axis=1)
-    on_sphere = np.zeros(bf.size, bool)
-    for v, rk in zip(V, r):
-        on_sphere |= np.abs(np.linalg.norm(fc.T - v, axis=1) - rk) < 0.05 * h + 0.02
+    corners = m.p[:, m.facets[:, bf]]                          # (3, 3 corners, facets)
+    on_sphere = np.zeros(bf.size, bool)        # all three corners on one sphere (gmsh puts
+    for v, rk in zip(V, r):                    # them there): a facet of the sphere surface
+        on_sphere |= np.all(np.abs(np.linalg.norm(corners - v[:, None, None], axis=0) - rk)
+                            < 1e-6, axis=0)
     n_in = inward_normal(V, (0, 1, 2))
     inlet = np.abs((fc.T - V[0]) @ n_in + e) < 1e-6
     out_faces = ((0, 1, 3), (1, 2, 3), (0, 2, 3))
@@ -163,6 +165,11 @@ def pore(reynolds, *, h=0.1, V=None, r=0.9, e=0.5, across=None):
         n = inward_normal(V, f)
         outlets.append((np.abs((fc.T - V[f[0]]) @ n) < 1e-6) & ~on_sphere)
     outlet = np.any(outlets, axis=0)
+
+    def facet_area(mask):
+        a, b, c = (corners[:, k, mask] for k in range(3))
+        return float(0.5 * np.linalg.norm(np.cross((b - a).T, (c - a).T), axis=1).sum())
+
     walls = bf[~(inlet | outlet)]
     d_wall, d_in = bu.get_dofs(walls).all(), bu.get_dofs(bf[inlet]).all()
     D = np.unique(np.concatenate([d_wall, d_in]))
@@ -215,7 +222,8 @@ def pore(reynolds, *, h=0.1, V=None, r=0.9, e=0.5, across=None):
     M = sum(qg * inward_normal(V, f) * -1 for qg, f in zip(q_out, out_faces)) / q_out.sum()
     u_w, d_w = Q / a_w, 2 * np.sqrt(a_w / np.pi)
     rows = [{"Re_w": 0, "sigma": a_w / a_b, "cos_theta": float(n_in @ M), "A_w": a_w,
-             "outflow_split": (q_out / q_out.sum()).round(4).tolist()}]
+             "outflow_split": (q_out / q_out.sum()).round(4).tolist(),
+             "A_out_mesh": [round(facet_area(mk), 5) for mk in outlets]}]
     for re in reynolds:
         rho = re / (u_w * d_w)                                 # mu = 1
         U, steps = newton(U, rho, A=A, B=B, stokes=stokes, basis_u=bu, nu=nu, D=D,
