@@ -1,14 +1,17 @@
 """Tables of ``docs/inertial-lbm.md``: LBM runs (JSON of ``lbm_periodic.py``) beside the laws
 and the network model on the same packings.
 
-For each LBM JSON: the packing (phi, n, seed) is rebuilt by ``random_inertial_case`` (copied
-3 x 3 x 3, the middle two periods as the sample) and the network's k/k_app is solved at the
-Reynolds numbers the LBM obtained, with the laws ``onset`` (the CLI's until session 7),
+For each LBM JSON (a run of ``lbm_periodic.py``, or a stored table of rows such as
+``docs/data/lbm_n800_reference.json`` and ``lbm_reference.json``, whose rows carry phi, seed, n
+and re): the packing (phi, n, seed) is rebuilt by ``random_inertial_case`` (copied 3 x 3 x 3, the
+middle two periods as the sample) and the network's k/k_app is solved at the Reynolds numbers the
+LBM obtained, with the package's current constants, with the laws ``onset`` (the CLI's until session 7),
 ``DERIVED_LAW``, ``pore`` (the CLI's in session 7) and ``chain`` (the CLI's since session 8;
 ``--laws`` picks). Printed per row: LBM, Beetstra, HKL, the network laws, and the relative
 differences in % of the pressure gradient. ``--json`` writes the rows.
 
     python docs/scripts/lbm_vs_network.py /tmp/lbm/ens_*.json --json rows.json
+    python docs/scripts/lbm_vs_network.py docs/data/lbm_n800_reference.json --laws pore chain
 """
 
 from __future__ import annotations
@@ -24,26 +27,39 @@ import numpy as np
 LAW_NAMES = ("onset", "derived", "pore", "chain")
 
 
+def _runs(path):
+    """(phi, n, seed, resolution, k_stokes_d2, rows) per packing of an LBM JSON: one run of
+    ``lbm_periodic.py`` ('result'), or a stored table ('rows' with phi, seed, n, re, lbm)."""
+    data = json.load(open(path))
+    if "result" in data:
+        res = data["result"]
+        rows = [{"re": r["re"], "converged": r["converged"], "lbm": r["k_ratio"],
+                 "beetstra": r["beetstra"], "hill_koch_ladd": r["hill_koch_ladd"]}
+                for r in res["rows"] if r["re"] > 0.5 and r["beetstra"] is not None]
+        return [(res["phi"], res["n"], res["seed"], res["resolution"], res["k_stokes_d2"], rows)]
+    groups = {}
+    for r in data["rows"]:
+        if r["re"] > 0.5:
+            groups.setdefault((r["phi"], r["n"], r["seed"]), []).append(r)
+    return [(phi, n, seed, rows[0]["resolution"], rows[0].get("k_lbm_d2"), rows)
+            for (phi, n, seed), rows in groups.items()]
+
+
 def compare(path, laws=LAW_NAMES):
     from network.flow import INERTIAL_LAWS
     from network.validation import DERIVED_LAW, random_inertial_case
 
-    res = json.load(open(path))["result"]
-    rows = [r for r in res["rows"] if r["re"] > 0.5 and r["beetstra"] is not None]
-    re = np.array([r["re"] for r in rows])
     options = dict(INERTIAL_LAWS, derived=DERIVED_LAW)
-    net = {}
-    for name in laws:
-        case = random_inertial_case(res["phi"], re, n_spheres=res["n"], rng=res["seed"],
-                                    **options[name])
-        net[name] = case.k_ratio
     out = []
-    for i, r in enumerate(rows):
-        out.append({"phi": res["phi"], "seed": res["seed"], "resolution": res["resolution"],
-                    "n": res["n"], "re": r["re"], "converged": r["converged"], "lbm": r["k_ratio"],
-                    "beetstra": r["beetstra"], "hill_koch_ladd": r["hill_koch_ladd"],
-                    **{name: float(net[name][i]) for name in laws},
-                    "k_lbm_d2": res["k_stokes_d2"]})
+    for phi, n, seed, resolution, k_d2, rows in _runs(path):
+        re = np.array([r["re"] for r in rows])
+        net = {name: random_inertial_case(phi, re, n_spheres=n, rng=seed,
+                                          **options[name]).k_ratio for name in laws}
+        for i, r in enumerate(rows):
+            out.append({"phi": phi, "seed": seed, "resolution": resolution, "n": n,
+                        "re": r["re"], "converged": r["converged"], "lbm": r["lbm"],
+                        "beetstra": r["beetstra"], "hill_koch_ladd": r["hill_koch_ladd"],
+                        **{name: float(net[name][i]) for name in laws}, "k_lbm_d2": k_d2})
     return out
 
 
