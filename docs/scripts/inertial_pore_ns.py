@@ -151,8 +151,8 @@ def pore(reynolds, *, h=0.1, V=None, r=0.9, e=0.5, across=None):
     nu = bu.N
     stokes = bmat([[A, B.T], [B, None]], "csr")
     bf = m.boundary_facets()
-    fc = m.p[:, m.facets[:, bf]].mean(axis=1)
     corners = m.p[:, m.facets[:, bf]]                          # (3, 3 corners, facets)
+    fc = corners.mean(axis=1)
     on_sphere = np.zeros(bf.size, bool)        # all three corners on one sphere (gmsh puts
     for v, rk in zip(V, r):                    # them there): a facet of the sphere surface
         on_sphere |= np.all(np.abs(np.linalg.norm(corners - v[:, None, None], axis=0) - rk)
