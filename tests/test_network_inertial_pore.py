@@ -28,9 +28,9 @@ from network.validation import (CHAIN_LAW, DERIVED_LAW, PORE_LAW, lattice_inerti
 
 PORE_RE = np.array([1, 5, 10, 20, 50, 100, 200], dtype=float)
 PORE_K_BODY = np.array([0.16268, 0.26898, 0.39773, 0.56481, 0.59493, 0.45438, 0.29099])
-#: The chained law's table: the same body's k_body and k_out, the kinetic energy the outflow
+#: The chained law's table: the same run's k_body and k_out, the kinetic energy the outflow
 #: carries through the three outlet windows over a flat profile (per rho u_w^2 Q/2)
-CHAIN_K_BODY = np.array([0.16268, 0.26898, 0.39773, 0.56481, 0.59493, 0.45438, 0.29099])
+CHAIN_K_BODY = PORE_K_BODY
 CHAIN_K_OUT = np.array([0.22793, 0.20537, 0.20253, 0.24920, 0.43552, 0.64169, 0.81336])
 PORE_SIGMA, PORE_COS, PORE_H_OVER_A = 0.63715, 1.0 / 3.0, 1.0 / np.sqrt(6) / 0.9
 
@@ -39,12 +39,17 @@ LBM_RE = np.array([1.00, 4.88, 9.68, 19.43])
 LBM_RATIO = np.array([1.0027, 1.0483, 1.1247, 1.2916])
 
 
+def _onset_fit(k):
+    """(k_peak, Re_c from the Re_w 5 and 10 rows) of k = k_peak t/sqrt(1+t^2), t = Re_w/Re_c."""
+    peak = k.max()
+    x = k[1:3] / peak
+    return peak, PORE_RE[1:3] / (x / np.sqrt(1 - x * x))
+
+
 def test_pore_constants_come_from_the_pore_table():
     # k = k_peak t/sqrt(1+t^2), t = Re_w/Re_c: Re_c from the Re_w 5 and 10 rows, slope
     # k_peak/Re_c = c_1 h/a
-    peak = PORE_K_BODY.max()
-    x = PORE_K_BODY[1:3] / peak
-    re_c = PORE_RE[1:3] / (x / np.sqrt(1 - x * x))
+    peak, re_c = _onset_fit(PORE_K_BODY)
     np.testing.assert_allclose(re_c, 10.49, rtol=0.07)      # 9.86 and 11.12
     assert re_c.mean() == pytest.approx(10.49, rel=0.001)
     assert peak / (re_c.mean() * PORE_H_OVER_A) == pytest.approx(PORE_ONSET_SLOPE, rel=0.01)
@@ -64,10 +69,8 @@ def test_chain_constants_come_from_the_pore_table():
     # recipe as the pore's constants on k_chain = k_body + k_out - k_out(5)
     chain = CHAIN_K_BODY + CHAIN_K_OUT - CHAIN_K_OUT[1]
     assert np.all(np.diff(chain) > 0)                 # keeps rising: no peak at Re_w 50
-    peak = chain.max()
+    peak, re_c = _onset_fit(chain)
     assert peak == pytest.approx(0.8990, abs=1e-4)
-    x = chain[1:3] / peak
-    re_c = PORE_RE[1:3] / (x / np.sqrt(1 - x * x))
     np.testing.assert_allclose(re_c, [15.95, 20.45], rtol=2e-3)
     assert peak / (re_c.mean() * PORE_H_OVER_A) == pytest.approx(CHAIN_ONSET_SLOPE, rel=0.002)
     cos = PORE_COS + CHAIN_RECOVERY * (1 - PORE_COS)

@@ -137,8 +137,9 @@ def solve_network(packing: Packing, *, axis="z", region: Region | None = None,
         More superficial velocities (m/s, > 0) for the resistance curve.
     inertial_law : {'chain', 'pore', 'onset', 'quadratic'}
         Per-conduit inertial loss (:data:`INERTIAL_LAWS`): 'chain' (default) the law from a
-        resolved 3-D pore body whose jets' kinetic energy the next body dissipates (within 1.9 %
-        of lattice-Boltzmann solutions of the same packings to Re_p 10, 3.5 % to Re_p 50);
+        resolved 3-D pore body whose jets' kinetic energy the next body dissipates (+0.8 to
+        +3.3 % of lattice-Boltzmann solutions of the same packings at Re_p 10, -0.6 to +6.4 %
+        at Re_p 50);
         'pore' the same body alone; 'onset' the expansion with the laminar jet profile and the
         X/(1+X) onset; 'quadratic' the flat-profile loss K q|q| from the start
         (``docs/inertial-flow.md``).
