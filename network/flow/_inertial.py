@@ -26,7 +26,10 @@ aggregation (Galerkin; about 10 V-cycles of work); a new hierarchy is built only
 still needs more than 40 iterations.
 At K = 0 the first step from zero is the Stokes solution. Velocities are solved in ascending
 order from the previous solution, every pore pressure extrapolated by its own power law of the
-last two points; with ``workers`` > 1 the sorted flows are dealt into interleaved chains
+last two points (from three on, a parabola in log p against log Q, held between the viscous
+and fully inertial powers 1 and 2), the whole field then scaled so that the inlet throats carry
+the flow's Q (the extrapolation's largest error: 1-2 % of Q, against 2e-4 in the pore
+balances; 20 000 spheres, one chain: 638 -> 557 CG iterations over 12 flows); with ``workers`` > 1 the sorted flows are dealt into interleaved chains
 solved in parallel processes (20 000 spheres, 12 flows, two chains: 403 and 374 CG
 iterations against 680 for one chain; ``docs/inertial-flow.md``).
 """
@@ -248,6 +251,30 @@ def solve_inertial(n_pores, conns, g, K, inlet, outlet, flows_m3_s, *, tol: floa
         amg = AMGSolver(J.matrix(g)[:nf, :nf], smoother="forward-backward")
     i, j = c[:, 0], c[:, 1]
 
+    # throats with exactly one end in the inlet: the total inlet flow is sum(sgn q) over them
+    edge = np.flatnonzero(is_in[i] != is_in[j])
+    e_sgn = np.where(is_in[i[edge]], 1.0, -1.0)
+    e_K = K[edge]
+    e_c = None if c_on is None else c_on[edge]
+
+    def match_inlet(p, Q):
+        """p scaled by the s that makes the total inlet flow Q (Newton on s over the inlet
+        throats alone; the predicted pressures carry the flow's shape, their level is
+        what an extrapolation misses most)."""
+        d = p[i[edge]] - p[j[edge]]
+        s = 1.0
+        for _ in range(8):
+            q, w = conduit_flow(s * d, g[edge], e_K, crossover=crossover, onset_scale=e_c)
+            f = e_sgn @ q - Q
+            df = e_sgn @ (w * d)
+            if not df > 0:
+                return p
+            step = f / df
+            s = min(max(s - step, 0.5 * s), 2.0 * s)
+            if abs(f) <= 1e-3 * tol * Q:
+                break
+        return s * p
+
     def residual(p, Q, q_start=None):
         q, w = conduit_flow(p[i] - p[j], g, K, crossover=crossover, onset_scale=c_on,
                             q_start=q_start)
@@ -294,16 +321,29 @@ def solve_inertial(n_pores, conns, g, K, inlet, outlet, flows_m3_s, *, tol: floa
             Q = flows[k]
             t0 = time.perf_counter()
             if len(hist) >= 2 and hist[-1][0] != hist[-2][0]:
-                # every pore's pressure follows its own power law of the last two flows
+                # every pore's pressure follows its own power law of the last two flows, or
+                # with three, a log-log parabola through them; kept between p2 (Q/q2)^1 and
+                # p2 (Q/q2)^2 (the viscous and the fully inertial limits)
                 (q1, p1), (q2, p2) = hist[-2], hist[-1]
+                lo, hi = p2 * (Q / q2), p2 * (Q / q2) ** 2
                 with np.errstate(divide="ignore", invalid="ignore"):
                     expo = np.log(p2 / p1) / np.log(q2 / q1)
-                expo = np.where((p1 > 0) & (p2 > 0) & np.isfinite(expo), expo, 1.0)
-                p = p2 * (Q / q2) ** np.clip(expo, 1.0, 2.0)
+                    expo = np.where((p1 > 0) & (p2 > 0) & np.isfinite(expo), expo, 1.0)
+                    p = p2 * (Q / q2) ** np.clip(expo, 1.0, 2.0)
+                    if len(hist) >= 3 and hist[-3][0] != q1:
+                        q0, p0 = hist[-3]
+                        x0, x1, x2, x = np.log([q0, q1, q2, Q])
+                        y = (np.log(p0) * (x - x1) * (x - x2) / ((x0 - x1) * (x0 - x2))
+                             + np.log(p1) * (x - x0) * (x - x2) / ((x1 - x0) * (x1 - x2))
+                             + np.log(p2) * (x - x0) * (x - x1) / ((x2 - x0) * (x2 - x1)))
+                        ok = (p0 > 0) & (p1 > 0) & (p2 > 0) & np.isfinite(y)
+                        p = np.where(ok, np.clip(np.exp(y), lo, hi), p)
             elif hist:
                 p = p * (Q / hist[-1][0])
             elif stokes is not None:
                 p = np.asarray(stokes[0], dtype=float) * (Q / float(stokes[1]))
+            if hist or stokes is not None:
+                p = match_inlet(p, Q)
             r, q, w = residual(p, Q)
             rel = np.abs(r).max() / Q
             it = cg_it = 0
