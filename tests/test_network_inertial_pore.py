@@ -167,3 +167,67 @@ def test_cli_json_names_the_law(tmp_path):
     out = tmp_path / "c.json"
     assert curve.main(["-q", "--velocities", "0.01,0.1", "--json", str(out)]) == 0
     assert json.loads(out.read_text())["inertial_law"] == "chain"
+
+
+def _window_row(rows, r):
+    """(sigma, c_1, f) of the chained law's recipe on one pore's rows (Re_w 0 row first)."""
+    geo = rows[0]
+    by = {row["Re_w"]: row for row in rows[1:]}
+    k_body = np.array([by[re]["k_body"] for re in PORE_RE])
+    k_out = np.array([by[re]["k_out"] for re in PORE_RE])
+    peak, re_c = _onset_fit(k_body + k_out - k_out[1])
+    c1 = peak / (re_c.mean() * np.sqrt(2.0 / 3.0) / 2.0 / r)     # h/a = (L sqrt(2/3)/4)/r, L 2
+    cos = (1 + geo["sigma"] ** 2 - peak) / (2 * geo["sigma"])    # the turning balance = peak
+    return geo["sigma"], c1, (cos - geo["cos_theta"]) / (1 - geo["cos_theta"])
+
+
+def test_window_table_comes_from_the_pore_rows():
+    # every row of CHAIN_WINDOW_TABLE is the chained recipe on the stored Navier-Stokes rows of
+    # one pore radius (the finest mesh run of each), and r 0.90's row is the 'chain' constants
+    import json
+    from pathlib import Path
+
+    from network.conductance import CHAIN_WINDOW_TABLE, window_constants
+
+    data = json.loads((Path(__file__).parents[1] / "docs" / "data"
+                       / "pore_ns_series.json").read_text())
+    runs = {0.90: data["corrected"]["h0.10_n8"]}
+    runs |= {float(k[1:]): v for k, v in data["radii"].items()}
+    runs |= {float(k[1:]): v for k, v in data["radii_across6"].items()}
+    rows = sorted((_window_row(v, r) for r, v in runs.items()), key=lambda x: x[0])
+    sigma, c1, f = (np.array(x) for x in zip(*rows))
+    np.testing.assert_allclose(CHAIN_WINDOW_TABLE["sigma"], sigma, atol=1e-4)
+    np.testing.assert_allclose(CHAIN_WINDOW_TABLE["onset_slope"], c1, atol=1e-4)
+    np.testing.assert_allclose(CHAIN_WINDOW_TABLE["recovery"], f, atol=1e-3)
+    assert window_constants(PORE_SIGMA)[0] == pytest.approx(CHAIN_ONSET_SLOPE, abs=1e-4)
+    assert window_constants(PORE_SIGMA)[1] == pytest.approx(CHAIN_RECOVERY, abs=1e-3)
+    # linear between rows, the end rows held outside
+    mid = 0.5 * (sigma[0] + sigma[1])
+    assert window_constants(mid)[1] == pytest.approx(0.5 * (f[0] + f[1]), abs=1e-3)
+    np.testing.assert_allclose(window_constants([0.1, 0.99])[1], [f[0], f[-1]], atol=1e-3)
+
+
+def test_window_law_with_one_row_is_the_chain_law(monkeypatch):
+    # a table whose every row holds the 'chain' constants gives the 'chain' law exactly: the
+    # per-conduit path changes nothing but where the constants come from
+    from network.conductance import _inertial as inertial
+
+    pk = random_packing(60, rng=2, periodic=False, solid_fraction=0.50)
+    tess = tessellate(pk)
+    idx = np.flatnonzero(np.all(np.asarray(tess.throat_pores) >= 0, axis=1))
+    rng = np.random.default_rng(3)
+    h = rng.uniform(0.2, 0.5, (idx.size, 2)) * 1e-3
+    conns = np.asarray(tess.throat_pores)[idx]
+    xyz = rng.normal(size=(conns.max() + 1, 3))
+    q = rng.normal(size=idx.size)
+    common = dict(pore_xyz_m=xyz, conns=conns, stokes_flow_m3_s=q, axis=0)
+    flat = {"sigma": (0.3, 0.9), "onset_slope": (CHAIN_ONSET_SLOPE,) * 2,
+            "recovery": (CHAIN_RECOVERY,) * 2}
+    monkeypatch.setattr(inertial, "CHAIN_WINDOW_TABLE", flat)
+    K1, c1, _ = conduit_law(tess, idx, h, **common, **{**CHAIN_LAW, "recovery": "window",
+                                                       "onset_slope": "window"})
+    K0, c0, _ = conduit_law(tess, idx, h, **common, **CHAIN_LAW)
+    np.testing.assert_allclose(K1, K0, rtol=1e-13)
+    np.testing.assert_allclose(c1, c0, rtol=1e-13)
+    with pytest.raises(ValueError, match="recovery must be a number or 'window'"):
+        conduit_law(tess, idx, h, **common, **{**CHAIN_LAW, "recovery": "sigma"})

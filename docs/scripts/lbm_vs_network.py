@@ -24,7 +24,7 @@ import numpy as np
 
 
 #: Network laws of the table: flow's CLI laws beside the single-constriction DERIVED_LAW.
-LAW_NAMES = ("onset", "derived", "pore", "chain")
+LAW_NAMES = ("onset", "derived", "pore", "chain", "window")
 
 
 def _runs(path):

@@ -39,10 +39,10 @@ import throats
 
 from .._air import MU_AIR_PA_S, RHO_AIR_KG_M3, check_density, check_viscosity
 
-__all__ = ["CHAIN_ONSET_SLOPE", "CHAIN_RECOVERY", "ONSET_SLOPE", "PORE_ONSET_SLOPE",
-           "PORE_RECOVERY", "PROFILES", "conduit_law",
+__all__ = ["CHAIN_ONSET_SLOPE", "CHAIN_RECOVERY", "CHAIN_WINDOW_TABLE", "ONSET_SLOPE",
+           "PORE_ONSET_SLOPE", "PORE_RECOVERY", "PROFILES", "conduit_law",
            "contraction_coefficient", "expansion_coefficient",
-           "inertial_coefficients", "onset_scales", "turning_cosines"]
+           "inertial_coefficients", "onset_scales", "turning_cosines", "window_constants"]
 
 #: Low-Re slope of a single sphere-ring constriction's excess loss coefficient,
 #: :math:`dk/dRe_w = c_1 h/a`: axisymmetric Navier-Stokes of six constrictions
@@ -70,6 +70,17 @@ PORE_RECOVERY = 0.455
 #: session 8's 0.0941 and 0.184 came from the partly closed outlets). Not fitted to bed data.
 CHAIN_ONSET_SLOPE = 0.1089
 CHAIN_RECOVERY = 0.097
+
+#: The chained body's two constants as functions of the window ratio: the same regular
+#: tetrahedron (edge 2) with sphere radii 0.95 / 0.90 / 0.85 / 0.80 / 0.75 / 0.70 (window
+#: ratio sigma below), the same recipe on each pore's own sigma and h/a = 0.408/r, the finest
+#: mesh run of each (h 0.10 with 8 / 6 / 4 elements across the gaps between spheres:
+#: ``docs/data/pore_ns_series.json``; ``docs/inertial-flow.md``, "A window-ratio law").
+#: :func:`window_constants` interpolates it linearly in sigma and holds the end values outside.
+#: Not fitted to bed data.
+CHAIN_WINDOW_TABLE = {"sigma": (0.5457, 0.6371, 0.6952, 0.7352, 0.7642, 0.7861),
+                      "onset_slope": (0.0949, 0.1089, 0.1149, 0.1158, 0.1111, 0.1060),
+                      "recovery": (-0.052, 0.097, 0.143, 0.174, 0.211, 0.246)}
 
 
 def contraction_coefficient(sigma):
@@ -210,9 +221,9 @@ def _onset(window, h_m, K, *, density_kg_m3, viscosity_pa_s, slope):
     """:func:`onset_scales` from ``_window_and_ratios``'s (A_w, sigma, a)."""
     rho = check_density(density_kg_m3)
     mu = check_viscosity(viscosity_pa_s)
-    c1 = float(slope)
-    if not (np.isfinite(c1) and c1 > 0):
-        raise ValueError(f"slope must be a finite number > 0, got {slope!r}")
+    c1 = np.asarray(slope, dtype=float)
+    if np.any(~np.isfinite(c1)) or np.any(c1 <= 0):
+        raise ValueError(f"slope must be finite and > 0, got {slope!r}")
     a_w, _, a = window
     K = np.asarray(K, dtype=float)
     if K.shape != (a_w.size, 2):
@@ -225,6 +236,24 @@ def _onset(window, h_m, K, *, density_kg_m3, viscosity_pa_s, slope):
     return np.where(np.isfinite(c) & (K > 0), c, 0.0)
 
 
+def window_constants(sigma, table=None):
+    r"""Onset slope :math:`c_1` and recovered share f of the chained pore body at window
+    ratios ``sigma`` (any shape): linear in sigma between the rows of ``table`` (default
+    :data:`CHAIN_WINDOW_TABLE`), the end rows' values outside them. Returns ``(c_1, f)``.
+
+    >>> c1, f = window_constants([0.30, 0.6371, 0.95])
+    >>> c1.round(4).tolist(), f.round(3).tolist()
+    ([0.0949, 0.1089, 0.106], [-0.052, 0.097, 0.246])
+    """
+    t = CHAIN_WINDOW_TABLE if table is None else table
+    x = np.asarray(t["sigma"], dtype=float)
+    if x.ndim != 1 or x.size < 1 or np.any(np.diff(x) <= 0):
+        raise ValueError("the table's sigma must increase")
+    s = np.asarray(sigma, dtype=float)
+    return (np.interp(s, x, np.asarray(t["onset_slope"], dtype=float)),
+            np.interp(s, x, np.asarray(t["recovery"], dtype=float)))
+
+
 def turning_cosines(centers_m, throat_vertices, pore_xyz_m, conns, flow_m3_s, axis: int, *,
                     recovery: float = 0.0):
     r"""Cosine between each conduit's jet and the mean outflow of the body it enters, (M, 2).
@@ -235,11 +264,13 @@ def turning_cosines(centers_m, throat_vertices, pore_xyz_m, conns, flow_m3_s, ax
     weighted by ``flow_m3_s``, e.g. the Stokes flows); a body without outflow (outlet)
     takes the flow axis. Column 0: :math:`d\cdot M_{Q_1}` (flow 0 → 1), column 1:
     :math:`-d\cdot M_{Q_0}`. ``recovery`` f (0 <= f <= 1) recovers that part of the cross
-    momentum: :math:`\cos \to \cos + f(1-\cos)` (f = 0: none, the momentum balance above).
+    momentum: :math:`\cos \to \cos + f(1-\cos)` (f = 0: none, the momentum balance above),
+    a number or one per conduit and column ((M, 2)); f < 0 (a body losing more than the
+    balance, :data:`CHAIN_WINDOW_TABLE`'s narrowest window) lowers the cosine, held at -1.
     """
-    f = float(recovery)
-    if not 0.0 <= f <= 1.0:
-        raise ValueError(f"recovery must lie in [0, 1], got {recovery!r}")
+    f = np.asarray(recovery, dtype=float)
+    if np.any(~np.isfinite(f)) or np.any(f > 1.0) or np.any(f < -1.0):
+        raise ValueError(f"recovery must lie in [-1, 1], got {recovery!r}")
     x = np.asarray(centers_m, dtype=float)[np.asarray(throat_vertices, dtype=np.int64)]
     n = np.cross(x[:, 1] - x[:, 0], x[:, 2] - x[:, 0])
     c = np.asarray(conns, dtype=np.int64)
@@ -255,7 +286,7 @@ def turning_cosines(centers_m, throat_vertices, pore_xyz_m, conns, flow_m3_s, ax
         M = np.where(tot[:, None] > 0, M / tot[:, None], np.eye(3)[int(axis)])
     cos = np.clip(np.column_stack([np.einsum("ij,ij->i", n, M[c[:, 1]]),
                                    -np.einsum("ij,ij->i", n, M[c[:, 0]])]), -1.0, 1.0)
-    return cos + f * (1.0 - cos)
+    return np.clip(cos + f * (1.0 - cos), -1.0, 1.0)
 
 
 def conduit_law(tessellation, throats_idx, h_m, *, internal=None, pore_xyz_m=None, conns=None,
@@ -272,10 +303,22 @@ def conduit_law(tessellation, throats_idx, h_m, *, internal=None, pore_xyz_m=Non
     window-Reynolds onset scales of :func:`onset_scales` (slope ``onset_slope``), else None;
     ``crossover`` is passed through (the X/(X_c+X) onset of
     :func:`network.flow.conduit_flow`). The law of a conduit is then
-    :math:`\Delta p = q/g + K q|q|\,\phi`, φ the onset factor.
+    :math:`\Delta p = q/g + K q|q|\,\phi`, φ the onset factor. ``recovery='window'`` and
+    ``onset_slope='window'`` take each from the window ratio sigma of the body the flow
+    expands into (:func:`window_constants`) instead of one number for every conduit.
     """
     if onset not in (None, "throat"):
         raise ValueError(f"onset must be None or 'throat', got {onset!r}")
+    win = _window_and_ratios(tessellation, throats_idx, h_m)       # once for K and the onset
+    by_window = window_constants(win[1][:, ::-1])     # column 0: flow 0 -> 1 expands into 1
+    if isinstance(recovery, str):
+        if recovery != "window":
+            raise ValueError(f"recovery must be a number or 'window', got {recovery!r}")
+        recovery = by_window[1]
+    if isinstance(onset_slope, str):
+        if onset_slope != "window":
+            raise ValueError(f"onset_slope must be a number or 'window', got {onset_slope!r}")
+        onset_slope = by_window[0]
     cos = None
     if turning:
         if stokes_flow_m3_s is None or pore_xyz_m is None or conns is None:
@@ -283,7 +326,6 @@ def conduit_law(tessellation, throats_idx, h_m, *, internal=None, pore_xyz_m=Non
         cos = turning_cosines(tessellation.packing.centers,
                               np.asarray(tessellation.throat_vertices)[throats_idx], pore_xyz_m,
                               conns, stokes_flow_m3_s, axis, recovery=recovery)
-    win = _window_and_ratios(tessellation, throats_idx, h_m)       # once for K and the onset
     K = _coefficients(win, internal=internal, density_kg_m3=density_kg_m3, profile=profile,
                       cos_theta=cos, contraction=contraction)
     c = None if onset is None else _onset(win, h_m, K, density_kg_m3=density_kg_m3,

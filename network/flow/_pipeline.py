@@ -57,7 +57,8 @@ INERTIAL_LAWS = {"onset": {"profile": "laminar", "crossover": 1.0},
                  "pore": {**DERIVED_LAW, "recovery": PORE_RECOVERY,
                           "onset_slope": PORE_ONSET_SLOPE},
                  "chain": {**DERIVED_LAW, "recovery": CHAIN_RECOVERY,
-                           "onset_slope": CHAIN_ONSET_SLOPE}}
+                           "onset_slope": CHAIN_ONSET_SLOPE},
+                 "window": {**DERIVED_LAW, "recovery": "window", "onset_slope": "window"}}
 DEFAULT_INERTIAL_LAW = "chain"
 
 

@@ -1,8 +1,8 @@
 """Validation: reference permeabilities and the cases that run the one pipeline against them."""
 
 from ._drag_laws import DRAG_LAWS, beetstra_drag, drag_ratio, hill_koch_ladd_drag
-from ._inertial_cases import (CHAIN_LAW, DERIVED_LAW, FINNEY_PATH, PORE_LAW, InertialCase,
-                              finney_inertial_case, lattice_inertial_case, random_inertial_case,
+from ._inertial_cases import (CHAIN_LAW, DERIVED_LAW, FINNEY_PATH, PORE_LAW, WINDOW_LAW,
+                              InertialCase, finney_inertial_case, lattice_inertial_case, random_inertial_case,
                               solve_sample_curve)
 from ._cases import ESTIMATORS, lattice_sample_permeability, random_sample_permeability
 from ._periodic import periodic_permeability
@@ -20,4 +20,4 @@ __all__ = ["CHAIN_LAW", "DERIVED_LAW", "DRAG_LAWS", "ESTIMATORS", "FINNEY_PATH",
            "hill_koch_ladd_drag", "kozeny_carman_permeability", "lattice_inertial_case",
            "lattice_permeability", "lattice_sample_permeability", "periodic_permeability",
            "PORE_LAW", "random_inertial_case", "random_sample_permeability",
-           "sangani_acrivos_sc_drag", "solve_sample_curve", "zick_homsy_sc_drag"]
+           "sangani_acrivos_sc_drag", "solve_sample_curve", "WINDOW_LAW", "zick_homsy_sc_drag"]

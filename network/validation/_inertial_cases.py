@@ -41,7 +41,7 @@ from ..packing import Packing, lattice_packing, periodic_copies, random_packing,
 from ..pores import Region, merge_pores, prune_disconnected, select_sample, tessellate
 from ._drag_laws import DRAG_LAWS, drag_ratio
 
-__all__ = ["CHAIN_LAW", "DERIVED_LAW", "FINNEY_PATH", "PORE_LAW", "InertialCase",
+__all__ = ["CHAIN_LAW", "DERIVED_LAW", "FINNEY_PATH", "PORE_LAW", "WINDOW_LAW", "InertialCase",
            "finney_inertial_case", "lattice_inertial_case", "random_inertial_case",
            "solve_sample_curve"]
 
@@ -60,6 +60,10 @@ PORE_LAW = dict(INERTIAL_LAWS["pore"])
 #: its jets carry out is the next body's loss; ``docs/inertial-flow.md``, "The chained pore"):
 #: ``network.solve``'s default law 'chain'.
 CHAIN_LAW = dict(INERTIAL_LAWS["chain"])
+
+#: The chained body's slope and recovery taken per conduit from its own window ratio
+#: (:data:`network.conductance.CHAIN_WINDOW_TABLE`: the chained pore at six window ratios).
+WINDOW_LAW = dict(INERTIAL_LAWS["window"])
 
 #: Finney's packing, central subset (radius 1, lengths in sphere radii).
 FINNEY_PATH = Path("/work/shared/data/finney/finney_subset_4021.csv")
