@@ -29,9 +29,11 @@ order from the previous solution, every pore pressure extrapolated by its own po
 last two points (from three on, a parabola in log p against log Q, held between the viscous
 and fully inertial powers 1 and 2), the whole field then scaled so that the inlet throats carry
 the flow's Q (the extrapolation's largest error: 1-2 % of Q, against 2e-4 in the pore
-balances; 20 000 spheres, one chain: 638 -> 557 CG iterations over 12 flows); with ``workers`` > 1 the sorted flows are dealt into interleaved chains
-solved in parallel processes (20 000 spheres, 12 flows, two chains: 403 and 374 CG
-iterations against 680 for one chain; ``docs/inertial-flow.md``).
+balances; 20 000 spheres, one chain: 638 -> 557 CG iterations over 12 flows). With
+``workers`` > 1 the sorted flows are cut into contiguous chains solved in parallel
+processes, the later chains two flows shorter for their cold start (20 000 spheres, 12 flows,
+two chains of 7 and 5: 307 and 358 CG iterations against 557 for one chain; interleaved
+chains took 357 and 383; ``docs/inertial-flow.md``).
 """
 
 from __future__ import annotations
@@ -204,9 +206,10 @@ def solve_inertial(n_pores, conns, g, K, inlet, outlet, flows_m3_s, *, tol: floa
     onset_scale : (Nt, 2) or (Nt,) array_like, optional, s/m³
         Window-Reynolds onset of :func:`conduit_flow` instead (exclusive with ``crossover``).
     workers : int, keyword-only
-        Processes (default 1): the sorted flows are dealt into ``workers`` interleaved
-        continuation chains (at least 4 flows each), solved side by side in forked
-        processes; each chain converges every flow to ``tol`` as one chain would.
+        Processes (default 1): the sorted flows are cut into ``workers`` contiguous
+        continuation chains (:func:`_chain_sizes`; at least 4 flows per chain on average),
+        solved side by side in forked processes; each chain converges every flow to ``tol``
+        as one chain would.
     stokes : (pressures (Np,), flow), optional
         A Stokes solution of the same network (pressures in Pa, outlet 0, and its total flow
         in m³/s): the first flow of each chain starts from it scaled to that flow instead
@@ -378,7 +381,7 @@ def solve_inertial(n_pores, conns, g, K, inlet, outlet, flows_m3_s, *, tol: floa
 
     order = np.argsort(flows, kind="stable")
     n_chains = max(1, min(int(workers), flows.size // _MIN_CHAIN))
-    chains = [order[m::n_chains] for m in range(n_chains)]
+    chains = np.split(order, np.cumsum(_chain_sizes(flows.size, n_chains))[:-1])
     out: list[InertialPoint | None] = [None] * flows.size
     for k, pt in _run_chains(chain, chains):
         out[k] = pt
@@ -388,6 +391,21 @@ def solve_inertial(n_pores, conns, g, K, inlet, outlet, flows_m3_s, *, tol: floa
 #: Fewest flows per continuation chain: a chain's first flow starts cold (one Newton step
 #: more), so shorter chains do not pay for their process.
 _MIN_CHAIN = 4
+
+#: Flows a chain that starts cold (from the Stokes solution scaled to a flow high on the
+#: curve) gives up to the first chain: its first flow costs about three warm ones (20 000
+#: spheres: 130 CG iterations against 40-60).
+_COLD_START_FLOWS = 2
+
+
+def _chain_sizes(n: int, chains: int) -> list[int]:
+    """Lengths of ``chains`` contiguous runs of ``n`` sorted flows: every run after the first
+    :data:`_COLD_START_FLOWS` shorter (12 flows, 2 chains: 7 and 5)."""
+    first = -(-(n + _COLD_START_FLOWS * (chains - 1)) // chains)
+    sizes = [first] + [max(1, first - _COLD_START_FLOWS)] * (chains - 1)
+    sizes[-1] = n - sum(sizes[:-1])
+    return sizes
+
 
 #: The chain function of the running :func:`solve_inertial`, for the forked workers.
 _CHAIN = None
