@@ -201,7 +201,9 @@ def add_air(ap, *, density: bool = True) -> None:
         ap.add_argument("--inertial-law", default=DEFAULT_INERTIAL_LAW,
                         choices=tuple(INERTIAL_LAWS),
                         help="per-conduit inertial loss: chain = the law from a resolved 3-D "
-                             "pore body in a chain (default), pore = the same body alone "
+                             "pore body in a chain (default), window = the same with its "
+                             "two constants from each conduit's window ratio, pore = the "
+                             "same body alone "
                              "(session 7's default), onset = laminar-jet expansion with X/(1+X) "
                              "onset (before session 7), quadratic = flat-profile K q|q| from the "
                              "start (docs/inertial-flow.md)")

@@ -6,7 +6,8 @@ solid_fraction=0.60)``, as the scaling part makes it; the sample is the default 
 tessellation, conductances, the Stokes solve and the Newton curve each timed, with Newton
 iterations per velocity and the 1-minute load average. :func:`inertial_validation` runs the
 drag-law cases of :mod:`network.validation` (Finney's packing and periodic random packings)
-for the conduit laws of :data:`INERTIAL_LAWS` (quadratic, onset, derived, pore, chain),
+for the conduit laws of :data:`INERTIAL_LAWS` (quadratic, onset, derived, pore, chain,
+window),
 and :func:`inertial_lines` prints both. Measurements: ``docs/inertial-flow.md``.
 """
 
@@ -77,9 +78,11 @@ def inertial_speed(n_spheres: int = 20_000, *, seed: int = 1, n_points: int = 12
 #: (``docs/inertial-flow.md``): 'quadratic' flat-profile K q|q|; 'onset' laminar profile +
 #: X_c = 1 (``network.solve``'s default until session 7); 'derived' the single-constriction
 #: Navier-Stokes law; 'pore' the same form with the 3-D pore body's onset slope and recovery
-#: (``network.solve``'s default in session 7); 'chain' that body's in a chain (the default).
+#: (``network.solve``'s default in session 7); 'chain' that body's in a chain (the default);
+#: 'window' the chained body's constants per conduit from its window ratio (session 10).
 INERTIAL_LAWS = {"quadratic": FLOW_LAWS["quadratic"], "onset": FLOW_LAWS["onset"],
-                 "derived": DERIVED_LAW, "pore": FLOW_LAWS["pore"], "chain": FLOW_LAWS["chain"]}
+                 "derived": DERIVED_LAW, "pore": FLOW_LAWS["pore"], "chain": FLOW_LAWS["chain"],
+                 "window": FLOW_LAWS["window"]}
 
 
 def inertial_validation(*, reynolds=INERTIAL_REYNOLDS, solid_fractions=(0.55, 0.60, 0.64),
