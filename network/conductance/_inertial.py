@@ -263,7 +263,7 @@ def turning_cosines(centers_m, throat_vertices, pore_xyz_m, conns, flow_m3_s, ax
     :math:`M_Q = \sum_{out} |q_g| o_g / \sum_{out} |q_g|` (outflow directions :math:`o_g`,
     weighted by ``flow_m3_s``, e.g. the Stokes flows); a body without outflow (outlet)
     takes the flow axis. Column 0: :math:`d\cdot M_{Q_1}` (flow 0 → 1), column 1:
-    :math:`-d\cdot M_{Q_0}`. ``recovery`` f (0 <= f <= 1) recovers that part of the cross
+    :math:`-d\cdot M_{Q_0}`. ``recovery`` f (-1 <= f <= 1) recovers that part of the cross
     momentum: :math:`\cos \to \cos + f(1-\cos)` (f = 0: none, the momentum balance above),
     a number or one per conduit and column ((M, 2)); f < 0 (a body losing more than the
     balance, :data:`CHAIN_WINDOW_TABLE`'s narrowest window) lowers the cosine, held at -1.
@@ -292,8 +292,9 @@ def turning_cosines(centers_m, throat_vertices, pore_xyz_m, conns, flow_m3_s, ax
 def conduit_law(tessellation, throats_idx, h_m, *, internal=None, pore_xyz_m=None, conns=None,
                 stokes_flow_m3_s=None, axis: int = 0, density_kg_m3: float = RHO_AIR_KG_M3,
                 viscosity_pa_s: float = MU_AIR_PA_S, profile: str = "uniform",
-                contraction: str = "sharp", turning: bool = False, recovery: float = 0.0,
-                onset=None, onset_slope: float = ONSET_SLOPE, crossover=None):
+                contraction: str = "sharp", turning: bool = False, recovery: float | str = 0.0,
+                onset=None, onset_slope: float | str = ONSET_SLOPE,
+                crossover=None):
     r"""The per-conduit inertial law of a sample's conduits: ``(K, onset_scale, crossover)``.
 
     ``K`` (M, 2), Pa s² m⁻⁶, from :func:`inertial_coefficients` (``profile``,
