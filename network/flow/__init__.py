@@ -10,7 +10,8 @@ from ._darcy import core_permeability, darcy_permeability
 from ._empirical import (ASABE_SOYBEAN_A, ASABE_SOYBEAN_B, asabe_d272_gradient, ergun_gradient,
                          kozeny_carman_gradient)
 from ._fits import GRAINS, fit_curve
-from ._inertial import InertialPoint, conduit_flow, solve_inertial
+from ._conduit_flow import conduit_flow
+from ._inertial import InertialPoint, solve_inertial
 from ._linear import (SolveInfo, apply_pressure_bc, assemble_laplacian, boundary_flows,
                       solve_fixed_pressure, solve_pressure, verify_solution)
 from ._pipeline import (CORE_MARGIN_DIAMETERS, CORE_MIN_DIAMETERS, DEFAULT_DEPTH_M,
