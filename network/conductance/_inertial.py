@@ -310,16 +310,14 @@ def conduit_law(tessellation, throats_idx, h_m, *, internal=None, pore_xyz_m=Non
     """
     if onset not in (None, "throat"):
         raise ValueError(f"onset must be None or 'throat', got {onset!r}")
+    for name, value in (("recovery", recovery), ("onset_slope", onset_slope)):
+        if isinstance(value, str) and value != "window":
+            raise ValueError(f"{name} must be a number or 'window', got {value!r}")
     win = _window_and_ratios(tessellation, throats_idx, h_m)       # once for K and the onset
-    by_window = window_constants(win[1][:, ::-1])     # column 0: flow 0 -> 1 expands into 1
-    if isinstance(recovery, str):
-        if recovery != "window":
-            raise ValueError(f"recovery must be a number or 'window', got {recovery!r}")
-        recovery = by_window[1]
-    if isinstance(onset_slope, str):
-        if onset_slope != "window":
-            raise ValueError(f"onset_slope must be a number or 'window', got {onset_slope!r}")
-        onset_slope = by_window[0]
+    if isinstance(recovery, str) or isinstance(onset_slope, str):
+        c1_w, f_w = window_constants(win[1][:, ::-1])     # column 0: flow 0 -> 1 expands into 1
+        recovery = f_w if isinstance(recovery, str) else recovery
+        onset_slope = c1_w if isinstance(onset_slope, str) else onset_slope
     cos = None
     if turning:
         if stokes_flow_m3_s is None or pore_xyz_m is None or conns is None:

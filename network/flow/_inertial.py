@@ -225,26 +225,8 @@ def solve_inertial(n_pores, conns, g, K, inlet, outlet, flows_m3_s, *, tol: floa
         for k in ks:
             Q = flows[k]
             t0 = time.perf_counter()
-            if len(hist) >= 2 and hist[-1][0] != hist[-2][0]:
-                # every pore's pressure follows its own power law of the last two flows, or
-                # with three, a log-log parabola through them; kept between p2 (Q/q2)^1 and
-                # p2 (Q/q2)^2 (the viscous and the fully inertial limits)
-                (q1, p1), (q2, p2) = hist[-2], hist[-1]
-                lo, hi = p2 * (Q / q2), p2 * (Q / q2) ** 2
-                with np.errstate(divide="ignore", invalid="ignore"):
-                    expo = np.log(p2 / p1) / np.log(q2 / q1)
-                    expo = np.where((p1 > 0) & (p2 > 0) & np.isfinite(expo), expo, 1.0)
-                    p = p2 * (Q / q2) ** np.clip(expo, 1.0, 2.0)
-                    if len(hist) >= 3 and hist[-3][0] != q1:
-                        q0, p0 = hist[-3]
-                        x0, x1, x2, x = np.log([q0, q1, q2, Q])
-                        y = (np.log(p0) * (x - x1) * (x - x2) / ((x0 - x1) * (x0 - x2))
-                             + np.log(p1) * (x - x0) * (x - x2) / ((x1 - x0) * (x1 - x2))
-                             + np.log(p2) * (x - x0) * (x - x1) / ((x2 - x0) * (x2 - x1)))
-                        ok = (p0 > 0) & (p1 > 0) & (p2 > 0) & np.isfinite(y)
-                        p = np.where(ok, np.clip(np.exp(y), lo, hi), p)
-            elif hist:
-                p = p * (Q / hist[-1][0])
+            if hist:
+                p = _predict(hist, Q, p)
             elif stokes is not None:
                 p = np.asarray(stokes[0], dtype=float) * (Q / float(stokes[1]))
             if hist or stokes is not None:
@@ -275,6 +257,7 @@ def solve_inertial(n_pores, conns, g, K, inlet, outlet, flows_m3_s, *, tol: floa
                 r, q, w, rel = r2, q2_, w2, rel2
             P = float(p[inlet[0]])
             hist.append((Q, p.copy()))
+            del hist[:-3]                   # _predict uses the last three
             done.append((k, InertialPoint(float(Q), P, bool(rel <= tol), it, cg_it, float(rel),
                                           time.perf_counter() - t0, p.copy(), q.copy())))
             log.info("Q %.4g m3/s: dP %.5g Pa, %d Newton / %d CG iterations, residual %.1e",
@@ -290,6 +273,31 @@ def solve_inertial(n_pores, conns, g, K, inlet, outlet, flows_m3_s, *, tol: floa
     return out
 
 
+def _predict(hist, Q, p):
+    """Start of the flow Q from the solved ``hist`` [(flow, pressures), ...] (ascending; ``p``
+    the last pressures): every pore's pressure follows its own power law of the last two
+    flows, or with three, a parabola in log p against log Q through them, kept between
+    p2 (Q/q2)^1 and p2 (Q/q2)^2 (the viscous and the fully inertial limits); with one flow (or
+    two equal ones), p scaled by Q/q."""
+    if len(hist) < 2 or hist[-1][0] == hist[-2][0]:
+        return p * (Q / hist[-1][0])
+    (q1, p1), (q2, p2) = hist[-2], hist[-1]
+    lo, hi = p2 * (Q / q2), p2 * (Q / q2) ** 2
+    with np.errstate(divide="ignore", invalid="ignore"):
+        expo = np.log(p2 / p1) / np.log(q2 / q1)
+        expo = np.where((p1 > 0) & (p2 > 0) & np.isfinite(expo), expo, 1.0)
+        p = p2 * (Q / q2) ** np.clip(expo, 1.0, 2.0)
+        if len(hist) >= 3 and hist[-3][0] != q1:
+            q0, p0 = hist[-3]
+            x0, x1, x2, x = np.log([q0, q1, q2, Q])
+            y = (np.log(p0) * (x - x1) * (x - x2) / ((x0 - x1) * (x0 - x2))
+                 + np.log(p1) * (x - x0) * (x - x2) / ((x1 - x0) * (x1 - x2))
+                 + np.log(p2) * (x - x0) * (x - x1) / ((x2 - x0) * (x2 - x1)))
+            ok = (p0 > 0) & (p1 > 0) & (p2 > 0) & np.isfinite(y)
+            p = np.where(ok, np.clip(np.exp(y), lo, hi), p)
+    return p
+
+
 #: Fewest flows per continuation chain: a chain's first flow starts cold (one Newton step
 #: more), so shorter chains do not pay for their process.
 _MIN_CHAIN = 4
@@ -301,8 +309,9 @@ _COLD_START_FLOWS = 2
 
 
 def _chain_sizes(n: int, chains: int) -> list[int]:
-    """Lengths of ``chains`` contiguous runs of ``n`` sorted flows: every run after the first
-    :data:`_COLD_START_FLOWS` shorter (12 flows, 2 chains: 7 and 5)."""
+    """Lengths of ``chains`` contiguous runs of ``n`` sorted flows: the runs after the first
+    :data:`_COLD_START_FLOWS` shorter than it, the last taking what is left (12 flows, 2
+    chains: 7 and 5; 3 chains: 6, 4 and 2)."""
     first = -(-(n + _COLD_START_FLOWS * (chains - 1)) // chains)
     sizes = [first] + [max(1, first - _COLD_START_FLOWS)] * (chains - 1)
     sizes[-1] = n - sum(sizes[:-1])
