@@ -17,6 +17,12 @@ CLIs                   ``python -m network.solve`` (permeability and pressure dr
 The names below (``__all__``) are the public API; the subpackages export more.
 """
 
+import sys as _sys
+
+if _sys.argv[:1] == ["-m"]:     # python -m network.<command>: a command process (network._lean)
+    from ._lean import lean_imports as _lean_imports
+    _lean_imports()
+
 from ._air import MU_AIR_PA_S, RHO_AIR_KG_M3
 from .airpaths import AirflowPath, BranchedResult, branched_pressure_drop, trace_paths
 from .conductance import (MODELS, POLICIES, ConductanceResult, QstarResult, thesis_conductance,

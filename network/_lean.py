@@ -1,0 +1,70 @@
+"""Leaner imports for command processes (``python -m network.<command>``), issue 18 item 2.
+
+Importing ``scipy.sparse`` and ``scipy.spatial`` (SciPy 1.15-1.17) costs this project's commands
+about 0.15 s of work they never use, a sixth of a 5 000-sphere ``network.solve``:
+
+- SciPy's array-API layer clones the ``numpy`` namespace (``dir(numpy)`` and ``getattr`` of every
+  name), which executes NumPy's lazily loaded ``numpy.f2py`` (and through it
+  ``charset_normalizer``), ``numpy.testing`` and ``numpy.ma``: 0.08 s;
+- SciPy's ``xp_capabilities`` decorator parses the numpydoc docstring of each of some 230
+  functions of ``scipy.special`` and ``scipy.spatial`` at import to append its array-API
+  support table to ``__doc__``: 0.07 s.
+
+:func:`lean_imports` registers the three NumPy submodules with the standard library's
+:class:`importlib.util.LazyLoader` (the module object exists, its code runs on the first
+attribute access: ``numpy.ma.masked_invalid`` or ``from numpy.testing import ...`` work as
+before) and, where SciPy's array-API layer has ``xp_capabilities``, replaces it by one that
+leaves functions and their docstrings as they are (the support tables feed SciPy's own test
+suite and documentation only). Computations are untouched. The package applies it only when
+Python was started as ``python -m network.<command>`` (``sys.argv[0]`` is ``'-m'`` while the
+package is imported), never when the library is imported into someone's session.
+"""
+
+from __future__ import annotations
+
+import importlib.util
+import sys
+
+#: NumPy submodules that SciPy's namespace clone executes and no command uses.
+LAZY_NUMPY = ("numpy.f2py", "numpy.testing", "numpy.ma")
+
+
+def _lazy(name: str) -> bool:
+    """Register ``name`` as a lazily executed module (and as its parent's attribute, so that
+    the parent's own ``__getattr__`` never imports it); False where it is already imported or
+    cannot be found."""
+    if name in sys.modules:
+        return False
+    spec = importlib.util.find_spec(name)
+    if spec is None or spec.loader is None:
+        return False
+    loader = importlib.util.LazyLoader(spec.loader)
+    spec.loader = loader
+    module = importlib.util.module_from_spec(spec)
+    sys.modules[name] = module
+    loader.exec_module(module)
+    parent, _, child = name.rpartition(".")
+    setattr(sys.modules[parent], child, module)
+    return True
+
+
+def _plain_capabilities(**_kw):
+    """SciPy's ``xp_capabilities(...)`` without its docstring rewriting: the function as it is."""
+    return lambda f: f
+
+
+def lean_imports() -> list[str]:
+    """Make :data:`LAZY_NUMPY` lazy and SciPy's ``xp_capabilities`` plain; the names of what
+    was changed (an empty list where everything was already imported)."""
+    import numpy  # noqa: F401  (the parent of the lazy submodules)
+
+    changed = [n for n in LAZY_NUMPY if _lazy(n)]
+    if "scipy.special" not in sys.modules:
+        try:
+            import scipy._lib._array_api as api
+        except ImportError:              # a SciPy without the array-API layer: nothing to do
+            return changed
+        if callable(getattr(api, "xp_capabilities", None)):
+            api.xp_capabilities = _plain_capabilities
+            changed.append("scipy xp_capabilities")
+    return changed

@@ -1,0 +1,56 @@
+"""Lean imports of command processes (network._lean, issue 18 item 2): NumPy's f2py, testing
+and ma are deferred, SciPy's docstring tables skipped, and nothing a command computes changes."""
+
+from __future__ import annotations
+
+import json
+import subprocess
+import sys
+
+PROBE = """
+import json, sys
+sys.argv = {argv!r}
+import network, numpy, scipy.special
+state = {{n: type(sys.modules[n]).__name__ for n in ("numpy.f2py", "numpy.testing", "numpy.ma")}}
+from numpy.testing import assert_allclose
+assert_allclose(scipy.special.gamma(5.0), 24.0, rtol=1e-15)
+masked = numpy.ma.masked_invalid([float("nan"), 1.0, 2.0])
+print(json.dumps({{"state": state, "count": int(masked.count()), "sum": float(masked.sum()),
+                  "ma": type(sys.modules["numpy.ma"]).__name__}}))
+"""
+
+
+def _probe(argv):
+    out = subprocess.run([sys.executable, "-c", PROBE.format(argv=argv)], capture_output=True,
+                         text=True, check=True)
+    return json.loads(out.stdout)
+
+
+def test_command_process_defers_numpy_submodules_until_used():
+    got = _probe(["-m"])               # what python -m network.<command> sees on import
+    assert got["state"] == {"numpy.f2py": "_LazyModule", "numpy.testing": "_LazyModule",
+                            "numpy.ma": "_LazyModule"}
+    # first use executes them: the masked mean of (nan, 1, 2) is over two values
+    assert (got["count"], got["sum"], got["ma"]) == (2, 3.0, "module")
+
+
+def test_library_import_leaves_numpy_and_scipy_alone():
+    got = _probe(["-c"])
+    assert set(got["state"].values()) == {"module"}
+    assert (got["count"], got["sum"]) == (2, 3.0)
+
+
+def test_command_answer_equals_the_library_answer(tmp_path):
+    """python -m network.solve (lean) and the same main() in a plain process agree: the network
+    to the bit, k and the drop to the CG tolerance (two runs of either differ by ~1e-13)."""
+    cmd = ["--stokes", "--quiet", "--json"]
+    a, b = tmp_path / "lean.json", tmp_path / "plain.json"
+    subprocess.run([sys.executable, "-m", "network.solve", *cmd, str(a)], check=True,
+                   capture_output=True)
+    plain = f"import network.solve as s; raise SystemExit(s.main({cmd + [str(b)]!r}))"
+    subprocess.run([sys.executable, "-c", plain], check=True, capture_output=True)
+    ja, jb = json.loads(a.read_text()), json.loads(b.read_text())
+    for key in ("porosity", "n_pores", "n_throats"):
+        assert ja[key] == jb[key], key
+    for key in ("permeability_m2", "pressure_drop_pa"):
+        assert abs(ja[key] / jb[key] - 1) < 1e-10, key
