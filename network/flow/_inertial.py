@@ -48,9 +48,8 @@ import numpy as np
 import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 
-from threadpoolctl import threadpool_limits
 
-from ._amg import AMGSolver
+from ._amg import AMGSolver, one_blas_thread
 from ._conduit_flow import conduit_flow
 
 __all__ = ["InertialPoint", "solve_inertial"]
@@ -239,7 +238,7 @@ def solve_inertial(n_pores, conns, g, K, inlet, outlet, flows_m3_s, *, tol: floa
                 # inexact Newton (forcing term eta ~ rel, so the step keeps Newton's quadratic
                 # rate) but never tighter than what brings the residual 10x below the target
                 eta = float(np.clip(max(0.1 * tol / rel, min(rel, 1e-2)), 1e-13, 1e-2))
-                with threadpool_limits(limits=1, user_api="blas"):
+                with one_blas_thread():
                     x, info = solve(J.matrix(w), -r, eta, refresh=it == 1 and bool(hist))
                 cg_it += info[1]
                 log.debug("Newton %d: residual %.2e, eta %.1e, %d CG", it, rel, eta, info[1])
