@@ -250,7 +250,8 @@ def test_window_law_on_a_fresh_loose_packing():
     from network.validation import WINDOW_LAW
 
     err = _against_lbm(0.55, 3, LBM_FRESH_RE, LBM_FRESH_RATIO, WINDOW_LAW,
-                       [1.0754, 1.1780, 1.3839, 1.9483], 3e-4)
-    # +1.3 / +2.5 / +4.2 / +5.9 %: inside 6 % to Re_p 50, over issue 14's 2 % at Re_p 10 (the
-    # loosest packings' miss; 'chain' +1.6 / +3.3 / +5.0 / +6.0 % on the same packing)
-    assert np.all(err > 0) and err[0] < 0.014 and err[1] < 0.026 and err[3] < 0.06
+                       [1.06939, 1.16730, 1.36570, 1.91212], 3e-4)
+    # +0.7 / +1.6 / +2.8 / +3.9 %: inside issue 14's 2 % at Re_p 10 and 6 % at Re_p 50 with the
+    # table extended to sigma 0.837 (session 11; the seven-row table of session 10 gave +1.3 /
+    # +2.5 / +4.2 / +5.9 %, 'chain' +1.6 / +3.3 / +5.0 / +6.0 % on the same packing)
+    assert np.all(err > 0) and err[0] < 0.008 and err[1] < 0.02 and err[3] < 0.045
