@@ -200,10 +200,10 @@ def add_air(ap, *, density: bool = True) -> None:
                         help="air density for the inertial losses, kg/m^3, > 0")
         ap.add_argument("--inertial-law", default=DEFAULT_INERTIAL_LAW,
                         choices=tuple(INERTIAL_LAWS),
-                        help="per-conduit inertial loss: chain = the law from a resolved 3-D "
-                             "pore body in a chain (default), window = the same with its "
-                             "two constants from each conduit's window ratio, pore = the "
-                             "same body alone "
+                        help="per-conduit inertial loss: window = the law from resolved 3-D "
+                             "pore bodies in a chain, its two constants from each conduit's "
+                             "window ratio (default), chain = the same with one pore's "
+                             "constants (the default of sessions 8-10), pore = one body alone "
                              "(session 7's default), onset = laminar-jet expansion with X/(1+X) "
                              "onset (before session 7), quadratic = flat-profile K q|q| from the "
                              "start (docs/inertial-flow.md)")

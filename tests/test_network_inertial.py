@@ -55,12 +55,12 @@ def test_stokes_limit_mass_balance_and_iterations(scene):
         fixed[inl] = True
         fixed[pt.pressure_pa == 0] = True
         assert np.max(np.abs(net[~fixed])) <= 1e-10 * Q
-    # resistance grows with Re; the default law ('chain' since session 8): k/k_app recorded with
-    # session 9's corrected constants (session 8's: 1.1621, 2.8877; 'pore' before: 1.1277 and
-    # 2.4000; onset: 1.09, 1.91)
+    # resistance grows with Re; the default law ('window' since session 11): k/k_app recorded
+    # with the nine-row window table ('chain', the default of sessions 8-10: 1.1777, 3.0273;
+    # session 8's chain 1.1621, 2.8877; 'pore' before: 1.1277 and 2.4000; onset: 1.09, 1.91)
     ratio = [scene.permeability_m2 / r["apparent_permeability_m2"] for r in rows]
     assert ratio[0] == pytest.approx(1.0, abs=1e-6) and 1.0 < ratio[2] < ratio[3]
-    np.testing.assert_allclose(ratio[2:], [1.1777, 3.0273], rtol=2e-3)
+    np.testing.assert_allclose(ratio[2:], [1.1677, 3.1076], rtol=2e-3)
 
 
 def test_parallel_chains_give_the_serial_curve():

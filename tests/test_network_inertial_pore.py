@@ -160,20 +160,21 @@ def test_conduit_law_matches_the_separate_steps():
 
 
 def test_cli_json_names_the_law(tmp_path):
-    # the default law changed in session 7 ('onset' -> 'pore') and 8 (-> 'chain'): every JSON
-    # says which it used
+    # the default law changed in session 7 ('onset' -> 'pore'), 8 (-> 'chain') and 11 (->
+    # 'window'): every JSON says which it used
     import json
 
     from network import curve, solve
 
-    for law, args in (("chain", []), ("pore", ["--inertial-law", "pore"]),
+    for law, args in (("window", []), ("chain", ["--inertial-law", "chain"]),
+                      ("pore", ["--inertial-law", "pore"]),
                       ("onset", ["--inertial-law", "onset"])):
         out = tmp_path / f"s_{law}.json"
         assert solve.main(["-q", "--json", str(out)] + args) == 0
         assert json.loads(out.read_text())["inertial_law"] == law
     out = tmp_path / "c.json"
     assert curve.main(["-q", "--velocities", "0.01,0.1", "--json", str(out)]) == 0
-    assert json.loads(out.read_text())["inertial_law"] == "chain"
+    assert json.loads(out.read_text())["inertial_law"] == "window"
 
 
 def _window_row(rows, r):

@@ -46,7 +46,7 @@ def inertial_speed(n_spheres: int = 20_000, *, seed: int = 1, n_points: int = 12
                    policy: str = "table-only", db=None, law: str = DEFAULT_INERTIAL_LAW,
                    workers: int | None = None) -> dict:
     """Stage times (s) of a ``n_points`` curve 0.005-0.3 m/s on the benchmark packing, with
-    the conduit ``law`` of :data:`INERTIAL_LAWS` (default 'chain', ``network.solve``'s), its
+    the conduit ``law`` of :data:`INERTIAL_LAWS` (default ``network.solve``'s, 'window'), its
     Newton solves in ``workers`` continuation chains (default: the usable cores); the
     process CPU time of the whole curve beside the wall times."""
     if workers is None:
@@ -78,8 +78,9 @@ def inertial_speed(n_spheres: int = 20_000, *, seed: int = 1, n_points: int = 12
 #: (``docs/inertial-flow.md``): 'quadratic' flat-profile K q|q|; 'onset' laminar profile +
 #: X_c = 1 (``network.solve``'s default until session 7); 'derived' the single-constriction
 #: Navier-Stokes law; 'pore' the same form with the 3-D pore body's onset slope and recovery
-#: (``network.solve``'s default in session 7); 'chain' that body's in a chain (the default);
-#: 'window' the chained body's constants per conduit from its window ratio (session 10).
+#: (``network.solve``'s default in session 7); 'chain' that body's in a chain (the default of
+#: sessions 8-10); 'window' the chained body's constants per conduit from its window ratio
+#: (session 10; the default since session 11).
 INERTIAL_LAWS = {"quadratic": FLOW_LAWS["quadratic"], "onset": FLOW_LAWS["onset"],
                  "derived": DERIVED_LAW, "pore": FLOW_LAWS["pore"], "chain": FLOW_LAWS["chain"],
                  "window": FLOW_LAWS["window"]}

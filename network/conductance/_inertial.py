@@ -60,7 +60,7 @@ ONSET_SLOPE = 0.0235
 PORE_ONSET_SLOPE = 0.1250
 PORE_RECOVERY = 0.455
 
-#: The same pore body in a chain (``network.solve``'s default law 'chain'): the loss a body
+#: The same pore body in a chain (law 'chain', the default of sessions 8-10): the loss a body
 #: causes is its own excess dissipation k_body plus the kinetic energy its jets carry out
 #: through the three outlet windows beyond what they carry at Re_w 5 (k_out - k_out(5); a
 #: do-nothing outlet does not charge it, the next body of a bed dissipates it). From the same
@@ -247,7 +247,7 @@ def window_constants(sigma, table=None):
 
     >>> c1, f = window_constants([0.30, 0.6371, 0.95])
     >>> c1.round(4).tolist(), f.round(3).tolist()
-    ([0.0857, 0.1089, 0.106], [-0.367, 0.097, 0.246])
+    ([0.0857, 0.1089, 0.0656], [-0.367, 0.097, 0.429])
     """
     t = CHAIN_WINDOW_TABLE if table is None else table
     x = np.asarray(t["sigma"], dtype=float)

@@ -58,11 +58,12 @@ PORE_LAW = dict(INERTIAL_LAWS["pore"])
 
 #: The same form with the slope and recovery of that pore body in a chain (the kinetic energy
 #: its jets carry out is the next body's loss; ``docs/inertial-flow.md``, "The chained pore"):
-#: ``network.solve``'s default law 'chain'.
+#: ``network.solve``'s default law in sessions 8-10.
 CHAIN_LAW = dict(INERTIAL_LAWS["chain"])
 
 #: The chained body's slope and recovery taken per conduit from its own window ratio
-#: (:data:`network.conductance.CHAIN_WINDOW_TABLE`: the chained pore at six window ratios).
+#: (:data:`network.conductance.CHAIN_WINDOW_TABLE`: the chained pore at nine window ratios):
+#: ``network.solve``'s default law since session 11.
 WINDOW_LAW = dict(INERTIAL_LAWS["window"])
 
 #: Finney's packing, central subset (radius 1, lengths in sphere radii).
