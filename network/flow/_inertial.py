@@ -48,7 +48,6 @@ import numpy as np
 import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 
-
 from ._amg import AMGSolver, one_blas_thread
 from ._conduit_flow import conduit_flow
 
