@@ -12,6 +12,10 @@ differences in % of the pressure gradient. ``--json`` writes the rows.
 
     python docs/scripts/lbm_vs_network.py /tmp/lbm/ens_*.json --json rows.json
     python docs/scripts/lbm_vs_network.py docs/data/lbm_n800_reference.json --laws pore chain
+
+A stored table of ordered arrays (``docs/data/lbm_arrays_reference.json``: rows with ``kind``
+'sc' or 'fcc') is compared through ``lattice_inertial_case`` (7 cells) instead; its rows print
+kind, phi, Re, LBM and the laws.
 """
 
 from __future__ import annotations
@@ -63,30 +67,74 @@ def compare(path, laws=LAW_NAMES):
     return out
 
 
+def compare_arrays(path, laws=LAW_NAMES):
+    """Rows of a stored ordered-array table (``kind``, phi, re, lbm) beside the network's
+    k/k_app of the same array (``lattice_inertial_case``, flow along a cube axis)."""
+    from network.flow import INERTIAL_LAWS
+    from network.validation import DERIVED_LAW, lattice_inertial_case
+
+    options = dict(INERTIAL_LAWS, derived=DERIVED_LAW)
+    groups = {}
+    for r in json.load(open(path))["rows"]:
+        groups.setdefault((r["kind"], r["phi"]), []).append(r)
+    out = []
+    for (kind, phi), rows in groups.items():
+        re = np.array([r["re"] for r in rows])
+        net = {name: lattice_inertial_case(kind, phi, re, **options[name]).k_ratio
+               for name in laws}
+        out += [{"kind": kind, "phi": phi, "re": r["re"], "converged": r["converged"],
+                 "lbm": r["lbm"], **{name: float(net[name][i]) for name in laws}}
+                for i, r in enumerate(rows)]
+    return out
+
+
+def _pc(x, y):
+    """x over y - 1, in %."""
+    return 100 * (x / y - 1)
+
+
+def _print_arrays(rows, laws):
+    pc = _pc
+    print(f"{'array':>5} {'phi':>5} {'Re':>6} {'LBM':>7} " + "".join(f"{n:>8}" for n in laws)
+          + "".join(f"{n[:5] + '/L%':>9}" for n in laws))
+    for r in rows:
+        print(f"{r['kind']:>5} {r['phi']:5.2f} {r['re']:6.1f} {r['lbm']:7.4f} "
+              + "".join(f"{r[n]:8.4f}" for n in laws)
+              + "".join(f"{pc(r[n], r['lbm']):+9.1f}" for n in laws)
+              + ("" if r["converged"] else " *"))
+
+
 def main(argv=None):
     p = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     p.add_argument("files", nargs="+")
     p.add_argument("--laws", nargs="+", default=list(LAW_NAMES), choices=LAW_NAMES)
     p.add_argument("--json", default=None)
     a = p.parse_args(argv)
-    rows = []
+    rows, arrays = [], []
     for f in a.files:
-        rows += compare(f, a.laws)
-    pc = lambda x, y: 100 * (x / y - 1)        # noqa: E731
-    print(f"{'phi':>5} {'seed':>4} {'D':>3} {'Re':>6} {'LBM':>7} {'Beet':>7} {'HKL':>7} "
-          + "".join(f"{n:>8}" for n in a.laws) + f" {'L/B %':>6} {'L/H %':>6} "
-          + "".join(f"{n[:5] + '/L%':>9}" for n in a.laws) + f" {a.laws[-1][:5] + '/B%':>9}")
-    for r in rows:
-        flag = "" if r["converged"] else " *"
-        print(f"{r['phi']:5.2f} {r['seed']:4d} {r['resolution']:3.0f} {r['re']:6.2f} "
-              f"{r['lbm']:7.4f} {r['beetstra']:7.4f} {r['hill_koch_ladd']:7.4f} "
-              + "".join(f"{r[n]:8.4f}" for n in a.laws)
-              + f" {pc(r['lbm'], r['beetstra']):+6.1f} {pc(r['lbm'], r['hill_koch_ladd']):+6.1f} "
-              + "".join(f"{pc(r[n], r['lbm']):+9.1f}" for n in a.laws)
-              + f" {pc(r[a.laws[-1]], r['beetstra']):+9.1f}{flag}")
+        data = json.load(open(f))
+        if "rows" in data and data["rows"] and "kind" in data["rows"][0]:
+            arrays += compare_arrays(f, a.laws)
+        else:
+            rows += compare(f, a.laws)
+    if arrays:
+        _print_arrays(arrays, a.laws)
+    if rows:
+        pc = _pc
+        print(f"{'phi':>5} {'seed':>4} {'D':>3} {'Re':>6} {'LBM':>7} {'Beet':>7} {'HKL':>7} "
+              + "".join(f"{n:>8}" for n in a.laws) + f" {'L/B %':>6} {'L/H %':>6} "
+              + "".join(f"{n[:5] + '/L%':>9}" for n in a.laws) + f" {a.laws[-1][:5] + '/B%':>9}")
+        for r in rows:
+            flag = "" if r["converged"] else " *"
+            print(f"{r['phi']:5.2f} {r['seed']:4d} {r['resolution']:3.0f} {r['re']:6.2f} "
+                  f"{r['lbm']:7.4f} {r['beetstra']:7.4f} {r['hill_koch_ladd']:7.4f} "
+                  + "".join(f"{r[n]:8.4f}" for n in a.laws)
+                  + f" {pc(r['lbm'], r['beetstra']):+6.1f} {pc(r['lbm'], r['hill_koch_ladd']):+6.1f} "
+                  + "".join(f"{pc(r[n], r['lbm']):+9.1f}" for n in a.laws)
+                  + f" {pc(r[a.laws[-1]], r['beetstra']):+9.1f}{flag}")
     if a.json:
         with open(a.json, "w") as fh:
-            json.dump(rows, fh, indent=1)
+            json.dump(rows + arrays, fh, indent=1)
     return 0
 
 
