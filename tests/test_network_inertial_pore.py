@@ -191,7 +191,8 @@ def _window_row(rows, r):
 
 def test_window_table_comes_from_the_pore_rows():
     # every row of CHAIN_WINDOW_TABLE is the chained recipe on the stored Navier-Stokes rows of
-    # one pore radius (the finest mesh run of each), and r 0.90's row is the 'chain' constants
+    # one pore radius (its h 0.10 run, the finest graded one where several), and r 0.90's row
+    # is the 'chain' constants
     import json
     from pathlib import Path
 

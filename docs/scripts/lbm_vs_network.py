@@ -5,10 +5,11 @@ For each LBM JSON (a run of ``lbm_periodic.py``, or a stored table of rows such 
 ``docs/data/lbm_n800_reference.json`` and ``lbm_reference.json``, whose rows carry phi, seed, n
 and re): the packing (phi, n, seed) is rebuilt by ``random_inertial_case`` (copied 3 x 3 x 3, the
 middle two periods as the sample) and the network's k/k_app is solved at the Reynolds numbers the
-LBM obtained, with the package's current constants, with the laws ``onset`` (the CLI's until session 7),
-``DERIVED_LAW``, ``pore`` (the CLI's in session 7) and ``chain`` (the CLI's since session 8;
-``--laws`` picks). Printed per row: LBM, Beetstra, HKL, the network laws, and the relative
-differences in % of the pressure gradient. ``--json`` writes the rows.
+LBM obtained, with the package's current constants, with the laws ``onset`` (the CLI's until
+session 7), ``DERIVED_LAW``, ``pore`` (the CLI's in session 7), ``chain`` (sessions 8-10) and
+``window`` (since session 11; ``--laws`` picks). Printed per row: LBM, Beetstra, HKL, the
+network laws, and the relative differences in % of the pressure gradient. ``--json`` writes
+the rows.
 
     python docs/scripts/lbm_vs_network.py /tmp/lbm/ens_*.json --json rows.json
     python docs/scripts/lbm_vs_network.py docs/data/lbm_n800_reference.json --laws pore chain
@@ -31,10 +32,10 @@ import numpy as np
 LAW_NAMES = ("onset", "derived", "pore", "chain", "window")
 
 
-def _runs(path):
-    """(phi, n, seed, resolution, k_stokes_d2, rows) per packing of an LBM JSON: one run of
-    ``lbm_periodic.py`` ('result'), or a stored table ('rows' with phi, seed, n, re, lbm)."""
-    data = json.load(open(path))
+def _runs(data):
+    """(phi, n, seed, resolution, k_stokes_d2, rows) per packing of a loaded LBM JSON: one run
+    of ``lbm_periodic.py`` ('result'), or a stored table ('rows' with phi, seed, n, re, lbm;
+    a packing's rows may come from runs of several resolutions, each row keeps its own)."""
     if "result" in data:
         res = data["result"]
         rows = [{"re": r["re"], "converged": r["converged"], "lbm": r["k_ratio"],
@@ -49,33 +50,41 @@ def _runs(path):
             for (phi, n, seed), rows in groups.items()]
 
 
-def compare(path, laws=LAW_NAMES):
+def _law_options():
+    """The network's laws by name: flow's CLI laws and the single-constriction 'derived'."""
     from network.flow import INERTIAL_LAWS
-    from network.validation import DERIVED_LAW, random_inertial_case
+    from network.validation import DERIVED_LAW
 
-    options = dict(INERTIAL_LAWS, derived=DERIVED_LAW)
+    return dict(INERTIAL_LAWS, derived=DERIVED_LAW)
+
+
+def compare(data, laws=LAW_NAMES):
+    """Rows of a loaded LBM JSON of random packings beside the network's k/k_app."""
+    from network.validation import random_inertial_case
+
+    options = _law_options()
     out = []
-    for phi, n, seed, resolution, k_d2, rows in _runs(path):
+    for phi, n, seed, resolution, k_d2, rows in _runs(data):
         re = np.array([r["re"] for r in rows])
         net = {name: random_inertial_case(phi, re, n_spheres=n, rng=seed,
                                           **options[name]).k_ratio for name in laws}
         for i, r in enumerate(rows):
-            out.append({"phi": phi, "seed": seed, "resolution": resolution, "n": n,
+            out.append({"phi": phi, "seed": seed, "resolution": r.get("resolution", resolution),
+                        "n": n,
                         "re": r["re"], "converged": r["converged"], "lbm": r["lbm"],
                         "beetstra": r["beetstra"], "hill_koch_ladd": r["hill_koch_ladd"],
                         **{name: float(net[name][i]) for name in laws}, "k_lbm_d2": k_d2})
     return out
 
 
-def compare_arrays(path, laws=LAW_NAMES):
-    """Rows of a stored ordered-array table (``kind``, phi, re, lbm) beside the network's
+def compare_arrays(data, laws=LAW_NAMES):
+    """Rows of a loaded ordered-array table (``kind``, phi, re, lbm) beside the network's
     k/k_app of the same array (``lattice_inertial_case``, flow along a cube axis)."""
-    from network.flow import INERTIAL_LAWS
-    from network.validation import DERIVED_LAW, lattice_inertial_case
+    from network.validation import lattice_inertial_case
 
-    options = dict(INERTIAL_LAWS, derived=DERIVED_LAW)
+    options = _law_options()
     groups = {}
-    for r in json.load(open(path))["rows"]:
+    for r in data["rows"]:
         groups.setdefault((r["kind"], r["phi"]), []).append(r)
     out = []
     for (kind, phi), rows in groups.items():
@@ -94,13 +103,12 @@ def _pc(x, y):
 
 
 def _print_arrays(rows, laws):
-    pc = _pc
     print(f"{'array':>5} {'phi':>5} {'Re':>6} {'LBM':>7} " + "".join(f"{n:>8}" for n in laws)
           + "".join(f"{n[:5] + '/L%':>9}" for n in laws))
     for r in rows:
         print(f"{r['kind']:>5} {r['phi']:5.2f} {r['re']:6.1f} {r['lbm']:7.4f} "
               + "".join(f"{r[n]:8.4f}" for n in laws)
-              + "".join(f"{pc(r[n], r['lbm']):+9.1f}" for n in laws)
+              + "".join(f"{_pc(r[n], r['lbm']):+9.1f}" for n in laws)
               + ("" if r["converged"] else " *"))
 
 
@@ -112,15 +120,15 @@ def main(argv=None):
     a = p.parse_args(argv)
     rows, arrays = [], []
     for f in a.files:
-        data = json.load(open(f))
+        with open(f) as fh:
+            data = json.load(fh)
         if "rows" in data and data["rows"] and "kind" in data["rows"][0]:
-            arrays += compare_arrays(f, a.laws)
+            arrays += compare_arrays(data, a.laws)
         else:
-            rows += compare(f, a.laws)
+            rows += compare(data, a.laws)
     if arrays:
         _print_arrays(arrays, a.laws)
     if rows:
-        pc = _pc
         print(f"{'phi':>5} {'seed':>4} {'D':>3} {'Re':>6} {'LBM':>7} {'Beet':>7} {'HKL':>7} "
               + "".join(f"{n:>8}" for n in a.laws) + f" {'L/B %':>6} {'L/H %':>6} "
               + "".join(f"{n[:5] + '/L%':>9}" for n in a.laws) + f" {a.laws[-1][:5] + '/B%':>9}")
@@ -129,9 +137,10 @@ def main(argv=None):
             print(f"{r['phi']:5.2f} {r['seed']:4d} {r['resolution']:3.0f} {r['re']:6.2f} "
                   f"{r['lbm']:7.4f} {r['beetstra']:7.4f} {r['hill_koch_ladd']:7.4f} "
                   + "".join(f"{r[n]:8.4f}" for n in a.laws)
-                  + f" {pc(r['lbm'], r['beetstra']):+6.1f} {pc(r['lbm'], r['hill_koch_ladd']):+6.1f} "
-                  + "".join(f"{pc(r[n], r['lbm']):+9.1f}" for n in a.laws)
-                  + f" {pc(r[a.laws[-1]], r['beetstra']):+9.1f}{flag}")
+                  + f" {_pc(r['lbm'], r['beetstra']):+6.1f}"
+                  + f" {_pc(r['lbm'], r['hill_koch_ladd']):+6.1f} "
+                  + "".join(f"{_pc(r[n], r['lbm']):+9.1f}" for n in a.laws)
+                  + f" {_pc(r[a.laws[-1]], r['beetstra']):+9.1f}{flag}")
     if a.json:
         with open(a.json, "w") as fh:
             json.dump(rows + arrays, fh, indent=1)

@@ -81,9 +81,9 @@ def inertial_speed(n_spheres: int = 20_000, *, seed: int = 1, n_points: int = 12
 #: (``network.solve``'s default in session 7); 'chain' that body's in a chain (the default of
 #: sessions 8-10); 'window' the chained body's constants per conduit from its window ratio
 #: (session 10; the default since session 11).
-INERTIAL_LAWS = {"quadratic": FLOW_LAWS["quadratic"], "onset": FLOW_LAWS["onset"],
-                 "derived": DERIVED_LAW, "pore": FLOW_LAWS["pore"], "chain": FLOW_LAWS["chain"],
-                 "window": FLOW_LAWS["window"]}
+INERTIAL_LAWS = ({"quadratic": FLOW_LAWS["quadratic"], "onset": FLOW_LAWS["onset"],
+                  "derived": DERIVED_LAW}
+                 | {k: v for k, v in FLOW_LAWS.items() if k not in ("quadratic", "onset")})
 
 
 def inertial_validation(*, reynolds=INERTIAL_REYNOLDS, solid_fractions=(0.55, 0.60, 0.64),

@@ -16,8 +16,8 @@ from ._result import ConductanceResult
 from ._table import default_table, has_grid, table_totals
 from ._thesis import thesis_conductance
 
-__all__ = ["CHAIN_ONSET_SLOPE", "CHAIN_RECOVERY", "CHAIN_WINDOW_TABLE", "MODELS", "ONSET_SLOPE", "PORE_ONSET_SLOPE",
-           "PORE_RECOVERY", "POLICIES",
+__all__ = ["CHAIN_ONSET_SLOPE", "CHAIN_RECOVERY", "CHAIN_WINDOW_TABLE", "MODELS", "ONSET_SLOPE",
+           "PORE_ONSET_SLOPE", "PORE_RECOVERY", "POLICIES",
            "SECTION_MODES", "ConductanceResult", "QstarResult", "check_model", "check_policy",
            "conduit_conductance", "conduit_law",
            "contraction_coefficient", "default_table", "expansion_coefficient", "has_grid",

@@ -74,9 +74,10 @@ CHAIN_RECOVERY = 0.097
 #: The chained body's two constants as functions of the window ratio: the same regular
 #: tetrahedron (edge 2) with sphere radii 0.97 / 0.95 / 0.90 / 0.85 / 0.80 / 0.75 / 0.70 / 0.60 /
 #: 0.50 (window ratio sigma below; the last two added in session 11), the same recipe on each
-#: pore's own sigma and h/a = 0.408/r, the finest mesh run of each (h 0.10 with 8 / 6 / 4
-#: elements across the gaps between spheres: ``docs/data/pore_ns_series.json``;
-#: ``docs/inertial-flow.md``, "A window-ratio law").
+#: pore's own sigma and h/a = 0.408/r, one run of each at h 0.10 with 8 / 6 / 4 elements across
+#: the gaps between spheres (r 0.90 / 0.80-0.85 / the others; r 0.60's finer h 0.07 check
+#: moved c_1 by 2.8 % and is not used): ``docs/data/pore_ns_series.json``;
+#: ``docs/inertial-flow.md``, "A window-ratio law".
 #: :func:`window_constants` interpolates it linearly in sigma and holds the end values outside.
 #: Not fitted to bed data.
 CHAIN_WINDOW_TABLE = {"sigma": (0.4925, 0.5457, 0.6371, 0.6952, 0.7352, 0.7642, 0.7861, 0.8167,

@@ -47,11 +47,7 @@ def conduit_flow(dp, g, K, *, crossover: float | None = None, onset_scale=None, 
     # start above the root: X/(X_c+X) >= 1 - X_c/X bounds it by the root of
     # K q^2 + (1 - X_c) q/g = |dp|; Newton on the convex increasing residual then descends
     # monotonically onto the root
-    b = (1.0 - float(crossover)) * inv_g
-    disc = np.sqrt(b * b + 4.0 * k * a)
-    with np.errstate(divide="ignore", invalid="ignore"):
-        up = np.where(b > 0, 2.0 * a / (b + disc), (disc - b) / (2.0 * k))
-    q = np.where(k > 0, np.minimum(g * a, np.nan_to_num(up, nan=np.inf, posinf=np.inf)), g * a)
+    q = _upper_bound(a, g, k, (1.0 - float(crossover)) * inv_g, k > 0)
     for _ in range(50):
         x = c * q
         f = q * inv_g + k * q * q * x / (1.0 + x) - a
@@ -65,6 +61,15 @@ def conduit_flow(dp, g, K, *, crossover: float | None = None, onset_scale=None, 
     return np.sign(dp) * q, w
 
 
+def _upper_bound(a, g, k, b, live):
+    """Newton's start above the root: the positive root of k q² + b q = |Δp| (b of either
+    sign), at most g|Δp|; g|Δp| (the Stokes flow) where ``live`` is False."""
+    disc = np.sqrt(b * b + 4.0 * k * a)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        up = np.where(b > 0, 2.0 * a / (b + disc), (disc - b) / (2.0 * k))
+    return np.where(live, np.minimum(g * a, np.nan_to_num(up, nan=np.inf, posinf=np.inf)), g * a)
+
+
 def _throat_onset_flow(dp, a, g, inv_g, k, c, q_start=None):
     r"""|Δp| = q/g + k q² φ(cq), φ(t) = t/√(1+t²): Newton from an upper bound
     (φ(t) >= 1 - 1/t bounds q by the root of k q² + (1/g - k/c) q = |Δp|, and by g|Δp|);
@@ -74,10 +79,8 @@ def _throat_onset_flow(dp, a, g, inv_g, k, c, q_start=None):
     below the root the first step lands above it (convexity), then the descent is monotone."""
     with np.errstate(divide="ignore", invalid="ignore"):
         b = inv_g - np.where(c > 0, k / c, 0.0)
-        disc = np.sqrt(b * b + 4.0 * k * a)
-        up = np.where(b > 0, 2.0 * a / (b + disc), (disc - b) / (2.0 * k))
     live = (k > 0) & (c > 0)
-    q = np.where(live, np.minimum(g * a, np.nan_to_num(up, nan=np.inf, posinf=np.inf)), g * a)
+    q = _upper_bound(a, g, k, b, live)
     if q_start is not None:
         qs = np.asarray(q_start, dtype=float)
         warm = live & (qs * dp > 0)
