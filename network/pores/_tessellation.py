@@ -2,7 +2,8 @@ r"""Delaunay tessellation of a packing: pores (tetrahedra) and throats (their fa
 
 Pores are the Delaunay tetrahedra of the sphere centres (thesis 3.5.2.2); throats are the
 triangular faces, each listed once: a face shared by two tetrahedra connects them, a face on
-the convex hull has ``-1`` as its second pore.
+the convex hull has ``-1`` as its second pore. The tetrahedra come from gmsh's Delaunay kernel,
+completed at the hull and checked, or from Qhull where that check fails (``_delaunay``).
 
 Degenerate input
 ----------------
@@ -31,16 +32,13 @@ from concurrent.futures import ThreadPoolExecutor
 import numpy as np
 import scipy.sparse as sp
 from scipy.sparse.csgraph import connected_components
-from scipy.spatial import Delaunay, QhullError
 
 from ..packing import Packing
+from ._delaunay import ENGINES, QHULL_OPTIONS, delaunay
 
-__all__ = ["Tessellation", "tessellate", "QHULL_OPTIONS", "tie_groups"]
+__all__ = ["ENGINES", "Tessellation", "tessellate", "QHULL_OPTIONS", "tie_groups"]
 
 log = logging.getLogger(__name__)
-
-#: Qhull options used for the 3-D Delaunay tessellation (see module docstring).
-QHULL_OPTIONS = "Qbb Qc Qz Q12"
 
 # rows per chunk of the vectorised geometry (bounds the temporaries of 500k-sphere packings)
 _CHUNK = 262_144
@@ -220,7 +218,8 @@ def _local_frame(centers):
 
 
 def tessellate(packing: Packing, *, qhull_options: str = QHULL_OPTIONS,
-               flat_tol: float = 1e-6, tie_tol: float = 1e-6, threads: int = 1) -> Tessellation:
+               flat_tol: float = 1e-6, tie_tol: float = 1e-6, threads: int = 1,
+               engine: str = "auto") -> Tessellation:
     r"""Delaunay tessellation of the sphere centres into pores and throats.
 
     Parameters
@@ -229,6 +228,11 @@ def tessellate(packing: Packing, *, qhull_options: str = QHULL_OPTIONS,
         Sphere centres (N, 3) m and radii (N,) m.
     qhull_options : str, optional
         Options for ``scipy.spatial.Delaunay`` (default ``"Qbb Qc Qz Q12"``).
+    engine : {'auto', 'gmsh', 'qhull'}, optional
+        'gmsh': gmsh's Delaunay kernel, completed at the hull and checked, Qhull where the
+        check fails (``network.pores._delaunay``; the same tetrahedra for centres in general
+        position, 2-3 times faster at 20 000 centres); 'auto' (default): that from 4 000
+        centres, Qhull below; 'qhull': Qhull only.
     flat_tol : float, optional
         A tetrahedron with volume < ``flat_tol`` :math:`\bar d^3` is flagged flat (default 1e-6).
     tie_tol : float, optional
@@ -251,7 +255,7 @@ def tessellate(packing: Packing, *, qhull_options: str = QHULL_OPTIONS,
 
     Notes
     -----
-    Faces are read from Qhull's neighbour table: face *k* of tetrahedron *t* is opposite its
+    Faces are read from the neighbour table: face *k* of tetrahedron *t* is opposite its
     vertex *k* and is kept once, by the tetrahedron with the lower index (or by *t* when the
     face is on the hull). This is equivalent to sorting the 4 N faces and taking unique rows,
     in O(N) instead of O(N log N). Side lengths follow the contract order
@@ -272,14 +276,7 @@ def tessellate(packing: Packing, *, qhull_options: str = QHULL_OPTIONS,
     if not isinstance(packing, Packing):
         raise TypeError(f"packing must be a Packing, got {type(packing).__name__}")
     pts, origin = _local_frame(packing.centers)
-    try:
-        dt = Delaunay(pts, qhull_options=qhull_options)
-    except QhullError as e:
-        raise ValueError(f"Delaunay tessellation failed for {packing.n} centres "
-                         f"(coplanar or degenerate input?): {str(e).splitlines()[0]}") from e
-    simp = np.ascontiguousarray(dt.simplices, dtype=np.int64)
-    neigh = np.ascontiguousarray(dt.neighbors, dtype=np.int64)
-    del dt
+    simp, neigh, used = delaunay(pts, engine=engine, qhull_options=qhull_options)
     n_p = simp.shape[0]
     dbar = packing.mean_diameter
     if threads > 1:
@@ -345,8 +342,8 @@ def tessellate(packing: Packing, *, qhull_options: str = QHULL_OPTIONS,
     if coplanar.size:
         log.warning("%d sphere(s) are in no tetrahedron (coincident with another centre to "
                     "Qhull precision)", coplanar.size)
-    log.info("tessellated %d spheres: %d pores (%d flat), %d throats (%d on the hull, %d tied)",
-             packing.n, n_p, int(flat.sum()), n_t, int((~inner).sum()), int(tied.sum()))
+    log.info("tessellated %d spheres (%s): %d pores (%d flat), %d throats (%d on the hull, "
+             "%d tied)", packing.n, used, n_p, int(flat.sum()), n_t, int((~inner).sum()), int(tied.sum()))
     if origin is not None:
         centroid += origin
         circ += origin
