@@ -90,3 +90,20 @@ def test_duplicates_and_flat_input_go_to_qhull(caplog):
             delaunay(flat, engine=engine)
     with pytest.raises(ValueError, match="unknown Delaunay engine"):
         delaunay(p, engine="cgal")
+
+
+def test_tiled_copies_keep_gmsh_and_give_the_same_pore_bodies():
+    """Translated copies (the bench's tiling above 1e5 spheres) make exactly co-spherical and
+    coplanar groups at the seams and on the hull: gmsh's triangulation is completed and
+    checked there too, and tie_groups gives Qhull's pore bodies."""
+    rng = np.random.default_rng(11)
+    c = rng.random((1200, 3))
+    tiled = np.vstack([c + np.array([i, j, 0.0]) * 1.001 for i in range(2) for j in range(2)])
+    simp, _, used = delaunay(tiled, engine="gmsh")
+    assert used == "gmsh"
+    pv = tiled[simp]
+    volume = np.abs(np.linalg.det(pv[:, 1:] - pv[:, :1])).sum() / 6
+    assert volume == pytest.approx(ConvexHull(tiled).volume, rel=1e-12)
+    pk = Packing(tiled, np.full(tiled.shape[0], 0.02))
+    a, b = tessellate(pk, engine="gmsh"), tessellate(pk, engine="qhull")
+    assert tie_groups(a)[1] == tie_groups(b)[1]

@@ -89,7 +89,7 @@ def _gmsh_tetrahedra(pts: np.ndarray) -> np.ndarray:
         import gmsh
     except (ImportError, OSError) as e:          # a broken libgmsh must not stop a solve
         raise _Unchecked(f"gmsh not importable: {e}") from e
-    with _GMSH_LOCK:                             # gmsh is not thread-safe
+    with _GMSH_LOCK:          # gmsh is not thread-safe (throats' meshing runs before or after)
         if not gmsh.isInitialized():
             gmsh.initialize(readConfigFiles=False, interruptible=False)
         gmsh.option.setNumber("General.Terminal", 0)

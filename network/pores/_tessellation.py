@@ -227,12 +227,12 @@ def tessellate(packing: Packing, *, qhull_options: str = QHULL_OPTIONS,
     packing : Packing
         Sphere centres (N, 3) m and radii (N,) m.
     qhull_options : str, optional
-        Options for ``scipy.spatial.Delaunay`` (default ``"Qbb Qc Qz Q12"``).
+        Options for ``scipy.spatial.Delaunay`` where Qhull runs (default ``"Qbb Qc Qz Q12"``).
     engine : {'auto', 'gmsh', 'qhull'}, optional
         'gmsh': gmsh's Delaunay kernel, completed at the hull and checked, Qhull where the
         check fails (``network.pores._delaunay``; the same tetrahedra for centres in general
-        position, 2-3 times faster at 20 000 centres); 'auto' (default): that from 4 000
-        centres, Qhull below; 'qhull': Qhull only.
+        position; 0.38 against 0.57-0.81 s at 20 000 centres, 25 against 82 s at 1e6);
+        'auto' (default): that from 4 000 centres, Qhull below; 'qhull': Qhull only.
     flat_tol : float, optional
         A tetrahedron with volume < ``flat_tol`` :math:`\bar d^3` is flagged flat (default 1e-6).
     tie_tol : float, optional
