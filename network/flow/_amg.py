@@ -38,6 +38,7 @@ def one_blas_thread():
         _BLAS = ThreadpoolController()
     return _BLAS.limit(limits=1, user_api="blas")
 
+
 @contextlib.contextmanager
 def _seeded_numpy_random(seed: int = 0):
     """NumPy's legacy global generator seeded for the block, its state restored after.

@@ -32,7 +32,7 @@ import scipy.sparse as sp
 from scipy.sparse.csgraph import connected_components
 from scipy.spatial import ConvexHull, Delaunay, QhullError
 
-__all__ = ["ENGINES", "GMSH_MIN_CENTRES", "QHULL_OPTIONS", "delaunay"]
+__all__ = ["CHUNK", "ENGINES", "FACES", "GMSH_MIN_CENTRES", "QHULL_OPTIONS", "delaunay"]
 
 log = logging.getLogger(__name__)
 
@@ -44,13 +44,14 @@ ENGINES = ("auto", "gmsh", "qhull")
 #: below this many centres Qhull is as fast as gmsh with its import and checks (fresh process:
 #: 0.05 against 0.02 s at 1 000 centres, even at 3 000-5 000, 0.38 against 0.76 s at 20 000)
 GMSH_MIN_CENTRES = 4000
-# face k of a tetrahedron is opposite vertex k (scipy's ``neighbors`` convention)
-_FACE = np.array([[1, 2, 3], [0, 2, 3], [0, 1, 3], [0, 1, 2]])
+#: vertices of face k of a tetrahedron: the face opposite vertex k (scipy's ``neighbors``
+#: convention)
+FACES = np.array([[1, 2, 3], [0, 2, 3], [0, 1, 3], [0, 1, 2]])
 # relative tolerance of the volume and area checks
 _VOLUME_TOL = 1e-9
 _GMSH_LOCK = threading.Lock()
-# rows per chunk of the volume sum (bounds its temporaries at a million centres)
-_CHUNK = 262_144
+#: rows per chunk of vectorised geometry (bounds the temporaries at a million centres)
+CHUNK = 262_144
 
 
 class _Unchecked(Exception):
@@ -116,7 +117,7 @@ def _all_keys(simp: np.ndarray, n: int) -> np.ndarray:
     vertex k), from the columns (no (4 Nt, 3) face array)."""
     c = [simp[:, i] for i in range(4)]
     key = np.empty((simp.shape[0], 4), dtype=np.int64)
-    for k, (a, b, d) in enumerate(_FACE):
+    for k, (a, b, d) in enumerate(FACES):
         key[:, k] = (c[a] * n + c[b]) * n + c[d]
     return key.ravel()
 
@@ -149,7 +150,7 @@ def _faces(simp: np.ndarray, slots: np.ndarray) -> np.ndarray:
     """Faces (M, 3) of the slots 4 t + k of tetrahedra with ascending rows (face k opposite
     vertex k, itself ascending)."""
     t, k = np.divmod(slots, 4)
-    return simp[t[:, None], _FACE[k]]
+    return simp[t[:, None], FACES[k]]
 
 
 def _orientation(f: np.ndarray, x: np.ndarray) -> np.ndarray:
@@ -243,9 +244,9 @@ def _gmsh_checked(pts: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         neigh = np.concatenate([neigh, np.full(extra.size, -1, dtype=np.int64)])
         slots = np.concatenate([single, n_old + np.arange(extra.size)])
         single = _match(_keys(_faces(simp, slots), n), slots, neigh)
-    volume = sum(np.abs(np.linalg.det(pts[simp[a:a + _CHUNK, 1:]]
-                                      - pts[simp[a:a + _CHUNK, :1]])).sum()
-                 for a in range(0, simp.shape[0], _CHUNK)) / 6.0
+    volume = sum(np.abs(np.linalg.det(pts[simp[a:a + CHUNK, 1:]]
+                                      - pts[simp[a:a + CHUNK, :1]])).sum()
+                 for a in range(0, simp.shape[0], CHUNK)) / 6.0
     try:
         hull = ConvexHull(pts, qhull_options="Qc")
     except QhullError as e:

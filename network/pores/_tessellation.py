@@ -34,17 +34,11 @@ import scipy.sparse as sp
 from scipy.sparse.csgraph import connected_components
 
 from ..packing import Packing
-from ._delaunay import ENGINES, QHULL_OPTIONS, delaunay
+from ._delaunay import CHUNK, ENGINES, FACES, QHULL_OPTIONS, delaunay
 
 __all__ = ["ENGINES", "Tessellation", "tessellate", "QHULL_OPTIONS", "tie_groups"]
 
 log = logging.getLogger(__name__)
-
-# rows per chunk of the vectorised geometry (bounds the temporaries of 500k-sphere packings)
-_CHUNK = 262_144
-
-# face k of a tetrahedron is opposite vertex k (scipy's ``neighbors`` convention)
-_FACE = np.array([[1, 2, 3], [0, 2, 3], [0, 1, 3], [0, 1, 2]])
 
 
 @dataclasses.dataclass(frozen=True)
@@ -173,8 +167,8 @@ def _pore_geometry(pts, simp):
     centroid = np.empty((n_p, 3))
     volume = np.empty(n_p)
     circ = np.empty((n_p, 3))
-    for a in range(0, n_p, _CHUNK):
-        b = min(a + _CHUNK, n_p)
+    for a in range(0, n_p, CHUNK):
+        b = min(a + CHUNK, n_p)
         pv = pts[simp[a:b]]                                   # (m, 4, 3)
         centroid[a:b] = pv.mean(axis=1)
         det = np.linalg.det(pv[:, 1:] - pv[:, :1])
@@ -297,9 +291,9 @@ def tessellate(packing: Packing, *, qhull_options: str = QHULL_OPTIONS,
     fn = nb[slots]
     n_t = slots.size
     tv = np.empty((n_t, 3), dtype=np.int64)
-    for a in range(0, n_t, _CHUNK):
-        b = min(a + _CHUNK, n_t)
-        tv[a:b] = np.sort(simp[ft[a:b, None], _FACE[fk[a:b]]], axis=1)
+    for a in range(0, n_t, CHUNK):
+        b = min(a + CHUNK, n_t)
+        tv[a:b] = np.sort(simp[ft[a:b, None], FACES[fk[a:b]]], axis=1)
     del fk
     # throat id of every (pore, face) slot
     tid = np.full(n_p * 4, -1, dtype=np.int64)
@@ -308,8 +302,8 @@ def tessellate(packing: Packing, *, qhull_options: str = QHULL_OPTIONS,
     # the other side of each interior face: find k' with neigh[fn, k'] == ft
     inner = fn >= 0
     inner_idx = np.flatnonzero(inner)
-    for a in range(0, inner_idx.size, _CHUNK):
-        j = inner_idx[a:a + _CHUNK]
+    for a in range(0, inner_idx.size, CHUNK):
+        j = inner_idx[a:a + CHUNK]
         other_k = np.argmax(neigh[fn[j]] == ft[j, None], axis=1)
         tid[fn[j] * 4 + other_k] = j
     pore_throats = tid.reshape(n_p, 4)
@@ -319,8 +313,8 @@ def tessellate(packing: Packing, *, qhull_options: str = QHULL_OPTIONS,
     sides = np.empty((n_t, 3))
     area = np.empty(n_t)
     tcent = np.empty((n_t, 3))
-    for a in range(0, n_t, _CHUNK):
-        b = min(a + _CHUNK, n_t)
+    for a in range(0, n_t, CHUNK):
+        b = min(a + CHUNK, n_t)
         p0, p1, p2 = pts[tv[a:b, 0]], pts[tv[a:b, 1]], pts[tv[a:b, 2]]
         sides[a:b, 0] = _norm(p1 - p0)
         sides[a:b, 1] = _norm(p2 - p0)
