@@ -16,7 +16,7 @@ law; :data:`DERIVED_LAW`: the law derived from single-constriction Navier-Stokes
   copied 3 x 3 x 3, the middle two periods as the sample, as
   :func:`random_sample_permeability` does;
 * :func:`finney_inertial_case`: a cube from the centre of Finney's (1970) measured random dense
-  packing (``/work/shared/data/finney``, packing fraction about 0.636);
+  packing (``shared/data/finney`` beside the checkout, packing fraction about 0.636);
 * :func:`lattice_inertial_case`: simple-cubic / BCC / FCC arrays (no reference ratio: Hill,
   Koch & Ladd's ordered-array numbers were not found in the stored references).
 
@@ -66,8 +66,13 @@ CHAIN_LAW = dict(INERTIAL_LAWS["chain"])
 #: ``network.solve``'s default law since session 11.
 WINDOW_LAW = dict(INERTIAL_LAWS["window"])
 
-#: Finney's packing, central subset (radius 1, lengths in sphere radii).
-FINNEY_PATH = Path("/work/shared/data/finney/finney_subset_4021.csv")
+#: Finney's packing, central subset (radius 1, lengths in sphere radii): in the ``shared/``
+#: folder beside the checkout (``../shared`` of the repository root, as a fresh clone has it),
+#: else at the development machine's ``/work/shared``.
+_FINNEY = Path("data/finney/finney_subset_4021.csv")
+FINNEY_PATH = next((p for p in (Path(__file__).resolve().parents[3] / "shared" / _FINNEY,
+                                Path("/work/shared") / _FINNEY) if p.exists()),
+                   Path(__file__).resolve().parents[3] / "shared" / _FINNEY)
 
 
 @dataclasses.dataclass
