@@ -25,6 +25,9 @@ default_db_path()
     ``$GRAINFLOW_CACHE_DB`` or ``~/.cache/grainflow/throats.sqlite``.
 GridSpec, GridTable, GRIDS, grid_coordinates, load_grid_table, CALIBRATED_SAFETY
     The interpolation grid over :math:`(\delta_{12}, \delta_{13}, \delta_{23}, \rho_1, \rho_2)`.
+point_kernel() / GridTable.kernel_arrays()
+    The grid's evaluation at one throat, numba-compiled, for compiled callers (bit for bit
+    the table's own).
 
 Command lines: ``python -m cache.precompute``, ``python -m cache.lookup``, ``python -m cache.bench``.
 
@@ -38,6 +41,7 @@ meshes or solves itself: it calls ``throats``.
 
 from ._build import PrecomputeSummary, precompute_grid, precompute_throats
 from ._dask import DaskConnectError, dask_executor
+from ._kernel import point_kernel
 from ._interp import CALIBRATED_SAFETY, ERROR_SAFETY, GRIDS, GridSpec, GridTable, grid_coordinates
 from ._lookup import (POLICIES, SOURCES, Lookup, default_db_path, export_grid, load_grid_table,
                       lookup_qstar, shipped_grid_path)
@@ -48,4 +52,5 @@ __all__ = ["signature", "shape_keys", "QUANTUM", "lookup_qstar", "Lookup", "POLI
            "default_db_path", "precompute_throats", "precompute_grid", "PrecomputeSummary", "open_store",
            "ThroatStore", "CacheFileError", "GridSpec", "GridTable", "GRIDS",
            "grid_coordinates", "load_grid_table", "export_grid", "shipped_grid_path",
-           "dask_executor", "DaskConnectError", "CALIBRATED_SAFETY", "ERROR_SAFETY"]
+           "dask_executor", "DaskConnectError", "CALIBRATED_SAFETY", "ERROR_SAFETY",
+           "point_kernel"]

@@ -355,6 +355,28 @@ class GridTable:
                            for k in self._k],
                      "ok": self.cell_ok.ravel(), "err": None}
 
+    def kernel_arrays(self, snap=GAP_SNAP):
+        """The arguments after the throat of :func:`cache._kernel.interp_point`: gap axis,
+        radius axis (first, last, 1/step, count), strides, float32 values, and per node its
+        five float32 curvatures and whether its cell is served (one row, (n, 6), one cache
+        line per lookup); None for a grid the kernel cannot take (a one-node axis)."""
+        if any(len(a) < 2 for a in self._axes):
+            return None
+        rho = self._axes[3]
+        if not np.array_equal(rho, self._axes[4]) or not all(self._uniform[3:]):
+            return None
+        if getattr(self, "_kernel", None) is None:
+            self._prepare()
+            f = self._f32
+            curv = np.zeros((f["views"][0].size, 6), dtype=np.float32)
+            for d, k in enumerate(f["k"]):
+                if k is not None:
+                    curv[:, d] = k
+            curv[:, 5] = f["ok"]
+            self._kernel = (self._axes[0], float(rho[0]), float(rho[-1]),
+                            1.0 / (rho[1] - rho[0]), len(rho), self._strides, f["views"][0], curv)
+        return self._kernel + (float(snap),)
+
     def _eval(self, x, errors=True):
         """ln Q* and error of one chunk; ``x`` the 5 coordinate columns, each (n,)."""
         self._prepare()

@@ -11,7 +11,7 @@ import numpy as np
 
 from cache import default_db_path, load_grid_table, open_store
 
-__all__ = ["default_table", "has_grid", "table_totals"]
+__all__ = ["default_table", "grid_alone", "has_grid", "table_totals"]
 
 
 def default_table() -> Path | None:
@@ -28,6 +28,25 @@ def has_grid(db) -> bool:
         return load_grid_table(db) is not None
     except Exception:  # noqa: BLE001 - no cache, no grid, foreign file: no table
         return False
+
+
+def grid_alone(db):
+    """The grid's :meth:`cache.GridTable.kernel_arrays` when the 'table-only' policy is served
+    by the interpolation grid alone (``db``, None the default table, holds no stored FE rows,
+    which would come first); None otherwise (no grid, stored rows, a grid the kernel cannot
+    take)."""
+    path = Path(db) if db is not None else default_table()
+    if path is None:
+        return None
+    try:
+        if path.exists() and path.stat().st_size > 0:
+            with open_store(path, create=False, check=False) as store:
+                if store.count() > 0:
+                    return None
+        table = load_grid_table(db)
+    except Exception:  # noqa: BLE001 - no cache, foreign file: the general path decides
+        return None
+    return None if table is None else table.kernel_arrays()
 
 
 def table_totals(path) -> tuple[int, float]:

@@ -23,8 +23,9 @@ from typing import Callable
 import numpy as np
 
 from .._air import MU_AIR_PA_S, RHO_AIR_KG_M3, check_density, check_positive, check_viscosity
-from ..conductance import (CHAIN_ONSET_SLOPE, CHAIN_RECOVERY, PORE_ONSET_SLOPE, PORE_RECOVERY,
-                           check_model, check_policy, conduit_law, has_grid, throat_conductance)
+from ..conductance import (CHAIN_ONSET_SLOPE, CHAIN_RECOVERY, KERNEL_MIN_THROATS, PORE_ONSET_SLOPE,
+                           PORE_RECOVERY, check_model, check_policy, conduit_law, has_grid,
+                           load_conduit_kernel, throat_conductance)
 from ..packing import Packing
 from ..pores import (Region, Tessellation, axis_index, default_region, merge_pores,
                      prune_disconnected, region_porosity, select_sample, tessellate, tie_groups)
@@ -180,8 +181,7 @@ def solve_network(packing: Packing, *, axis="z", region: Region | None = None,
     if inertia and (conductance is not None or conductance_model != "conduit"):
         raise ValueError("inertia needs the conduit model (its window and body areas); "
                          f"got {conductance_model if conductance is None else 'custom'}")
-    times: dict = {}
-    peaks: dict = {}
+    times, peaks = {}, {}
 
     def stage(name):
         return _Stage(name, times, peaks, trace_memory)
@@ -193,14 +193,15 @@ def solve_network(packing: Packing, *, axis="z", region: Region | None = None,
                           axis=axis) if region is None else region)
     eps_job = None
     if threads > 1:
-        # work that needs no tessellation, on a second core while Qhull (which releases the
-        # GIL) runs: the Q* table's load, pyamg's import, the porosity; the thread ends
-        # with its job
-        side = ThreadPoolExecutor(1)
+        # work that needs no tessellation, on a second core while gmsh or Qhull (which release
+        # the GIL) runs: the Q* table's load (and the compiled conduit loop's for a large
+        # packing), pyamg's import, the porosity; the thread ends with its job
+        side, own = ThreadPoolExecutor(1), conductance is None
         eps_job = side.submit(_beside_qhull, packing, reg, ax,
                               porosity_points if porosity is None else 0,
-                              db if conductance is None and policy != "shape-factor"
-                              else False)
+                              db if own and policy != "shape-factor" else False,
+                              own and conductance_model == "conduit" and policy == "table-only"
+                              and qstar_fn is None and 10 * packing.n >= KERNEL_MIN_THROATS)
         side.shutdown(wait=False)
     with stage("tessellate"):
         tess = tessellate(packing, threads=threads) if tessellation is None else tessellation
@@ -316,12 +317,12 @@ def solve_network(packing: Packing, *, axis="z", region: Region | None = None,
         throat_qstar=None if window_qstar is None else window_qstar[sample.throats])
 
 
-def _beside_qhull(packing, reg, ax, porosity_points, db):
-    """The Q* table loaded (``db``; False: none needed), pyamg imported, and the region's
-    (porosity, standard error) when ``porosity_points`` (else None): what
-    :func:`solve_network` runs beside the tessellation."""
-    if db is not False:
-        has_grid(db)
+def _beside_qhull(packing, reg, ax, porosity_points, db, kernel=False):
+    """The Q* table loaded (``db``; False: none needed), the compiled conduit loop loaded
+    (``kernel``), pyamg imported, and the region's (porosity, standard error) when
+    ``porosity_points`` (else None): what :func:`solve_network` runs beside the tessellation."""
+    if db is not False and has_grid(db) and kernel:
+        load_conduit_kernel(db)
     import pyamg  # noqa: F401 - imported here, beside Qhull, instead of in the solve stage
     return region_porosity(packing, reg, ax, n_points=porosity_points) if porosity_points \
         else None
