@@ -217,10 +217,12 @@ def conduit_conductance(tessellation, throats_idx=None, *, viscosity_pa_s: float
 
 #: Fewest throats for which :func:`conduit_conductance` runs the compiled loop
 #: (:mod:`._conduit_kernel`): importing numba and loading the loop from its cache cost
-#: 0.5-0.6 s of one core (held GIL) in a fresh process, the loop saves about 4 µs of CPU
-#: per throat (1.3 against 0.6 s of one core at 249 000 throats). A packing of N spheres
-#: gives about 10 N sample throats.
-KERNEL_MIN_THROATS = 100_000
+#: 0.5-0.6 s of one core, with the GIL held, in a fresh process; the loop saves about
+#: 1.5-2 µs per throat of a two-thread stage (0.92 -> 0.45-0.59 s at 249 000 throats). At
+#: 20 000 spheres (192 000 sample throats) the two cancel (the load slows the tessellation
+#: beside it by as much as the stage gains), at 100 000 it gains 2.7 s. A packing of N
+#: spheres gives about 10 N sample throats.
+KERNEL_MIN_THROATS = 300_000
 
 
 def load_conduit_kernel(db=None) -> bool:
