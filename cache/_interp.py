@@ -356,7 +356,7 @@ class GridTable:
                      "ok": self.cell_ok.ravel(), "err": None}
 
     def kernel_arrays(self, snap=GAP_SNAP):
-        """The arguments after the throat of :func:`cache._kernel.interp_point`: gap axis,
+        """The arguments after the throat of :func:`cache.point_kernel`'s function: gap axis,
         radius axis (first, last, 1/step, count), strides, float32 values, and per node its
         five float32 curvatures and whether its cell is served (one row, (n, 6), one cache
         line per lookup); None for a grid the kernel cannot take (a one-node axis)."""

@@ -65,7 +65,9 @@ def conduit_conductance(tessellation, throats_idx=None, *, viscosity_pa_s: float
     viscosity_pa_s : float, keyword-only
         μ (default 1.932e-5 Pa s, air as in the thesis).
     policy, rtol, db, workers, progress : keyword-only
-        Q* policy and options, as ``network._conductance.throat_qstar``.
+        Q* policy and options, as ``network._conductance.throat_qstar``. 'table-only' with
+        the grid alone (no stored FE rows) on :data:`KERNEL_MIN_THROATS` throats or more runs
+        the compiled loop of :mod:`._conduit_kernel` (the same bits, 2-2.5x faster).
     sections : {'qstar', 'ratio'}, keyword-only
         'qstar' (default): the Q* policy answers every section (n_sections + 1 per throat);
         'ratio': the policy answers the window only, the profile comes from
