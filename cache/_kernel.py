@@ -32,7 +32,7 @@ def point_kernel():
 
                 inline = numba.njit(inline="always", error_model="numpy")
                 g = globals()
-                for name in ("_lerp", "_square", "_cube"):
+                for name in ("_gap_cell", "_rho_cell", "_lerp", "_square", "_cube"):
                     g[name] = inline(g[name])
                 _COMPILED.append(numba.njit(cache=True, nogil=True,
                                             error_model="numpy")(interp_point))
@@ -50,53 +50,14 @@ def interp_point(r0, r1, r2, s0, s1, s2, gap, rho_lo, rho_hi, rho_inv, n_rho, st
     :meth:`GridTable.kernel_arrays`.
     """
     inv = 1.0 / ((r0 + r1 + r2) * (1.0 / 3.0))
-    ng = gap.shape[0]
-    outside = False
-    base = 0
-    t0 = t1 = t2 = t3 = t4 = np.float32(0.0)
-    for d in range(5):
-        if d == 0:
-            xd = (s0 - r0 - r1) * inv
-        elif d == 1:
-            xd = (s1 - r0 - r2) * inv
-        elif d == 2:
-            xd = (s2 - r1 - r2) * inv
-        elif d == 3:
-            xd = r0 * inv - 1.0
-        else:
-            xd = r1 * inv - 1.0
-        if d < 3:
-            key = xd + snap                      # searchsorted(gap, key, 'right') - 1
-            lo, hi = 0, ng
-            while lo < hi:
-                mid = (lo + hi) >> 1
-                if gap[mid] <= key:
-                    lo = mid + 1
-                else:
-                    hi = mid
-            i = min(max(lo - 1, 0), ng - 2)
-            a = gap[i]
-            td = np.float32((xd - a) / (gap[i + 1] - a))
-            if xd < gap[0] - 1e-9 or xd > gap[ng - 1] + 1e-9:
-                outside = True
-        else:
-            fd = (xd - rho_lo) * rho_inv
-            fi = min(max(np.floor(fd), 0.0), n_rho - 2.0)
-            td = np.float32(fd - fi)
-            i = int(fi)
-            if xd < rho_lo - 1e-9 or xd > rho_hi + 1e-9:
-                outside = True
-        base += i * strides[d]
-        if d == 0:
-            t0 = td
-        elif d == 1:
-            t1 = td
-        elif d == 2:
-            t2 = td
-        elif d == 3:
-            t3 = td
-        else:
-            t4 = td
+    i0, t0, o0 = _gap_cell((s0 - r0 - r1) * inv, gap, snap)
+    i1, t1, o1 = _gap_cell((s1 - r0 - r2) * inv, gap, snap)
+    i2, t2, o2 = _gap_cell((s2 - r1 - r2) * inv, gap, snap)
+    i3, t3, o3 = _rho_cell(r0 * inv - 1.0, rho_lo, rho_hi, rho_inv, n_rho)
+    i4, t4, o4 = _rho_cell(r1 * inv - 1.0, rho_lo, rho_hi, rho_inv, n_rho)
+    outside = o0 or o1 or o2 or o3 or o4
+    base = (i0 * strides[0] + i1 * strides[1] + i2 * strides[2] + i3 * strides[3]
+            + i4 * strides[4])
     # the 32 corners blended by b <- a + t (b - a) in float32 along d = 4, 3, ..., 0, the
     # tree GridTable's chunked evaluation reduces (same pairs, so the same bits)
     s0_, s1_, s2_, s3_, s4_ = strides[0], strides[1], strides[2], strides[3], strides[4]
@@ -110,6 +71,30 @@ def interp_point(r0, r1, r2, s0, s1, s2, gap, rho_lo, rho_hi, rho_inv, n_rho, st
     v -= np.float64(t3 * (one - t3) * kk[3])
     v -= np.float64(t4 * (one - t4) * kk[4])
     return v, kk[5] > 0 and not outside
+
+
+def _gap_cell(x, gap, snap):
+    """(cell index, float32 position in it, outside the axis) on a gap axis:
+    ``searchsorted(gap, x + snap, 'right') - 1`` by bisection, clipped to the cells."""
+    ng = gap.shape[0]
+    key = x + snap
+    lo, hi = 0, ng
+    while lo < hi:
+        mid = (lo + hi) >> 1
+        if gap[mid] <= key:
+            lo = mid + 1
+        else:
+            hi = mid
+    i = min(max(lo - 1, 0), ng - 2)
+    a = gap[i]
+    return i, np.float32((x - a) / (gap[i + 1] - a)), x < gap[0] - 1e-9 or x > gap[ng - 1] + 1e-9
+
+
+def _rho_cell(x, lo, hi, inv_step, n):
+    """(cell index, float32 position in it, outside the axis) on the uniform radius axis."""
+    f = (x - lo) * inv_step
+    fi = min(max(np.floor(f), 0.0), n - 2.0)
+    return int(fi), np.float32(f - fi), x < lo - 1e-9 or x > hi + 1e-9
 
 
 def _lerp(a, b, t):

@@ -1,7 +1,8 @@
 """Leaner imports for command processes (``python -m network.<command>``), issue 18 item 2.
 
-Importing ``scipy.sparse`` and ``scipy.spatial`` (measured with SciPy 1.17.1) costs this project's commands
-about 0.15 s of work they never use, a sixth of a 5 000-sphere ``network.solve``:
+Importing ``scipy.sparse`` and ``scipy.spatial`` (measured with SciPy 1.17.1) costs this
+project's commands about 0.15 s of work they never use, a sixth of a 5 000-sphere
+``network.solve``:
 
 - SciPy's array-API layer clones the ``numpy`` namespace (``dir(numpy)`` and ``getattr`` of every
   name), which executes NumPy's lazily loaded ``numpy.f2py`` (and through it

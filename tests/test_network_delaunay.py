@@ -1,4 +1,5 @@
-"""gmsh's Delaunay kernel, completed at the hull and checked, against Qhull (network.pores._delaunay)."""
+"""gmsh's Delaunay kernel, completed at the hull and checked, against Qhull
+(network.pores._delaunay)."""
 
 import logging
 

@@ -16,11 +16,12 @@ from ._result import ConductanceResult
 from ._table import default_table, has_grid, table_totals
 from ._thesis import thesis_conductance
 
-__all__ = ["KERNEL_MIN_THROATS", "CHAIN_ONSET_SLOPE", "CHAIN_RECOVERY", "CHAIN_WINDOW_TABLE", "MODELS", "ONSET_SLOPE",
-           "PORE_ONSET_SLOPE", "PORE_RECOVERY", "POLICIES",
+__all__ = ["CHAIN_ONSET_SLOPE", "CHAIN_RECOVERY", "CHAIN_WINDOW_TABLE", "KERNEL_MIN_THROATS",
+           "MODELS", "ONSET_SLOPE", "PORE_ONSET_SLOPE", "PORE_RECOVERY", "POLICIES",
            "SECTION_MODES", "ConductanceResult", "QstarResult", "check_model", "check_policy",
            "conduit_conductance", "conduit_law",
            "contraction_coefficient", "default_table", "expansion_coefficient", "has_grid",
-           "inertial_coefficients", "load_conduit_kernel", "onset_scales", "qstar_from_function", "section_estimate",
+           "inertial_coefficients", "load_conduit_kernel", "onset_scales",
+           "qstar_from_function", "section_estimate",
            "side_resistance", "table_totals", "thesis_conductance", "throat_conductance",
            "throat_qstar", "turning_cosines", "window_constants"]

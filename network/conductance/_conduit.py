@@ -276,10 +276,7 @@ def _kernel_block(r_n, s_n, h_n, mu, n_sections, grid, numpy_rows, rtol=1e-3):
     compiled_conduit_rows()(np.ascontiguousarray(r_n), np.ascontiguousarray(s_n),
                             np.ascontiguousarray(h_n), np.linspace(0.0, 1.0, int(n_sections) + 1),
                             *grid, q_win, R, looked, flagged)
-    Rt = (R[:, 0] + R[:, 1]) * mu
-    with np.errstate(divide="ignore", over="ignore"):
-        gg = np.where(np.isinf(Rt), 0.0, 1.0 / np.where(Rt > 0, Rt, np.nan))
-    gg = np.where(Rt == 0, np.nan, gg)
+    gg = _conductance(R, mu)
     rows = np.flatnonzero(flagged)
     done = n - rows.size
     qstats = {"n": done, "policy": "table-only", "rtol": rtol, "n_fe": 0,
@@ -331,7 +328,13 @@ def _conduit_block(r_n, s_n, h_n, mu, section_stats, throat_qstar, *, sections, 
             out[live] = qq
             return out
     R = side_resistance(r_n, s_n, h_n, y0, n_sections=n_sections, section_q=section_q)
-    Rt = R.sum(axis=1) * mu
-    with np.errstate(divide="ignore"):
+    return q_win, _conductance(R, mu), qres.stats
+
+
+def _conductance(R, mu):
+    """g = 1/(μ (R_P + R_Q)) of conduits from their halves' R/μ (N, 2): 0 for a closed one
+    (R = inf), NaN for a zero length (R = 0: sliver to sliver)."""
+    Rt = (R[:, 0] + R[:, 1]) * mu
+    with np.errstate(divide="ignore", over="ignore"):
         gg = np.where(np.isinf(Rt), 0.0, 1.0 / np.where(Rt > 0, Rt, np.nan))
-    return q_win, np.where(Rt == 0, np.nan, gg), qres.stats
+    return np.where(Rt == 0, np.nan, gg)

@@ -18,7 +18,8 @@ import numpy as np
 import throats
 from cache import POLICIES, SOURCES, lookup_qstar
 
-__all__ = ["POLICIES", "SOURCES", "QstarResult", "check_policy", "throat_qstar", "qstar_from_function"]
+__all__ = ["POLICIES", "SOURCES", "QstarResult", "check_policy", "throat_qstar",
+           "qstar_from_function"]
 
 log = logging.getLogger(__name__)
 

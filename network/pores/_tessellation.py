@@ -337,7 +337,8 @@ def tessellate(packing: Packing, *, qhull_options: str = QHULL_OPTIONS,
         log.warning("%d sphere(s) are in no tetrahedron (coincident with another centre to "
                     "Qhull precision)", coplanar.size)
     log.info("tessellated %d spheres (%s): %d pores (%d flat), %d throats (%d on the hull, "
-             "%d tied)", packing.n, used, n_p, int(flat.sum()), n_t, int((~inner).sum()), int(tied.sum()))
+             "%d tied)", packing.n, used, n_p, int(flat.sum()), n_t, int((~inner).sum()),
+             int(tied.sum()))
     if origin is not None:
         centroid += origin
         circ += origin
