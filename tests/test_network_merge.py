@@ -24,6 +24,21 @@ def test_circumsphere_closed_form():
     assert np.isnan(r[0])                                   # flat: no circumsphere
 
 
+def test_circumsphere_equidistant_and_order_free():
+    """The closed form's centre is equidistant from the four vertices to round-off, the same
+    from any base vertex, and matches LAPACK's solve of 2 e_i . c' = |e_i|^2."""
+    rng = np.random.default_rng(7)
+    p = rng.normal(size=(2000, 4, 3))
+    c, r = circumspheres(p)
+    d = np.linalg.norm(p - c[:, None], axis=2)
+    np.testing.assert_allclose(d, np.repeat(r[:, None], 4, axis=1), rtol=1e-11)
+    c2, _ = circumspheres(p[:, [2, 0, 3, 1]])
+    np.testing.assert_allclose(c2, c, rtol=1e-11, atol=1e-11 * r.max())
+    e = p[:, 1:] - p[:, :1]
+    lu = np.linalg.solve(e, 0.5 * np.einsum("nij,nij->ni", e, e)[..., None])[..., 0] + p[:, 0]
+    np.testing.assert_allclose(c, lu, rtol=1e-11, atol=1e-11 * r.max())
+
+
 def test_cube_is_one_body_centred():
     c = np.array(list(itertools.product([0.0, 1.0], repeat=3))) * 2e-3
     t = tessellate(Packing(c, np.full(8, 0.8e-3)))

@@ -32,6 +32,8 @@ import scipy.sparse as sp
 from scipy.sparse.csgraph import connected_components
 from scipy.spatial import ConvexHull, Delaunay, QhullError
 
+from ._simplex import cross_rows, edge_determinants, row_norm
+
 __all__ = ["CHUNK", "ENGINES", "FACES", "GMSH_MIN_CENTRES", "QHULL_OPTIONS", "delaunay"]
 
 log = logging.getLogger(__name__)
@@ -158,7 +160,7 @@ def _orientation(f: np.ndarray, x: np.ndarray) -> np.ndarray:
     or 0 where the floating-point determinant is within its error bound (Shewchuk's orient3d
     filter, widened 10x) of zero."""
     u, v, w = f[:, 1] - f[:, 0], f[:, 2] - f[:, 0], x - f[:, 0]
-    det = np.einsum("ij,ij->i", u, np.cross(v, w))
+    det = (u * cross_rows(v, w)).sum(axis=1)
     au, av, aw = np.abs(u), np.abs(v), np.abs(w)
     perm = (au[:, 0] * (av[:, 1] * aw[:, 2] + av[:, 2] * aw[:, 1])
             + au[:, 1] * (av[:, 2] * aw[:, 0] + av[:, 0] * aw[:, 2])
@@ -244,8 +246,7 @@ def _gmsh_checked(pts: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         neigh = np.concatenate([neigh, np.full(extra.size, -1, dtype=np.int64)])
         slots = np.concatenate([single, n_old + np.arange(extra.size)])
         single = _match(_keys(_faces(simp, slots), n), slots, neigh)
-    volume = sum(np.abs(np.linalg.det(pts[simp[a:a + CHUNK, 1:]]
-                                      - pts[simp[a:a + CHUNK, :1]])).sum()
+    volume = sum(np.abs(edge_determinants(pts, simp[a:a + CHUNK])).sum()
                  for a in range(0, simp.shape[0], CHUNK)) / 6.0
     try:
         hull = ConvexHull(pts, qhull_options="Qc")
@@ -259,7 +260,7 @@ def _gmsh_checked(pts: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     on_hull[hull.coplanar[:, 0]] = True
     outer = _faces(simp, single)
     x = pts[outer]                                          # (F, 3, 3)
-    area = 0.5 * np.linalg.norm(np.cross(x[:, 1] - x[:, 0], x[:, 2] - x[:, 0]), axis=1).sum()
+    area = 0.5 * row_norm(cross_rows(x[:, 1] - x[:, 0], x[:, 2] - x[:, 0])).sum()
     if not on_hull[outer].all() or not abs(area - hull.area) <= _VOLUME_TOL * hull.area:
         raise _Unchecked("an unmatched face inside the hull")
     return simp, neigh.reshape(-1, 4)

@@ -45,6 +45,8 @@ import numpy as np
 import scipy.sparse as sp
 from scipy.sparse.csgraph import connected_components
 
+from ._simplex import circumcentres, cross_rows, row_norm
+
 __all__ = ["PoreMerge", "merge_pores", "circumspheres"]
 
 logger = logging.getLogger(__name__)
@@ -100,22 +102,9 @@ def circumspheres(points):
     ([[0.5, 0.5, 0.5]], 0.75)
     """
     p = np.asarray(points, dtype=float)
-    e = p[:, 1:] - p[:, :1]
-    rhs = 0.5 * np.einsum("nij,nij->ni", e, e)
-    det = np.linalg.det(e)
-    scale = np.einsum("nij,nij->n", e, e) ** 1.5 / 3 ** 1.5
-    ok = np.abs(det) > 1e-12 * np.maximum(scale, 1e-300)
-    c = np.full((p.shape[0], 3), np.nan)
-    if ok.any():
-        c[ok] = np.linalg.solve(e[ok], rhs[ok][..., None])[..., 0] + p[ok, 0]
-    r = _norm(c - p[:, 0])
-    return c, r
-
-
-def _norm(v):
-    """Row lengths of an (N, 3) array: np.linalg.norm(v, axis=1), same bits, without the slow
-    reduction over a length-3 axis."""
-    return np.sqrt(v[:, 0] * v[:, 0] + v[:, 1] * v[:, 1] + v[:, 2] * v[:, 2])
+    c, _ = circumcentres(p.reshape(-1, 3), np.arange(4 * p.shape[0]).reshape(-1, 4),
+                         flat_tol=1e-12)
+    return c, row_norm(c - p[:, 0])
 
 
 def merge_pores(tessellation, *, tolerance: float = 0.02, min_quality: float = 0.2,
@@ -171,12 +160,12 @@ def merge_pores(tessellation, *, tolerance: float = 0.02, min_quality: float = 0
     # the tessellation's circumcentres (the same solve; NaN only for |det| = 0, where the
     # quality below is 0 and the tetrahedron flat either way)
     cen = t.pore_circumcenter
-    rad = _norm(cen - xyz[:, 0])
+    rad = row_norm(cen - xyz[:, 0])
     # radius ratio 3 r_in / R, r_in = 3 V / (sum of face areas)
     fa = 0.0
     for f in ((1, 2, 3), (0, 2, 3), (0, 1, 3), (0, 1, 2)):
         a, b, c = xyz[:, f[0]], xyz[:, f[1]], xyz[:, f[2]]
-        fa = fa + 0.5 * _norm(np.cross(b - a, c - a))
+        fa = fa + 0.5 * row_norm(cross_rows(b - a, c - a))
     with np.errstate(divide="ignore", invalid="ignore"):
         quality = 9.0 * t.pore_volume / (fa * rad)
     flat = ~(quality >= min_quality)
@@ -191,8 +180,8 @@ def merge_pores(tessellation, *, tolerance: float = 0.02, min_quality: float = 0
     vp, vq = pv[p].sum(axis=1) - face_sum, pv[q].sum(axis=1) - face_sum
     both = ok[p] & ok[q]
     with np.errstate(invalid="ignore"):
-        dq = np.abs(_norm(pts[vq] - cen[p]) - rad[p]) / rad[p]
-        dp = np.abs(_norm(pts[vp] - cen[q]) - rad[q]) / rad[q]
+        dq = np.abs(row_norm(pts[vq] - cen[p]) - rad[p]) / rad[p]
+        dp = np.abs(row_norm(pts[vp] - cen[q]) - rad[q]) / rad[q]
     thr = max(tol, 1e-9)
     merge = both & (dq <= thr) & (dp <= thr)
     mp, mq = p[merge], q[merge]

@@ -35,6 +35,7 @@ from scipy.sparse.csgraph import connected_components
 
 from ..packing import Packing
 from ._delaunay import CHUNK, ENGINES, FACES, QHULL_OPTIONS, delaunay
+from ._simplex import circumcentres, column_norm, cross_components, row_norm
 
 __all__ = ["ENGINES", "Tessellation", "tessellate", "QHULL_OPTIONS", "tie_groups"]
 
@@ -162,38 +163,19 @@ class Tessellation:
 
 def _pore_geometry(pts, simp):
     """Centroids (N, 3), volumes (N,) and circumcentres (N, 3) of the tetrahedra ``simp`` of
-    ``pts``, in chunks so that the (chunk, 4, 3) temporaries stay small."""
+    ``pts`` (:func:`circumcentres`: V = |D| / 6), in chunks so that the (chunk, 4, 3)
+    temporaries stay small."""
     n_p = simp.shape[0]
     centroid = np.empty((n_p, 3))
     volume = np.empty(n_p)
     circ = np.empty((n_p, 3))
     for a in range(0, n_p, CHUNK):
         b = min(a + CHUNK, n_p)
-        pv = pts[simp[a:b]]                                   # (m, 4, 3)
-        centroid[a:b] = pv.mean(axis=1)
-        det = np.linalg.det(pv[:, 1:] - pv[:, :1])
+        s = simp[a:b]                # the centroid as pv.mean(axis=1) sums it: same bits
+        centroid[a:b] = (((pts[s[:, 0]] + pts[s[:, 1]]) + pts[s[:, 2]]) + pts[s[:, 3]]) / 4.0
+        circ[a:b], det = circumcentres(pts, simp[a:b])
         volume[a:b] = np.abs(det) / 6.0
-        circ[a:b] = _circumcenters(pv, det)
     return centroid, volume, circ
-
-
-def _circumcenters(p: np.ndarray, det=None) -> np.ndarray:
-    """Circumcentres of tetrahedra given as (N, 4, 3) vertex coordinates (NaN when flat);
-    ``det`` the determinant of their edge vectors when the caller has it."""
-    a = p[:, 1:] - p[:, :1]                      # (N, 3, 3) edge vectors
-    rhs = 0.5 * np.einsum("nij,nij->ni", a, a)   # |e|^2 / 2
-    det = np.linalg.det(a) if det is None else det
-    ok = np.abs(det) > 0
-    out = np.full((p.shape[0], 3), np.nan)
-    if ok.any():
-        out[ok] = np.linalg.solve(a[ok], rhs[ok][..., None])[..., 0] + p[ok, 0]
-    return out
-
-
-def _norm(v):
-    """Row lengths of an (N, 3) array: np.linalg.norm(v, axis=1), same bits, without the slow
-    reduction over a length-3 axis."""
-    return np.sqrt(v[:, 0] * v[:, 0] + v[:, 1] * v[:, 1] + v[:, 2] * v[:, 2])
 
 
 def _local_frame(centers):
@@ -291,9 +273,13 @@ def tessellate(packing: Packing, *, qhull_options: str = QHULL_OPTIONS,
     fn = nb[slots]
     n_t = slots.size
     tv = np.empty((n_t, 3), dtype=np.int64)
+    # ascending rows (gmsh's, sorted by the engine) give ascending faces as they stand
+    ascending = bool(np.all(simp[:, :-1] < simp[:, 1:]))
     for a in range(0, n_t, CHUNK):
         b = min(a + CHUNK, n_t)
-        tv[a:b] = np.sort(simp[ft[a:b, None], FACES[fk[a:b]]], axis=1)
+        tv[a:b] = simp[ft[a:b, None], FACES[fk[a:b]]]
+        if not ascending:
+            tv[a:b].sort(axis=1)
     del fk
     # throat id of every (pore, face) slot
     tid = np.full(n_p * 4, -1, dtype=np.int64)
@@ -315,18 +301,19 @@ def tessellate(packing: Packing, *, qhull_options: str = QHULL_OPTIONS,
     tcent = np.empty((n_t, 3))
     for a in range(0, n_t, CHUNK):
         b = min(a + CHUNK, n_t)
-        p0, p1, p2 = pts[tv[a:b, 0]], pts[tv[a:b, 1]], pts[tv[a:b, 2]]
-        sides[a:b, 0] = _norm(p1 - p0)
-        sides[a:b, 1] = _norm(p2 - p0)
-        sides[a:b, 2] = _norm(p2 - p1)
-        area[a:b] = 0.5 * _norm(np.cross(p1 - p0, p2 - p0))
-        tcent[a:b] = (p0 + p1 + p2) / 3.0
+        x = pts.T[:, tv[a:b].T]                  # (3 components, 3 vertices, m): contiguous
+        p0, p1, p2 = x[:, 0], x[:, 1], x[:, 2]
+        e1, e2, e3 = p1 - p0, p2 - p0, p2 - p1
+        for k, e in enumerate((e1, e2, e3)):
+            sides[a:b, k] = column_norm(e)
+        area[a:b] = 0.5 * column_norm(cross_components(e1, e2))
+        tcent[a:b] = ((p0 + p1 + p2) / 3.0).T
     if pores is not None:
         centroid, volume, circ = pores.result()
     flat = volume < flat_tol * dbar**3
     tied = np.zeros(n_t, dtype=bool)
     cc = circ[ft[inner]] - circ[fn[inner]]
-    tied[inner] = _norm(cc) < tie_tol * dbar  # NaN compares False
+    tied[inner] = row_norm(cc) < tie_tol * dbar  # NaN compares False
     del cc
     tied[inner] |= flat[ft[inner]] | flat[fn[inner]]
 
