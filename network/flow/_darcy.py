@@ -134,12 +134,13 @@ def core_permeability(sample, g, p, *, margin_m: float, viscosity_pa_s: float = 
     axial_margin_m : float, keyword-only
         Margin at the inlet and outlet ends, m (default ``margin_m``); ``margin_m`` is then
         the lateral one.
-    faces : (Ms, 3, 3) array_like, keyword-only
+    faces : (Ms, 3, 3) array_like or callable, keyword-only
         The three sphere centres of each throat's face, m. Given, a throat crossing a plane
         counts with the fraction of its face (projected along the axis) that lies in the core
         cross-section (:func:`clipped_area_fraction`) instead of where its pore-to-pore
         segment crosses: a lattice's pore columns then count in proportion to the window's
-        area wherever its edges fall.
+        area wherever its edges fall. A callable is given the indices of the throats that
+        cross a plane and returns their faces (k, 3, 3) (only those are gathered).
 
     Returns
     -------
@@ -176,29 +177,31 @@ def core_permeability(sample, g, p, *, margin_m: float, viscosity_pa_s: float = 
                          "axis: enlarge the sample or reduce margin_m")
     grad = -np.polyfit(xa, p[core], 1)[0]
     i, j = sample.conns[:, 0], sample.conns[:, 1]
-    xi, xj = x[i], x[j]
-    q = g * (p[i] - p[j])                                       # flow from i to j
-    ai, aj = xi[:, ax], xj[:, ax]
+    ai, aj = x[i, ax], x[j, ax]
     planes = np.linspace(lo[ax], hi[ax], int(n_planes) + 2)[1:-1]
+    # only the throats whose segment crosses some plane weigh: the others are dropped first
+    crossing = np.zeros(ai.size, dtype=bool)
+    for x0 in planes:
+        crossing |= (ai < x0) != (aj < x0)
+    rows = np.flatnonzero(crossing)
+    i, j, ai, aj = i[rows], j[rows], ai[rows], aj[rows]
+    q = g[rows] * (p[i] - p[j])                                 # flow from i to j
+    sign = np.sign(aj - ai)
     if faces is not None:
-        # the clipped fraction only of throats that cross some plane (the others weigh 0)
-        crossing = np.zeros(q.size, dtype=bool)
-        for x0 in planes:
-            crossing |= (ai < x0) != (aj < x0)
-        rows = np.flatnonzero(crossing)
-        inside = np.zeros(q.size)
-        inside[rows] = clipped_area_fraction(np.asarray(faces, dtype=float)[rows][:, :, lat],
-                                             lo[lat], hi[lat])
+        f = faces(rows) if callable(faces) else np.asarray(faces, dtype=float)[rows]
+        inside = clipped_area_fraction(np.asarray(f, dtype=float)[:, :, lat], lo[lat], hi[lat])
+    else:
+        xi, xj = x[i][:, lat], x[j][:, lat]
     flows = []
     for x0 in planes:
         cross = (ai < x0) != (aj < x0)
         if faces is None:
             t = np.where(cross, (x0 - ai) / np.where(cross, aj - ai, 1.0), 0.0)
-            pt = xi[:, lat] + t[:, None] * (xj[:, lat] - xi[:, lat])
+            pt = xi + t[:, None] * (xj - xi)
             w = cross & np.all((pt >= lo[lat]) & (pt < hi[lat]), axis=1)
         else:
             w = np.where(cross, inside, 0.0)
-        flows.append(np.sum(q * w * np.sign(aj - ai)))
+        flows.append(np.sum(q * w * sign))
     if not np.any(flows):
         raise ValueError("no throat crosses the core planes")
     area = float(np.prod(hi[lat] - lo[lat]))

@@ -45,7 +45,6 @@ DEFAULT_VELOCITY_M_S = 0.013
 #: Bed depth of the thesis's comparison, m.
 DEFAULT_DEPTH_M = 0.25
 
-
 #: Per-conduit inertial laws: options of :func:`network.conductance.conduit_law`
 #: (``docs/inertial-flow.md``). 'pore': smooth contraction, flat-profile expansion against the
 #: body's Stokes outflow direction with the 3-D pore's recovery and window-Re onset slope;
@@ -368,9 +367,10 @@ def _inset_estimate(sample, g, p, region, grain_diameter_m, viscosity_pa_s, tess
                     INSET_MIN_DIAMETERS + 2 * lat)
         return None
     try:
-        faces = tessellation.packing.centers[tessellation.throat_vertices[sample.throats]]
-        k = core_permeability(sample, g, p, margin_m=lat * d, axial_margin_m=end * d,
-                              viscosity_pa_s=viscosity_pa_s, faces=faces)
+        k = core_permeability(  # faces gathered only for the throats crossing a plane
+            sample, g, p, margin_m=lat * d, axial_margin_m=end * d, viscosity_pa_s=viscosity_pa_s,
+            faces=lambda rows: tessellation.packing.centers[
+                tessellation.throat_vertices[sample.throats[rows]]])
     except ValueError as exc:
         log.warning("no boundary-free estimate (%s): permeability_m2 is the whole-sample value",
                     exc)
