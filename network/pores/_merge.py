@@ -45,7 +45,7 @@ import numpy as np
 import scipy.sparse as sp
 from scipy.sparse.csgraph import connected_components
 
-from ._simplex import circumcentres, cross_rows, row_norm
+from ._simplex import circumcentres, column_norm, cross_components, row_norm
 
 __all__ = ["PoreMerge", "merge_pores", "circumspheres"]
 
@@ -156,16 +156,18 @@ def merge_pores(tessellation, *, tolerance: float = 0.02, min_quality: float = 0
     pts = t.packing.centers
     pv = t.pore_vertices
     n_p = pv.shape[0]
-    xyz = pts[pv]                                        # (Np, 4, 3)
+    pts_c = np.ascontiguousarray(pts.T)     # component-major: each gather reads one row
+    x = pts_c[:, pv.T]                      # (3 components, 4 vertices, Np)
     # the tessellation's circumcentres (the same solve; NaN only for |det| = 0, where the
     # quality below is 0 and the tetrahedron flat either way)
     cen = t.pore_circumcenter
-    rad = row_norm(cen - xyz[:, 0])
+    cen_c = np.ascontiguousarray(cen.T)
+    rad = column_norm(cen_c - x[:, 0])
     # radius ratio 3 r_in / R, r_in = 3 V / (sum of face areas)
     fa = 0.0
     for f in ((1, 2, 3), (0, 2, 3), (0, 1, 3), (0, 1, 2)):
-        a, b, c = xyz[:, f[0]], xyz[:, f[1]], xyz[:, f[2]]
-        fa = fa + 0.5 * row_norm(cross_rows(b - a, c - a))
+        a, b, c = x[:, f[0]], x[:, f[1]], x[:, f[2]]
+        fa = fa + 0.5 * column_norm(cross_components(b - a, c - a))
     with np.errstate(divide="ignore", invalid="ignore"):
         quality = 9.0 * t.pore_volume / (fa * rad)
     flat = ~(quality >= min_quality)
@@ -176,12 +178,14 @@ def merge_pores(tessellation, *, tolerance: float = 0.02, min_quality: float = 0
     p, q = tp[inner, 0], tp[inner, 1]
     # fourth vertex of each tetrahedron: the one not on the shared face (the face's three
     # vertices are three of the tetrahedron's four, so the vertex sums differ by the fourth)
-    face_sum = t.throat_vertices[inner].sum(axis=1)
-    vp, vq = pv[p].sum(axis=1) - face_sum, pv[q].sum(axis=1) - face_sum
+    tv = t.throat_vertices
+    face_sum = (tv[:, 0] + tv[:, 1] + tv[:, 2])[inner]
+    vertex_sum = pv[:, 0] + pv[:, 1] + pv[:, 2] + pv[:, 3]
+    vp, vq = vertex_sum[p] - face_sum, vertex_sum[q] - face_sum
     both = ok[p] & ok[q]
     with np.errstate(invalid="ignore"):
-        dq = np.abs(row_norm(pts[vq] - cen[p]) - rad[p]) / rad[p]
-        dp = np.abs(row_norm(pts[vp] - cen[q]) - rad[q]) / rad[q]
+        dq = np.abs(column_norm(pts_c[:, vq] - cen_c[:, p]) - rad[p]) / rad[p]
+        dp = np.abs(column_norm(pts_c[:, vp] - cen_c[:, q]) - rad[q]) / rad[q]
     thr = max(tol, 1e-9)
     merge = both & (dq <= thr) & (dp <= thr)
     mp, mq = p[merge], q[merge]
@@ -210,7 +214,8 @@ def merge_pores(tessellation, *, tolerance: float = 0.02, min_quality: float = 0
     # singletons: the tetrahedron's centroid; groups: unique vertices of their members
     center = np.zeros((n_g, 3))
     single = size[labels] == 1
-    center[labels[single]] = xyz[single].mean(axis=1)
+    xs = x[:, :, single]                    # their centroid summed as mean(axis=1) sums it
+    center[labels[single]] = (((xs[:, 0] + xs[:, 1]) + xs[:, 2]) + xs[:, 3]).T / 4.0
     sel = ~single & use
     if sel.any():
         key = np.unique(labels[sel, None].astype(np.int64) * (pts.shape[0] + 1) + pv[sel])
