@@ -8,6 +8,7 @@ the 1-based array index of a ``.npz``).
 
 from __future__ import annotations
 
+import io
 import logging
 import os
 import zipfile
@@ -64,11 +65,12 @@ def _read_csv(path: Path) -> Packing:
     lines, then ``x y z r`` rows); an optional header names x, y, z and r/radius/diameter."""
     src = str(path)
     text = path.read_text(errors="replace").splitlines()
-    lines = [(i + 1, ln.strip()) for i, ln in enumerate(text)]
-    lines = [(i, ln) for i, ln in lines if ln and not ln.startswith("#")]
-    if not lines:
+    # the first line that is neither blank nor a comment: the header or the first row
+    first = next((i for i, ln in enumerate(text)
+                  if (t := ln.strip()) and not t.startswith("#")), None)
+    if first is None:
         raise ValueError(f"{src}: empty file (no data row)")
-    head_no, head = lines[0]
+    head_no, head = first + 1, text[first].strip()
     delim = _delimiter(head)
     names = [h.lower() for h in _split(head, delim)]
     scale = 1.0
@@ -82,26 +84,33 @@ def _read_csv(path: Path) -> Packing:
         if "grain_id" in names:
             cols.append(names.index("grain_id"))
         scale = 0.5 if rname[0] in _DIAMETER_NAMES else 1.0
-        body = lines[1:]
-        if not body:
-            raise ValueError(f"{src}: no data row after the header")
+        start = first + 1
     else:  # no header: x, y, z, r in that order
         cols = [0, 1, 2, 3]
-        body = lines
+        start = first
     ncols = len(names)
     if ncols < 4:
         raise ValueError(f"{src}: row {head_no}: expected at least 4 columns (x y z r), got "
                          f"{ncols}: {head!r}")
+    if next((i for i in range(len(text) - 1, start - 1, -1)      # the last row, from the end
+             if (t := text[i].strip()) and not t.startswith("#")), None) is None:
+        raise ValueError(f"{src}: no data row after the header")
+    raw = text[start:]
     fast = None
-    try:
-        fast = np.loadtxt([ln for _, ln in body], delimiter=delim, ndmin=2)
+    try:  # NumPy's C parser (it skips blank and '#' lines itself)
+        fast = np.loadtxt(io.StringIO("\n".join(raw)), delimiter=delim, ndmin=2, comments="#")
     except ValueError:
         fast = None
-    if fast is None or fast.shape[1] != ncols:
-        fast = _parse_rows([_split(ln, delim) for _, ln in body], ncols,
-                           [i for i, _ in body], src)
+    if fast is not None and fast.shape == (len(raw), ncols):
+        lineno = np.arange(start + 1, start + 1 + len(raw))   # every line a row
+    else:
+        body = [(i, t) for i, ln in enumerate(raw, start + 1)
+                if (t := ln.strip()) and not t.startswith("#")]
+        if fast is None or fast.shape != (len(body), ncols):
+            fast = _parse_rows([_split(ln, delim) for _, ln in body], ncols,
+                               [i for i, _ in body], src)
+        lineno = np.array([i for i, _ in body])
     data = fast[:, cols]
-    lineno = np.array([i for i, _ in body])
     validate_spheres(data[:, :3], data[:, 3] * scale, lineno, src)
     grain = None
     if data.shape[1] == 5:
@@ -109,7 +118,7 @@ def _read_csv(path: Path) -> Packing:
         bad = np.flatnonzero(~np.isfinite(grain) | (np.mod(grain, 1) != 0))
         if bad.size:
             raise ValueError(f"{src}: row {lineno[bad[0]]}: grain_id must be a whole number, "
-                             f"got {grain[bad[0]]!r}")
+                             f"got {float(grain[bad[0]])!r}")
         check_grains(data[:, :3], data[:, 3] * scale, grain, lineno, src)
     return Packing(data[:, :3], data[:, 3] * scale, source=src, grain_id=grain)
 

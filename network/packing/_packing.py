@@ -171,7 +171,7 @@ def validate_spheres(centers, radii, lines, source, *, check_duplicates=True):
     bad = radii <= 0
     if bad.any():
         i = int(np.flatnonzero(bad)[0])
-        raise ValueError(f"{source}: row {lines[i]}: radius must be > 0, got {radii[i]!r}")
+        raise ValueError(f"{source}: row {lines[i]}: radius must be > 0, got {float(radii[i])!r}")
     if check_duplicates:
         order = np.lexsort(centers.T[::-1])
         s = centers[order]
