@@ -242,6 +242,23 @@ def test_window_law_with_one_row_is_the_chain_law(monkeypatch):
         conduit_law(tess, idx, h, **common, **{**CHAIN_LAW, "recovery": "sigma"})
 
 
+def test_conduit_law_threads_change_no_bit():
+    """The body sections' areas and the turning cosines on threads: the same K and onset."""
+    pk = random_packing(80, rng=4, periodic=False, solid_fraction=0.55)
+    tess = tessellate(pk)
+    idx = np.flatnonzero(np.all(np.asarray(tess.throat_pores) >= 0, axis=1))
+    rng = np.random.default_rng(5)
+    h = rng.uniform(0.2, 0.5, (idx.size, 2)) * 1e-3
+    conns = np.asarray(tess.throat_pores)[idx]
+    common = dict(pore_xyz_m=rng.normal(size=(conns.max() + 1, 3)), conns=conns,
+                  stokes_flow_m3_s=rng.normal(size=idx.size), axis=2)
+    for law in ({**CHAIN_LAW, "recovery": "window", "onset_slope": "window"}, CHAIN_LAW):
+        K1, c1, _ = conduit_law(tess, idx, h, **common, **law)
+        K2, c2, _ = conduit_law(tess, idx, h, **common, **law, threads=2)
+        assert np.array_equal(K1, K2) and np.array_equal(c1, c2)
+        assert np.isfinite(K1).all() and (K1 >= 0).all()
+
+
 #: LBM k/k_app of a packing run after the window table was fixed (phi 0.55, n 800, seed 3,
 #: D 40, GPU, session 10; docs/data/lbm_n800_reference.json)
 LBM_FRESH_RE = np.array([4.8366, 9.5617, 19.0943, 47.0578])

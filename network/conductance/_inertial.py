@@ -33,6 +33,8 @@ table and the validation against the LBM drag laws: ``docs/inertial-flow.md``.
 
 from __future__ import annotations
 
+from concurrent.futures import ThreadPoolExecutor
+
 import numpy as np
 
 import throats
@@ -179,20 +181,26 @@ def _coefficients(window, *, internal, density_kg_m3, profile, cos_theta, contra
     return K
 
 
-def _window_and_ratios(tessellation, throats_idx, h_m):
-    """Open window area (M,), area ratios sigma (M, 2) per side, mean sphere radius (M,)."""
+def _window_and_ratios(tessellation, throats_idx, h_m, pool=None):
+    """Open window area (M,), area ratios sigma (M, 2) per side, mean sphere radius (M,);
+    the two body sections' areas on ``pool``'s threads when given (the same bits)."""
     idx = np.asarray(throats_idx, dtype=np.int64)
     h = np.asarray(h_m, dtype=float)
     if h.shape != (idx.size, 2):
         raise ValueError(f"h_m must have shape ({idx.size}, 2), got {h.shape}")
     radii = np.asarray(tessellation.throat_radii, dtype=float)[idx]
     sides = np.asarray(tessellation.throat_sides, dtype=float)[idx]
-    a_w = np.asarray(throats.open_area(radii, sides), dtype=float)
     point = 1e-12 * sides.min(axis=1, keepdims=True)
+
+    def body_area(side):
+        rk = np.sqrt(np.maximum(radii**2 - h[:, side, None] ** 2, 0.0))
+        return np.asarray(throats.open_area(np.maximum(rk, point), sides), dtype=float)
+
+    bodies = [pool.submit(body_area, side) for side in (0, 1)] if pool else None
+    a_w = np.asarray(throats.open_area(radii, sides), dtype=float)
     sigma = np.empty((idx.size, 2))
     for side in (0, 1):
-        rk = np.sqrt(np.maximum(radii**2 - h[:, side, None] ** 2, 0.0))
-        a_b = np.asarray(throats.open_area(np.maximum(rk, point), sides), dtype=float)
+        a_b = bodies[side].result() if bodies else body_area(side)
         with np.errstate(divide="ignore", invalid="ignore"):
             sigma[:, side] = np.where(a_b > 0, a_w / a_b, 1.0)
     return a_w, sigma, radii.mean(axis=1)
@@ -259,6 +267,24 @@ def window_constants(sigma, table=None):
             np.interp(s, x, np.asarray(t["recovery"], dtype=float)))
 
 
+def _recovery(recovery):
+    """``recovery`` as an array, checked to lie in [-1, 1]."""
+    f = np.asarray(recovery, dtype=float)
+    if np.any(~np.isfinite(f)) or np.any(f > 1.0) or np.any(f < -1.0):
+        raise ValueError(f"recovery must lie in [-1, 1], got {recovery!r}")
+    return f
+
+
+class _now:
+    """A call made at once, with the ``result()`` of a future (the one-thread path)."""
+
+    def __init__(self, fn, *args):
+        self.value = fn(*args)
+
+    def result(self):
+        return self.value
+
+
 def turning_cosines(centers_m, throat_vertices, pore_xyz_m, conns, flow_m3_s, axis: int, *,
                     recovery: float = 0.0):
     r"""Cosine between each conduit's jet and the mean outflow of the body it enters, (M, 2).
@@ -273,9 +299,7 @@ def turning_cosines(centers_m, throat_vertices, pore_xyz_m, conns, flow_m3_s, ax
     a number or one per conduit and column ((M, 2)); f < 0 (a body losing more than the
     balance, :data:`CHAIN_WINDOW_TABLE`'s narrowest window) lowers the cosine, held at -1.
     """
-    f = np.asarray(recovery, dtype=float)
-    if np.any(~np.isfinite(f)) or np.any(f > 1.0) or np.any(f < -1.0):
-        raise ValueError(f"recovery must lie in [-1, 1], got {recovery!r}")
+    f = _recovery(recovery)
     x = np.asarray(centers_m, dtype=float)[np.asarray(throat_vertices, dtype=np.int64)]
     n = np.cross(x[:, 1] - x[:, 0], x[:, 2] - x[:, 0])
     c = np.asarray(conns, dtype=np.int64)
@@ -299,7 +323,7 @@ def conduit_law(tessellation, throats_idx, h_m, *, internal=None, pore_xyz_m=Non
                 viscosity_pa_s: float = MU_AIR_PA_S, profile: str = "uniform",
                 contraction: str = "sharp", turning: bool = False, recovery: float | str = 0.0,
                 onset=None, onset_slope: float | str = ONSET_SLOPE,
-                crossover=None):
+                crossover=None, threads: int = 1):
     r"""The per-conduit inertial law of a sample's conduits: ``(K, onset_scale, crossover)``.
 
     ``K`` (M, 2), Pa s² m⁻⁶, from :func:`inertial_coefficients` (``profile``,
@@ -312,24 +336,36 @@ def conduit_law(tessellation, throats_idx, h_m, *, internal=None, pore_xyz_m=Non
     :math:`\Delta p = q/g + K q|q|\,\phi`, φ the onset factor. ``recovery='window'`` and
     ``onset_slope='window'`` take each from the window ratio sigma of the body the flow
     expands into (:func:`window_constants`) instead of one number for every conduit.
+    ``threads`` > 1: the body sections' open areas and the turning cosines run on two more
+    threads beside the window's (the same bits).
     """
     if onset not in (None, "throat"):
         raise ValueError(f"onset must be None or 'throat', got {onset!r}")
     for name, value in (("recovery", recovery), ("onset_slope", onset_slope)):
         if isinstance(value, str) and value != "window":
             raise ValueError(f"{name} must be a number or 'window', got {value!r}")
-    win = _window_and_ratios(tessellation, throats_idx, h_m)       # once for K and the onset
+    if turning and (stokes_flow_m3_s is None or pore_xyz_m is None or conns is None):
+        raise ValueError("turning needs the Stokes flows, pore positions and conns")
+    pool = ThreadPoolExecutor(2) if int(threads) > 1 else None
+    try:
+        # the cosines without recovery (which may come from the window ratios below): the
+        # same bits as with it, cos + f (1 - cos) being applied to them last either way
+        bare = (pool.submit if pool else _now)(
+            turning_cosines, tessellation.packing.centers,
+            np.asarray(tessellation.throat_vertices)[throats_idx], pore_xyz_m, conns,
+            stokes_flow_m3_s, axis) if turning else None
+        win = _window_and_ratios(tessellation, throats_idx, h_m, pool)  # for K and the onset
+        cos = None if bare is None else bare.result()
+    finally:
+        if pool:
+            pool.shutdown()
     if isinstance(recovery, str) or isinstance(onset_slope, str):
         c1_w, f_w = window_constants(win[1][:, ::-1])     # column 0: flow 0 -> 1 expands into 1
         recovery = f_w if isinstance(recovery, str) else recovery
         onset_slope = c1_w if isinstance(onset_slope, str) else onset_slope
-    cos = None
-    if turning:
-        if stokes_flow_m3_s is None or pore_xyz_m is None or conns is None:
-            raise ValueError("turning needs the Stokes flows, pore positions and conns")
-        cos = turning_cosines(tessellation.packing.centers,
-                              np.asarray(tessellation.throat_vertices)[throats_idx], pore_xyz_m,
-                              conns, stokes_flow_m3_s, axis, recovery=recovery)
+    if cos is not None:
+        f = _recovery(recovery)
+        cos = np.clip(cos + f * (1.0 - cos), -1.0, 1.0)
     K = _coefficients(win, internal=internal, density_kg_m3=density_kg_m3, profile=profile,
                       cos_theta=cos, contraction=contraction)
     c = None if onset is None else _onset(win, h_m, K, density_kg_m3=density_kg_m3,

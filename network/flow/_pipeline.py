@@ -251,7 +251,7 @@ def solve_network(packing: Packing, *, axis="z", region: Region | None = None,
                 tess, sample.throats, cres.h_m[keep], internal=np.asarray(cres.internal)[keep],
                 pore_xyz_m=sample.pore_xyz, conns=sample.conns,
                 stokes_flow_m3_s=check["throat_flow"], axis=ax, density_kg_m3=density_kg_m3,
-                viscosity_pa_s=viscosity_pa_s, **INERTIAL_LAWS[inertial_law])
+                viscosity_pa_s=viscosity_pa_s, threads=threads, **INERTIAL_LAWS[inertial_law])
             us = [velocity_m_s] + curve_u
             pts = solve_inertial(sample.n_pores, sample.conns, g, K, sample.inlet,
                                  sample.outlet, np.asarray(us) * sample.area_m2,
