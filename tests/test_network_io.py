@@ -56,6 +56,12 @@ def test_lammps_dump(tmp_path):
     ("x,y,z,r\n" + "".join(f"{i},0,0,1\n" for i in range(5)) + "5,0,1\n", "row 7: expected 4 values"),
     ("x,y,z,r\n0,0,0,1\n1,0,0,1\n", "too few spheres"),
     ("a,b,c\n1,2,3\n", "lacks column"),
+    # blank and comment lines among the rows: the file's line numbers still
+    ("# yade\nx,y,z,r\n\n" + "".join(f"{i},0,0,1\n# c\n" for i in range(5)) + "5,0,0,-1\n",
+     "row 14: radius must be > 0"),
+    ("x y z r\n" + "".join(f"{i} 0 0 1  # inline\n" for i in range(5)) + "\n\n5 0 nan 1\n",
+     "row 9: non-finite"),
+    ("x,y,z,r\n\n# only a comment\n", "no data row after the header"),
 ])
 def test_bad_csv_messages(tmp_path, bad, match):
     p = tmp_path / "bad.csv"
