@@ -88,7 +88,9 @@ def circumspheres(points):
     r"""Circumcentres and circumradii of tetrahedra, given as (N, 4, 3) vertex coordinates.
 
     Solves :math:`2(\mathbf v_i - \mathbf v_0)\cdot \mathbf c' = |\mathbf v_i - \mathbf v_0|^2`
-    for :math:`\mathbf c' = \mathbf c - \mathbf v_0`. Flat tetrahedra give NaN.
+    for :math:`\mathbf c' = \mathbf c - \mathbf v_0` by Cramer's rule
+    (:func:`network.pores._simplex.circumcentres`). Flat tetrahedra (:math:`|D| \le 10^{-12}`
+    of the mean squared edge to the power 3/2) give NaN.
 
     Returns
     -------

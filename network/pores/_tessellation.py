@@ -163,17 +163,17 @@ class Tessellation:
 
 def _pore_geometry(pts, simp):
     """Centroids (N, 3), volumes (N,) and circumcentres (N, 3) of the tetrahedra ``simp`` of
-    ``pts`` (:func:`circumcentres`: V = |D| / 6), in chunks so that the (chunk, 4, 3)
-    temporaries stay small."""
+    ``pts`` (:func:`circumcentres`, V = |D| / 6; the centroid summed in the order of
+    ``mean(axis=1)``), in chunks so that the (3, chunk, 4) temporaries stay small."""
     n_p = simp.shape[0]
     centroid = np.empty((n_p, 3))
     volume = np.empty(n_p)
     circ = np.empty((n_p, 3))
     for a in range(0, n_p, CHUNK):
         b = min(a + CHUNK, n_p)
-        s = simp[a:b]                # the centroid as pv.mean(axis=1) sums it: same bits
+        s = simp[a:b]
         centroid[a:b] = (((pts[s[:, 0]] + pts[s[:, 1]]) + pts[s[:, 2]]) + pts[s[:, 3]]) / 4.0
-        circ[a:b], det = circumcentres(pts, simp[a:b])
+        circ[a:b], det = circumcentres(pts, s)
         volume[a:b] = np.abs(det) / 6.0
     return centroid, volume, circ
 
