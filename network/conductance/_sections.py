@@ -192,7 +192,7 @@ def side_resistance(radii, sides, h_side, y_window, *, n_sections: int = 8,
         closed |= ~fin[:, c]
     y = np.where(fin, y, 0.0)
     dth = np.maximum(th_end / m, 1e-300)
-    with np.errstate(divide="ignore", invalid="ignore"):
+    with np.errstate(divide="ignore", invalid="ignore", over="ignore"):   # inf: a steep wall
         dy = np.gradient(y, axis=1) / dth[:, None] / dhdth
     dy[:, 0] = 0.0                                              # symmetry at the window
     with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
