@@ -216,20 +216,26 @@ def test_window_table_comes_from_the_pore_rows():
     np.testing.assert_allclose(window_constants([0.1, 0.99])[1], [f[0], f[-1]], atol=1e-3)
 
 
+def _interior_law_inputs(n, packing_seed, solid_fraction, seed, *, axis):
+    """A small random packing's interior throats with random heights (m), pore positions and
+    Stokes flows: ``(tessellation, throat indices, h, conduit_law keywords)``."""
+    pk = random_packing(n, rng=packing_seed, periodic=False, solid_fraction=solid_fraction)
+    tess = tessellate(pk)
+    idx = np.flatnonzero(np.all(np.asarray(tess.throat_pores) >= 0, axis=1))
+    rng = np.random.default_rng(seed)
+    h = rng.uniform(0.2, 0.5, (idx.size, 2)) * 1e-3
+    conns = np.asarray(tess.throat_pores)[idx]
+    xyz = rng.normal(size=(conns.max() + 1, 3))
+    q = rng.normal(size=idx.size)
+    return tess, idx, h, dict(pore_xyz_m=xyz, conns=conns, stokes_flow_m3_s=q, axis=axis)
+
+
 def test_window_law_with_one_row_is_the_chain_law(monkeypatch):
     # a table whose every row holds the 'chain' constants gives the 'chain' law exactly: the
     # per-conduit path changes nothing but where the constants come from
     from network.conductance import _inertial as inertial
 
-    pk = random_packing(60, rng=2, periodic=False, solid_fraction=0.50)
-    tess = tessellate(pk)
-    idx = np.flatnonzero(np.all(np.asarray(tess.throat_pores) >= 0, axis=1))
-    rng = np.random.default_rng(3)
-    h = rng.uniform(0.2, 0.5, (idx.size, 2)) * 1e-3
-    conns = np.asarray(tess.throat_pores)[idx]
-    xyz = rng.normal(size=(conns.max() + 1, 3))
-    q = rng.normal(size=idx.size)
-    common = dict(pore_xyz_m=xyz, conns=conns, stokes_flow_m3_s=q, axis=0)
+    tess, idx, h, common = _interior_law_inputs(60, 2, 0.50, 3, axis=0)
     flat = {"sigma": (0.3, 0.9), "onset_slope": (CHAIN_ONSET_SLOPE,) * 2,
             "recovery": (CHAIN_RECOVERY,) * 2}
     monkeypatch.setattr(inertial, "CHAIN_WINDOW_TABLE", flat)
@@ -244,14 +250,7 @@ def test_window_law_with_one_row_is_the_chain_law(monkeypatch):
 
 def test_conduit_law_threads_change_no_bit():
     """The body sections' areas and the turning cosines on threads: the same K and onset."""
-    pk = random_packing(80, rng=4, periodic=False, solid_fraction=0.55)
-    tess = tessellate(pk)
-    idx = np.flatnonzero(np.all(np.asarray(tess.throat_pores) >= 0, axis=1))
-    rng = np.random.default_rng(5)
-    h = rng.uniform(0.2, 0.5, (idx.size, 2)) * 1e-3
-    conns = np.asarray(tess.throat_pores)[idx]
-    common = dict(pore_xyz_m=rng.normal(size=(conns.max() + 1, 3)), conns=conns,
-                  stokes_flow_m3_s=rng.normal(size=idx.size), axis=2)
+    tess, idx, h, common = _interior_law_inputs(80, 4, 0.55, 5, axis=2)
     for law in ({**CHAIN_LAW, "recovery": "window", "onset_slope": "window"}, CHAIN_LAW):
         K1, c1, _ = conduit_law(tess, idx, h, **common, **law)
         K2, c2, _ = conduit_law(tess, idx, h, **common, **law, threads=2)
