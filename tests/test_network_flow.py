@@ -74,8 +74,14 @@ def test_amg_matches_spsolve_under_contrast(contrast):
     assert info.converged
     assert check["balance_error"] <= 1e-8 and check["max_pore_residual"] <= 1e-8
     p_ref, _, check_ref = solve_fixed_pressure(idx.size, c, g, inlet, outlet, solver=spsolve)
-    np.testing.assert_allclose(p, p_ref, rtol=0, atol=1e-7)
+    # the mass-balance tolerance (1e-8 of the flow per pore) pins a pore's pressure only to
+    # about 1e-8 q_in / G_i: at contrast 1e12 the pores joined by conductances 1e-5 of the
+    # largest come to within 9e-7 of the direct solve (RCM order; 2e-9 in the tessellation's),
+    # the others and every throat flow far closer
+    np.testing.assert_allclose(p, p_ref, rtol=0, atol=1e-7 if contrast <= 1e6 else 1e-5)
     np.testing.assert_allclose(check["q_in"], check_ref["q_in"], rtol=1e-7)
+    q, q_ref = check["throat_flow"], check_ref["throat_flow"]
+    assert np.abs(q - q_ref).max() <= 1e-7 * np.abs(q_ref).max()
 
 
 def test_non_convergence_reported_not_raised():
