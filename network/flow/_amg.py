@@ -5,8 +5,8 @@ matrix :math:`\tilde A = D^{-1/2} A D^{-1/2}` (near-null space :math:`D^{1/2}\ma
 The unknowns are renumbered by reverse Cuthill-McKee (SciPy's ``csgraph``) before the hierarchy
 is built: pyamg's greedy aggregation and the Gauss-Seidel sweeps follow the node order, and a
 banded order gives better aggregates and smoothing than the tessellation's (20 000 spheres:
-40 -> 33 CG iterations, setup and solve 0.66-0.74 -> 0.53-0.64 s, the ordering 0.02 s;
-100 000: 43 -> 33, 5.4 -> 3.7-4.7 s; ``docs/network-bench.md``, "Session 14"). It is built on
+40 -> 31 CG iterations, setup and solve 0.57-0.68 -> 0.51-0.53 s with the ordering's 0.02-0.04;
+100 000: 43 -> 35, 4.8-5.4 -> 4.1 s; ``docs/network-bench.md``, "Session 14"). It is built on
 the first solve; later right-hand sides reuse it. If CG has not converged after
 150 iterations the hierarchy is rebuilt once with ``strength='evolution'`` and kept: later
 solves with the same matrix start from it and never rebuild. :meth:`AMGSolver.preconditioner`
@@ -266,6 +266,7 @@ class AMGSolver:
                 ops.append(sp.csr_matrix(lv.R @ (ops[-1] @ lv.P)))
             cycle = _VCycle(ops, [lv.P for lv in ml.levels[:-1]],
                             [lv.R for lv in ml.levels[:-1]], self.smoother)
+
         def apply(r):           # callers limit BLAS threads around the whole CG
             return self._back(cycle(self._to(r)))
 
