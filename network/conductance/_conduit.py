@@ -141,16 +141,20 @@ def conduit_conductance(tessellation, throats_idx=None, *, viscosity_pa_s: float
     tp = t.throat_pores[idx]
     internal = pm.internal_throat[idx]
     # conduit heights: normal distance from the face plane to each pore body centre
-    xyz = t.packing.centers[t.throat_vertices[idx]]
-    nrm = np.cross(xyz[:, 1] - xyz[:, 0], xyz[:, 2] - xyz[:, 0])
-    nrm /= np.maximum(np.sqrt(nrm[:, 0] * nrm[:, 0] + nrm[:, 1] * nrm[:, 1]
-                              + nrm[:, 2] * nrm[:, 2]), 1e-300)[:, None]
+    # (component-major: each component a contiguous row, the gathers and products run over it)
+    x = np.ascontiguousarray(t.packing.centers.T)[:, t.throat_vertices[idx].T]   # (3, 3, M)
+    u, v = x[:, 1] - x[:, 0], x[:, 2] - x[:, 0]
+    nrm = np.stack([u[1] * v[2] - u[2] * v[1], u[2] * v[0] - u[0] * v[2],
+                    u[0] * v[1] - u[1] * v[0]])                      # face normal, (3, M)
+    nrm /= np.maximum(np.sqrt(nrm[0] * nrm[0] + nrm[1] * nrm[1] + nrm[2] * nrm[2]), 1e-300)
+    centre = np.ascontiguousarray(pm.center.T)
     h = np.zeros((idx.size, 2))
     for side in (0, 1):
         pore = tp[:, side]
         ok = pore >= 0
-        cen = pm.center[pm.labels[pore[ok]]]
-        h[ok, side] = np.abs(np.einsum("ij,ij->i", cen - xyz[ok, 0], nrm[ok]))
+        d = centre[:, pm.labels[pore[ok]]] - x[:, 0][:, ok]
+        n = nrm[:, ok]
+        h[ok, side] = np.abs(d[0] * n[0] + d[1] * n[1] + d[2] * n[2])
     hull = tp[:, 1] < 0
     h[hull, 1] = h[hull, 0]
 

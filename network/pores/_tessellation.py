@@ -35,7 +35,7 @@ from scipy.sparse.csgraph import connected_components
 
 from ..packing import Packing
 from ._delaunay import CHUNK, ENGINES, FACES, QHULL_OPTIONS, delaunay
-from ._simplex import circumcentres, column_norm, cross_components, row_norm
+from ._simplex import circumcentres, column_norm, cross_components
 
 __all__ = ["ENGINES", "Tessellation", "tessellate", "QHULL_OPTIONS", "tie_groups"]
 
@@ -312,10 +312,10 @@ def tessellate(packing: Packing, *, qhull_options: str = QHULL_OPTIONS,
         centroid, volume, circ = pores.result()
     flat = volume < flat_tol * dbar**3
     tied = np.zeros(n_t, dtype=bool)
-    cc = circ[ft[inner]] - circ[fn[inner]]
-    tied[inner] = row_norm(cc) < tie_tol * dbar  # NaN compares False
-    del cc
-    tied[inner] |= flat[ft[inner]] | flat[fn[inner]]
+    a, b = ft[inner], fn[inner]
+    circ_c = np.ascontiguousarray(circ.T)            # component rows: contiguous gathers
+    tied[inner] = column_norm(circ_c[:, a] - circ_c[:, b]) < tie_tol * dbar  # NaN: False
+    tied[inner] |= flat[a] | flat[b]
 
     in_simplex = np.zeros(packing.n, dtype=bool)
     in_simplex[simp.ravel()] = True
