@@ -214,15 +214,16 @@ def _shipped_table(name, solver_version):
 def _quick_valid(r, s):
     """Cheap row checks of the hot path (finite, positive, strict triangle inequality).
 
-    Column by column (a reduction over a length-3 axis costs more than the three columns):
-    ``0 < x < inf`` is False for NaN, inf and non-positive values.
+    ``0 < x < inf`` is False for NaN, inf and non-positive values; it is tested on the flat
+    (3N,) arrays (one contiguous pass; a reduction over a length-3 axis, or three strided
+    columns, costs two to three times more) and the rare failures are mapped to their rows.
     """
     l12, l13, l23 = s[:, 0], s[:, 1], s[:, 2]
     with np.errstate(invalid="ignore"):
         ok = (l12 < l13 + l23) & (l13 < l12 + l23) & (l23 < l12 + l13)
         for a in (r, s):
-            for c in range(3):
-                ok &= (a[:, c] > 0) & (a[:, c] < np.inf)
+            flat = np.ascontiguousarray(a).ravel()
+            ok[np.flatnonzero(~((flat > 0) & (flat < np.inf))) // 3] = False
     return ok
 
 
