@@ -136,3 +136,25 @@ def test_table_policies_use_values_already_stored_in_the_db(heldout, tmp_path):
     mixed = cache.lookup_qstar(r, s, db=db, policy="table+fe", rtol=1.0, solver=_no_fe)
     assert list(mixed.source) == ["exact"] * 10 + ["interp"] * 14
     np.testing.assert_array_equal(mixed.qstar, res.qstar)
+
+
+def test_invalid_rows_fail_alone(heldout, tmp_path):
+    """Rows with NaN, inf, zero or negative entries or sides that are no triangle come back
+    'failed' (NaN, a message); the valid rows beside them get what they get alone."""
+    r, s, _ = heldout
+    bad_r, bad_s = np.tile(r[:1], (6, 1)), np.tile(s[:1], (6, 1))
+    bad_r[0, 1] = np.nan
+    bad_r[1, 2] = -1.0
+    bad_s[2, 0] = np.inf
+    bad_s[3, 2] = 0.0
+    bad_s[4] = [1.0, 1.0, 3.0]                     # 3 > 1 + 1: no triangle
+    bad_r[5, 0] = np.inf
+    rr, ss = np.vstack([r, bad_r]), np.vstack([s, bad_s])
+    db = tmp_path / "t.sqlite"
+    both = cache.lookup_qstar(rr, ss, db=db, policy="table-only")
+    alone = cache.lookup_qstar(r, s, db=db, policy="table-only")
+    n = len(r)
+    np.testing.assert_array_equal(both.qstar[:n], alone.qstar)
+    assert list(both.source[n:]) == ["failed"] * 6
+    assert np.isnan(both.qstar[n:]).all() and all(m for m in both.message[n:])
+    assert both.stats["n_failed"] == 6
