@@ -34,7 +34,7 @@ import throats
 
 from .._air import MU_AIR_PA_S, check_viscosity
 from .._json import jsonable
-from ..pores import PoreMerge, merge_pores
+from ..pores import PoreMerge, column_norm, cross_components, merge_pores
 from ._qstar import SOURCES, qstar_from_function, throat_qstar as policy_qstar
 from ._result import ConductanceResult
 from ._conduit_kernel import compiled_conduit_rows
@@ -143,10 +143,8 @@ def conduit_conductance(tessellation, throats_idx=None, *, viscosity_pa_s: float
     # conduit heights: normal distance from the face plane to each pore body centre
     # (component-major: each component a contiguous row, the gathers and products run over it)
     x = np.ascontiguousarray(t.packing.centers.T)[:, t.throat_vertices[idx].T]   # (3, 3, M)
-    u, v = x[:, 1] - x[:, 0], x[:, 2] - x[:, 0]
-    nrm = np.stack([u[1] * v[2] - u[2] * v[1], u[2] * v[0] - u[0] * v[2],
-                    u[0] * v[1] - u[1] * v[0]])                      # face normal, (3, M)
-    nrm /= np.maximum(np.sqrt(nrm[0] * nrm[0] + nrm[1] * nrm[1] + nrm[2] * nrm[2]), 1e-300)
+    nrm = np.stack(cross_components(x[:, 1] - x[:, 0], x[:, 2] - x[:, 0]))  # face normal
+    nrm /= np.maximum(column_norm(nrm), 1e-300)
     centre = np.ascontiguousarray(pm.center.T)
     h = np.zeros((idx.size, 2))
     for side in (0, 1):

@@ -196,7 +196,7 @@ def solve_network(packing: Packing, *, axis="z", region: Region | None = None,
         # the GIL) runs: the Q* table's load (and the compiled conduit loop's for a large
         # packing), pyamg's import, the porosity; the thread ends with its job
         side, own = ThreadPoolExecutor(1), conductance is None
-        eps_job = side.submit(_beside_qhull, packing, reg, ax,
+        eps_job = side.submit(_beside_tessellation, packing, reg, ax,
                               porosity_points if porosity is None else 0,
                               db if own and policy != "shape-factor" else False,
                               own and conductance_model == "conduit" and policy == "table-only"
@@ -316,7 +316,7 @@ def solve_network(packing: Packing, *, axis="z", region: Region | None = None,
         throat_qstar=None if window_qstar is None else window_qstar[sample.throats])
 
 
-def _beside_qhull(packing, reg, ax, porosity_points, db, kernel=False):
+def _beside_tessellation(packing, reg, ax, porosity_points, db, kernel=False):
     """The Q* table loaded (``db``; False: none needed), the compiled conduit loop loaded
     (``kernel``), pyamg imported, and the region's (porosity, standard error) when
     ``porosity_points`` (else None): what :func:`solve_network` runs beside the tessellation."""

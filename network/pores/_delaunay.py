@@ -32,7 +32,7 @@ import scipy.sparse as sp
 from scipy.sparse.csgraph import connected_components
 from scipy.spatial import ConvexHull, Delaunay, QhullError
 
-from ._simplex import cross_rows, edge_determinants, row_norm
+from ._simplex import column_norm, cross_components, edge_determinants
 
 __all__ = ["CHUNK", "ENGINES", "FACES", "GMSH_MIN_CENTRES", "QHULL_OPTIONS", "delaunay"]
 
@@ -160,7 +160,8 @@ def _orientation(f: np.ndarray, x: np.ndarray) -> np.ndarray:
     or 0 where the floating-point determinant is within its error bound (Shewchuk's orient3d
     filter, widened 10x) of zero."""
     u, v, w = f[:, 1] - f[:, 0], f[:, 2] - f[:, 0], x - f[:, 0]
-    det = (u * cross_rows(v, w)).sum(axis=1)
+    c = cross_components(v.T, w.T)
+    det = u[:, 0] * c[0] + u[:, 1] * c[1] + u[:, 2] * c[2]
     au, av, aw = np.abs(u), np.abs(v), np.abs(w)
     perm = (au[:, 0] * (av[:, 1] * aw[:, 2] + av[:, 2] * aw[:, 1])
             + au[:, 1] * (av[:, 2] * aw[:, 0] + av[:, 0] * aw[:, 2])
@@ -260,7 +261,7 @@ def _gmsh_checked(pts: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     on_hull[hull.coplanar[:, 0]] = True
     outer = _faces(simp, single)
     x = pts[outer]                                          # (F, 3, 3)
-    area = 0.5 * row_norm(cross_rows(x[:, 1] - x[:, 0], x[:, 2] - x[:, 0])).sum()
+    area = 0.5 * column_norm(cross_components((x[:, 1] - x[:, 0]).T, (x[:, 2] - x[:, 0]).T)).sum()
     if not on_hull[outer].all() or not abs(area - hull.area) <= _VOLUME_TOL * hull.area:
         raise _Unchecked("an unmatched face inside the hull")
     return simp, neigh.reshape(-1, 4)

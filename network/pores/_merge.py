@@ -45,7 +45,7 @@ import numpy as np
 import scipy.sparse as sp
 from scipy.sparse.csgraph import connected_components
 
-from ._simplex import circumcentres, column_norm, cross_components, row_norm
+from ._simplex import circumcentres, column_norm
 
 __all__ = ["PoreMerge", "merge_pores", "circumspheres"]
 
@@ -106,7 +106,7 @@ def circumspheres(points):
     p = np.asarray(points, dtype=float)
     c, _ = circumcentres(p.reshape(-1, 3), np.arange(4 * p.shape[0]).reshape(-1, 4),
                          flat_tol=1e-12)
-    return c, row_norm(c - p[:, 0])
+    return c, column_norm((c - p[:, 0]).T)
 
 
 def merge_pores(tessellation, *, tolerance: float = 0.02, min_quality: float = 0.2,
@@ -116,8 +116,9 @@ def merge_pores(tessellation, *, tolerance: float = 0.02, min_quality: float = 0
     Parameters
     ----------
     tessellation : Tessellation
-        From :func:`network.tessellate` (uses ``pore_vertices``, ``throat_pores``,
-        ``throat_vertices``, ``pore_volume`` and the packing's centres).
+        From :func:`network.tessellate` (uses ``pore_vertices``, ``pore_throats``,
+        ``throat_pores``, ``throat_vertices``, ``throat_area``, ``pore_volume`` and the
+        packing's centres).
     tolerance : float, keyword-only
         Relative co-sphericity tolerance :math:`\tau` (default 0.02; 0 merges only exact ties
         to 1e-9).
@@ -166,10 +167,9 @@ def merge_pores(tessellation, *, tolerance: float = 0.02, min_quality: float = 0
     cen_c = np.ascontiguousarray(cen.T)
     rad = column_norm(cen_c - x[:, 0])
     # radius ratio 3 r_in / R, r_in = 3 V / (sum of face areas)
-    fa = 0.0
-    for f in ((1, 2, 3), (0, 2, 3), (0, 1, 3), (0, 1, 2)):
-        a, b, c = x[:, f[0]], x[:, f[1]], x[:, f[2]]
-        fa = fa + 0.5 * column_norm(cross_components(b - a, c - a))
+    # (the four face areas are the tessellation's throat areas: face k opposite vertex k)
+    ta = t.throat_area[t.pore_throats]
+    fa = ((ta[:, 0] + ta[:, 1]) + ta[:, 2]) + ta[:, 3]
     with np.errstate(divide="ignore", invalid="ignore"):
         quality = 9.0 * t.pore_volume / (fa * rad)
     flat = ~(quality >= min_quality)

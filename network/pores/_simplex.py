@@ -12,19 +12,13 @@ from __future__ import annotations
 
 import numpy as np
 
-__all__ = ["circumcentres", "column_norm", "cross_components", "cross_rows", "edge_determinants",
-           "row_norm"]
-
-
-def row_norm(v: np.ndarray) -> np.ndarray:
-    """Row lengths of an (N, 3) array, :math:`\\sqrt{v_x^2 + v_y^2 + v_z^2}` (the bits of
-    ``np.linalg.norm(v, axis=1)`` without its slow reduction over a length-3 axis)."""
-    return np.sqrt(v[:, 0] * v[:, 0] + v[:, 1] * v[:, 1] + v[:, 2] * v[:, 2])
+__all__ = ["circumcentres", "column_norm", "cross_components", "edge_determinants"]
 
 
 def column_norm(v) -> np.ndarray:
-    """Lengths of vectors stored by component, ``v[0], v[1], v[2]`` (M,) each (a (3, M)
-    array): the same bits as :func:`row_norm` of the transposed (M, 3) array."""
+    """Lengths of vectors stored by component, ``v[0], v[1], v[2]`` (M,) each (a (3, M) array,
+    or ``w.T`` of an (M, 3) one): :math:`\\sqrt{v_x^2 + v_y^2 + v_z^2}`, the bits of
+    ``np.linalg.norm(w, axis=1)`` without its slow reduction over a length-3 axis."""
     return np.sqrt(v[0] * v[0] + v[1] * v[1] + v[2] * v[2])
 
 
@@ -32,11 +26,6 @@ def cross_components(u, v) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Cross product :math:`u \\times v` of vectors stored by component (``u[0], u[1], u[2]``,
     (M,) each): its three components."""
     return (u[1] * v[2] - u[2] * v[1], u[2] * v[0] - u[0] * v[2], u[0] * v[1] - u[1] * v[0])
-
-
-def cross_rows(u: np.ndarray, v: np.ndarray) -> np.ndarray:
-    """Row-wise cross product :math:`u \\times v` of two (N, 3) arrays, (N, 3)."""
-    return np.stack(cross_components(u.T, v.T), axis=1)
 
 
 def _edges(pts: np.ndarray, simp: np.ndarray) -> tuple[np.ndarray, np.ndarray]:

@@ -312,10 +312,10 @@ def tessellate(packing: Packing, *, qhull_options: str = QHULL_OPTIONS,
         centroid, volume, circ = pores.result()
     flat = volume < flat_tol * dbar**3
     tied = np.zeros(n_t, dtype=bool)
-    a, b = ft[inner], fn[inner]
+    p_in, q_in = ft[inner], fn[inner]                # the two pores of each interior face
     circ_c = np.ascontiguousarray(circ.T)            # component rows: contiguous gathers
-    tied[inner] = column_norm(circ_c[:, a] - circ_c[:, b]) < tie_tol * dbar  # NaN: False
-    tied[inner] |= flat[a] | flat[b]
+    tied[inner] = column_norm(circ_c[:, p_in] - circ_c[:, q_in]) < tie_tol * dbar  # NaN: False
+    tied[inner] |= flat[p_in] | flat[q_in]
 
     in_simplex = np.zeros(packing.n, dtype=bool)
     in_simplex[simp.ravel()] = True
