@@ -54,3 +54,24 @@ def test_command_answer_equals_the_library_answer(tmp_path):
         assert ja[key] == jb[key], key
     for key in ("permeability_m2", "pressure_drop_pa"):
         assert abs(ja[key] / jb[key] - 1) < 1e-10, key
+
+
+FINISH = """
+import atexit, sys
+from network._cli import finish
+atexit.register(lambda: print("handler ran"))
+sys.stdout.write("unflushed, ")
+sys.stderr.write("no newline")
+finish({code})
+print("never reached")
+"""
+
+
+def test_finish_runs_handlers_flushes_and_keeps_the_exit_status():
+    """finish() ends the process by os._exit: the atexit handlers still run, buffered output
+    (a pipe: block-buffered) still arrives, and the status is the command's."""
+    for code in (0, 1, 2):
+        out = subprocess.run([sys.executable, "-c", FINISH.format(code=code)],
+                             capture_output=True, text=True)
+        assert (out.returncode, out.stdout, out.stderr) == (code, "unflushed, handler ran\n",
+                                                            "no newline")
