@@ -165,3 +165,34 @@ def test_amg_setup_is_reproducible_and_leaves_numpy_random_alone():
     np.random.rand(7)                        # another global state for the second setup
     x2, i2 = AMGSolver(A_ii).solve(b_i)
     assert i1.iterations == i2.iterations and np.array_equal(x1, x2)
+
+
+def test_finest_smoothing_weight_is_the_gershgorin_bound():
+    """The finest prolongator is smoothed with rho = max_i sum_j |a_ij| / a_ii (issue 18): 2 for
+    a condensed grid Laplacian, never below the largest eigenvalue of D^-1 A; a matrix that is
+    not diagonally dominant (bound > 2) keeps pyamg's estimate. Both solve to the tolerance."""
+    from network.flow import AMGSolver
+    from network.flow._amg import gershgorin_bound
+    rng = np.random.default_rng(3)
+    idx, c = grid_network(8, 8, 8)
+    A = assemble_laplacian(idx.size, c, 10.0 ** rng.uniform(0, 3, len(c)))
+    A_ii, b_i, _, _ = apply_pressure_bc(A, np.zeros(idx.size), idx[:, :, [0, -1]].ravel(),
+                                        np.r_[np.ones(64), np.zeros(64)])
+    dense = A_ii.toarray()
+    top = np.linalg.eigvals(dense / np.diag(dense)[:, None]).real.max()
+    bound = gershgorin_bound(A_ii)
+    assert abs(bound - 2.0) <= 1e-14 and top <= bound
+    amg = AMGSolver(A_ii)
+    x, info = amg.solve(b_i)
+    assert amg.rho == bound and info.converged
+    assert amg._ml.levels[0].A.rho == bound      # what pyamg's smoother read (its rho cache)
+    np.testing.assert_allclose(x, spsolve(sp.csc_array(A_ii), b_i), rtol=1e-7)
+    # SPD, not diagonally dominant: M^T M + I of a random sparse M
+    M = sp.random_array((300, 300), density=0.02, random_state=4) + sp.eye_array(300)
+    S = sp.csr_array(M.T @ M + sp.eye_array(300))
+    assert gershgorin_bound(S) > 2.0
+    amg = AMGSolver(S)
+    b = rng.standard_normal(300)
+    y, info = amg.solve(b)
+    assert amg.rho is None and info.converged
+    np.testing.assert_allclose(S @ y, b, atol=1e-8 * np.linalg.norm(b))
