@@ -9,14 +9,18 @@ project's commands about 0.15 s of work they never use, a sixth of a 5 000-spher
   ``charset_normalizer``), ``numpy.testing`` and ``numpy.ma``: 0.08 s;
 - SciPy's ``xp_capabilities`` decorator parses the numpydoc docstring of each of some 230
   functions of ``scipy.special`` and ``scipy.spatial`` at import to append its array-API
-  support table to ``__doc__``: 0.07 s.
+  support table to ``__doc__``: 0.07 s;
+- pyamg's ``__init__`` imports every solver family, its gallery (and ``scipy.io``), its plots and
+  ``importlib.metadata``: 0.05 s, where the smoothed-aggregation modules the commands use take
+  0.01 s.
 
 :func:`lean_imports` registers the three NumPy submodules with the standard library's
 :class:`importlib.util.LazyLoader` (the module object exists, its code runs on the first
 attribute access: ``numpy.ma.masked_invalid`` or ``from numpy.testing import ...`` work as
 before) and, where SciPy's array-API layer has ``xp_capabilities``, replaces it by one that
 leaves functions and their docstrings as they are (the support tables feed SciPy's own test
-suite and documentation only). Computations are untouched. The package applies it only when
+suite and documentation only), and registers pyamg with its ``__init__`` deferred to the first
+package-level name asked for (:func:`_package_first`). Computations are untouched. The package applies it only when
 Python was started as ``python -m network.<command>`` (``sys.argv[0]`` is ``'-m'`` while the
 package is imported), never when the library is imported into someone's session.
 """
@@ -28,6 +32,11 @@ import sys
 
 #: NumPy submodules that SciPy's namespace clone executes and no command uses.
 LAZY_NUMPY = ("numpy.f2py", "numpy.testing", "numpy.ma")
+#: Packages whose ``__init__`` imports far more than the commands use: pyamg's imports every
+#: solver family, its gallery (and through it ``scipy.io``), its plotting helpers and
+#: ``importlib.metadata`` for its version, 0.05 s where the smoothed-aggregation modules the
+#: commands use take 0.01 s.
+LAZY_INIT = ("pyamg",)
 
 
 def _lazy(name: str) -> bool:
@@ -54,12 +63,37 @@ def _plain_capabilities(**_kw):
     return lambda f: f
 
 
+def _package_first(name: str) -> bool:
+    """Register package ``name`` with its ``__init__`` not yet run: its submodules import as
+    ever (``import pyamg.aggregation`` runs only what that module needs), and the first
+    package-level name asked for that is not a submodule (``pyamg.solve``, ``pyamg.__version__``)
+    runs ``__init__`` then. False where it is already imported or cannot be found."""
+    if name in sys.modules:
+        return False
+    spec = importlib.util.find_spec(name)
+    if spec is None or spec.loader is None or spec.submodule_search_locations is None:
+        return False
+    module = importlib.util.module_from_spec(spec)
+
+    def __getattr__(attr: str):
+        if not attr.startswith("__") and importlib.util.find_spec(f"{name}.{attr}"):
+            return importlib.import_module(f"{name}.{attr}")
+        del module.__dict__["__getattr__"]       # the package as its own __init__ makes it
+        spec.loader.exec_module(module)
+        return getattr(module, attr)
+
+    module.__getattr__ = __getattr__
+    sys.modules[name] = module
+    return True
+
+
 def lean_imports() -> list[str]:
     """Make :data:`LAZY_NUMPY` lazy and SciPy's ``xp_capabilities`` plain; the names of what
     was changed (an empty list where everything was already imported)."""
     import numpy  # noqa: F401  (the parent of the lazy submodules)
 
     changed = [n for n in LAZY_NUMPY if _lazy(n)]
+    changed += [n for n in LAZY_INIT if _package_first(n)]
     if "scipy.special" not in sys.modules:
         try:
             import scipy._lib._array_api as api

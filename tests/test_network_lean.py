@@ -75,3 +75,33 @@ def test_finish_runs_handlers_flushes_and_keeps_the_exit_status():
                              capture_output=True, text=True)
         assert (out.returncode, out.stdout, out.stderr) == (code, "unflushed, handler ran\n",
                                                             "no newline")
+
+
+PYAMG = """
+import json, sys
+sys.argv = {argv!r}
+import network
+import pyamg.aggregation
+from pyamg import amg_core
+before = "pyamg.gallery" in sys.modules
+version, solver = pyamg.__version__, pyamg.smoothed_aggregation_solver
+print(json.dumps({{"gallery_before": before, "gallery_after": "pyamg.gallery" in sys.modules,
+                  "version": version, "solver": solver.__name__,
+                  "core": amg_core.__name__}}))
+"""
+
+
+def test_command_process_runs_pyamg_init_only_when_a_package_name_is_asked_for():
+    """A command imports pyamg's smoothed-aggregation modules without pyamg's __init__ (its
+    gallery, plotting and version lookup); the first package-level name runs it, and then the
+    package is the one a plain import gives."""
+    from importlib.metadata import version
+    runs = {}
+    for argv in (["-m"], ["-c"]):
+        out = subprocess.run([sys.executable, "-c", PYAMG.format(argv=argv)],
+                             capture_output=True, text=True, check=True)
+        runs[argv[0]] = json.loads(out.stdout)
+    assert runs["-m"]["gallery_before"] is False and runs["-c"]["gallery_before"] is True
+    for got in runs.values():
+        assert got["gallery_after"] is True and got["version"] == version("pyamg")
+        assert (got["solver"], got["core"]) == ("smoothed_aggregation_solver", "pyamg.amg_core")

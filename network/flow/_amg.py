@@ -193,7 +193,7 @@ class AMGSolver:
         """The hierarchy for ``strength``, built only when the held one is another."""
         if self._ml is not None and self.strength == strength:
             return self._ml, 0.0
-        import pyamg
+        from pyamg.aggregation import smoothed_aggregation_solver
         t0 = time.perf_counter()
         with one_blas_thread(), _seeded_numpy_random():
             # B = D^(1/2) 1 is the scaled Laplacian's exact null vector away from the
@@ -206,7 +206,7 @@ class AMGSolver:
             if self.rho is not None:
                 self._As.rho = self.rho
                 smooth = [("richardson", {"omega": 4.0 / 3.0}), "jacobi"]
-            self._ml = pyamg.smoothed_aggregation_solver(
+            self._ml = smoothed_aggregation_solver(
                 self._As, B=self._B, symmetry="symmetric", strength=strength, max_coarse=500,
                 coarse_solver="splu", improve_candidates=None, smooth=smooth)
         for level in self._ml.levels:       # pyamg's 1x1 BSR kernels are slower than CSR's

@@ -322,7 +322,7 @@ def _beside_tessellation(packing, reg, ax, porosity_points, db, kernel=False):
     ``porosity_points`` (else None): what :func:`solve_network` runs beside the tessellation."""
     if db is not False and has_grid(db) and kernel:
         load_conduit_kernel(db)
-    import pyamg  # noqa: F401 - imported here, beside Qhull, instead of in the solve stage
+    import pyamg.aggregation, pyamg.krylov, pyamg.relaxation.smoothing  # noqa: F401 (solve's)
     return region_porosity(packing, reg, ax, n_points=porosity_points) if porosity_points \
         else None
 
