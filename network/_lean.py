@@ -20,9 +20,10 @@ attribute access: ``numpy.ma.masked_invalid`` or ``from numpy.testing import ...
 before) and, where SciPy's array-API layer has ``xp_capabilities``, replaces it by one that
 leaves functions and their docstrings as they are (the support tables feed SciPy's own test
 suite and documentation only), and registers pyamg with its ``__init__`` deferred to the first
-package-level name asked for (:func:`_package_first`). Computations are untouched. The package applies it only when
-Python was started as ``python -m network.<command>`` (``sys.argv[0]`` is ``'-m'`` while the
-package is imported), never when the library is imported into someone's session.
+package-level name asked for (:func:`_package_first`). Computations are untouched. The package
+applies it only when Python was started as ``python -m network.<command>`` (``sys.argv[0]`` is
+``'-m'`` while the package is imported), never when the library is imported into someone's
+session.
 """
 
 from __future__ import annotations
@@ -88,8 +89,9 @@ def _package_first(name: str) -> bool:
 
 
 def lean_imports() -> list[str]:
-    """Make :data:`LAZY_NUMPY` lazy and SciPy's ``xp_capabilities`` plain; the names of what
-    was changed (an empty list where everything was already imported)."""
+    """Make :data:`LAZY_NUMPY` lazy, :data:`LAZY_INIT`'s ``__init__`` deferred and SciPy's
+    ``xp_capabilities`` plain; the names of what was changed (an empty list where everything
+    was already imported)."""
     import numpy  # noqa: F401  (the parent of the lazy submodules)
 
     changed = [n for n in LAZY_NUMPY if _lazy(n)]
