@@ -100,21 +100,28 @@ def test_per_packing_rows(run):
 def test_per_packing_yade_where_installed(run, monkeypatch):
     """``--per-packing --yade`` times YADE's FlowEngine on the same packing where the ``yade``
     program is installed (FlowEngine's solve and the whole command, positive, the engine inside
-    the command); without it the row says so; ``--yade`` alone is bad input."""
+    the command), each run paired with one of ours; without it the row says so; ``--yade``
+    alone is bad input."""
     import shutil
 
     from network.benchmarks import _per_packing
 
     tmp, _ = run
     path = packing_file(SIZES[0], tmp, 1)
-    here = _per_packing.yade_times(path, 1)
+    once = _per_packing.yade_run(path)
     if shutil.which("yade") is None:
-        assert here is None
+        assert once is None
     else:
-        assert len(here["flowengine_s"]) == len(here["command_s"]) == 1
-        assert 0 < here["flowengine_median_s"] < here["command_median_s"] < 120
+        engine, whole = once
+        assert 0 < engine < whole < 120
+        # paired with ours: the ratio of each pair, its median, the pairs ours was faster in
+        here = _per_packing.yade_summary([once, once], [0.5 * engine, 2.0 * engine])
+        assert here["ratio_to_flowengine"] == [0.5, 2.0]
+        assert here["ratio_to_flowengine_median"] == 1.25
+        assert here["faster_than_flowengine_runs"] == 1
+        assert here["flowengine_median_s"] == engine and here["command_median_s"] == whole
     monkeypatch.setattr(_per_packing.shutil, "which", lambda name: None)
-    assert _per_packing.yade_times(path, 1) is None
+    assert _per_packing.yade_run(path) is None
     rows = _per_packing.per_packing([SIZES[0]], tmp, 1, repeats=1, bundled=False, yade=True)
     assert rows[0]["mode"] == "stokes" and rows[0]["yade_here"] is None
     assert "YADE here: not installed" in _per_packing.per_packing_line(rows[0])

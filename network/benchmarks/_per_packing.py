@@ -12,7 +12,9 @@ YADE's FlowEngine on the 5 000-sphere packing (its own triangulation and Cholesk
 ``yade=True`` (``network.bench --per-packing --yade``) YADE itself runs on the same packings
 on this machine (``docs/scripts/yade_flowengine.py`` through ``yade -n -x``; Debian's ``yade``
 package): its first ``emulateAction`` (FlowEngine's triangulation, factorisation and solve,
-without YADE's start-up) and its whole command, beside the ``--stokes`` row.
+without YADE's start-up) and its whole command, one YADE run right after each of ours on the
+``--stokes`` rows, so that each pair sees the same host speed (a shared host's speed moves by
+25 % within an hour): the row carries the paired ratio ours / FlowEngine.
 """
 
 from __future__ import annotations
@@ -40,34 +42,45 @@ YADE_SCRIPT = Path(__file__).resolve().parents[2] / "docs" / "scripts" / "yade_f
 _YADE_FIRST = re.compile(r"first emulateAction ([0-9.]+) s")
 
 
-def yade_times(path: Path, repeats: int) -> dict | None:
-    """YADE on ``path``, ``repeats`` runs: FlowEngine's first solve and the whole command (s),
-    or None where ``yade`` or the script is missing."""
+def yade_run(path: Path) -> tuple[float, float] | None:
+    """One YADE run on ``path``: (FlowEngine's first solve, the whole command) in s, or None
+    where ``yade`` or the script is missing."""
     exe = shutil.which("yade")
     if exe is None or not YADE_SCRIPT.is_file():
         return None
-    engine, whole = [], []
-    for _ in range(repeats):
-        t0 = time.perf_counter()
-        out = subprocess.run([exe, "-n", "-x", str(YADE_SCRIPT), str(path)],
-                             capture_output=True, text=True, check=False)
-        dt = time.perf_counter() - t0
-        m = _YADE_FIRST.search(out.stdout + out.stderr)
-        if out.returncode != 0 or m is None:
-            raise RuntimeError(f"yade on {path} exited {out.returncode}: "
-                               f"{(out.stdout + out.stderr).strip()[-200:]}")
-        engine.append(float(m.group(1)))
-        whole.append(dt)
+    t0 = time.perf_counter()
+    out = subprocess.run([exe, "-n", "-x", str(YADE_SCRIPT), str(path)],
+                         capture_output=True, text=True, check=False)
+    dt = time.perf_counter() - t0
+    m = _YADE_FIRST.search(out.stdout + out.stderr)
+    if out.returncode != 0 or m is None:
+        raise RuntimeError(f"yade on {path} exited {out.returncode}: "
+                           f"{(out.stdout + out.stderr).strip()[-200:]}")
+    return float(m.group(1)), dt
+
+
+def yade_summary(runs: list, ours: list) -> dict | None:
+    """FlowEngine and whole-command times of YADE ``runs`` (from :func:`yade_run`), each run
+    right after the one of ``ours`` (s) at the same index: medians, and the paired ratio
+    ours / FlowEngine (median; how many pairs ours was faster). None without YADE."""
+    if not runs or runs[0] is None:
+        return None
+    engine, whole = [r[0] for r in runs], [r[1] for r in runs]
+    ratio = [a / e for a, e in zip(ours, engine)]
     return {"flowengine_s": engine, "command_s": whole,
             "flowengine_median_s": statistics.median(engine),
-            "command_median_s": statistics.median(whole)}
+            "command_median_s": statistics.median(whole),
+            "ratio_to_flowengine": ratio,
+            "ratio_to_flowengine_median": statistics.median(ratio),
+            "faster_than_flowengine_runs": sum(q < 1.0 for q in ratio)}
 
 
 def per_packing(sizes, workdir: Path, seed: int, repeats: int = 7,
                 bundled: bool = True, yade: bool = False) -> list[dict]:
     """Wall times of ``python -m network.solve`` on the bench packings of ``sizes`` (and the
     bundled scene): one row per packing and mode with min, median and max over ``repeats``;
-    with ``yade`` the ``--stokes`` rows of the bench packings carry :func:`yade_times` too."""
+    with ``yade`` the ``--stokes`` rows of the bench packings carry the :func:`yade_summary`
+    of YADE runs interleaved with ours."""
     env = dict(os.environ)
     env.pop("PYTHONDONTWRITEBYTECODE", None)
     cases = [(n, packing_file(n, workdir, seed)) for n in sizes]
@@ -77,7 +90,8 @@ def per_packing(sizes, workdir: Path, seed: int, repeats: int = 7,
     for n, path in cases:
         for mode, extra in MODES.items():
             cmd = [sys.executable, "-m", "network.solve", str(path), "--quiet", *extra]
-            times = []
+            times, yade_runs = [], []
+            beside = yade and mode == "stokes" and n is not None
             for i in range(repeats + 1):
                 t0 = time.perf_counter()
                 out = subprocess.run(cmd, env=env, capture_output=True, text=True, check=False)
@@ -87,6 +101,8 @@ def per_packing(sizes, workdir: Path, seed: int, repeats: int = 7,
                                        f"{out.stderr.strip()[-200:]}")
                 if i:                                   # the first run is the warm-up
                     times.append(dt)
+                    if beside:              # YADE right after each run: the same host speed
+                        yade_runs.append(yade_run(path))
             row = {"packing": str(path), "n_spheres": n, "mode": mode, "runs": repeats,
                    "min_s": min(times), "median_s": statistics.median(times),
                    "max_s": max(times), "times_s": times,
@@ -95,8 +111,8 @@ def per_packing(sizes, workdir: Path, seed: int, repeats: int = 7,
                    "loadavg_after": os.getloadavg()[0]}
             if row["target_s"] is not None:
                 row["met"] = row["median_s"] <= row["target_s"]
-            if yade and mode == "stokes" and n is not None:
-                row["yade_here"] = yade_times(path, max(1, min(repeats, 3)))
+            if beside:
+                row["yade_here"] = yade_summary(yade_runs, times)
             rows.append(row)
             print("  " + per_packing_line(row), flush=True)
     return rows
@@ -112,8 +128,11 @@ def per_packing_line(row: dict) -> str:
             tail += f" (YADE {row['yade_s']:.2f} s)"
     here = row.get("yade_here")
     if here:
-        tail += (f"; YADE here: FlowEngine {here['flowengine_median_s']:.2f} s, whole command "
-                 f"{here['command_median_s']:.2f} s (median of {len(here['command_s'])})")
+        tail += (f"; YADE here, each run after one of ours: FlowEngine "
+                 f"{here['flowengine_median_s']:.2f} s, whole command "
+                 f"{here['command_median_s']:.2f} s (medians of {len(here['command_s'])}); "
+                 f"ours / FlowEngine {here['ratio_to_flowengine_median']:.2f} (faster in "
+                 f"{here['faster_than_flowengine_runs']} of {len(here['command_s'])} pairs)")
     elif "yade_here" in row:
         tail += "; YADE here: not installed"
     return (f"{name:>16s} {row['mode']:>8s}: median {row['median_s']:.3f} s, min "
