@@ -14,10 +14,10 @@ project's commands about 0.15 s of work they never use, a sixth of a 5 000-spher
   ``importlib.metadata``: 0.05 s, where the smoothed-aggregation modules the commands use take
   0.01 s.
 
-:func:`lean_imports` registers the three NumPy submodules with the standard library's
+:func:`lean_imports` registers ``numpy.f2py`` and ``numpy.testing`` with the standard library's
 :class:`importlib.util.LazyLoader` (the module object exists, its code runs on the first
-attribute access: ``numpy.ma.masked_invalid`` or ``from numpy.testing import ...`` work as
-before) and, where SciPy's array-API layer has ``xp_capabilities``, replaces it by one that
+attribute access: ``from numpy.testing import ...`` works as before; ``numpy.ma`` is left to
+load, :data:`LAZY_NUMPY`) and, where SciPy's array-API layer has ``xp_capabilities``, replaces it by one that
 leaves functions and their docstrings as they are (the support tables feed SciPy's own test
 suite and documentation only), and registers pyamg with its ``__init__`` deferred to the first
 package-level name asked for (:func:`_package_first`). Computations are untouched. The package
@@ -30,9 +30,14 @@ from __future__ import annotations
 
 import importlib.util
 import sys
+import threading
 
-#: NumPy submodules that SciPy's namespace clone executes and no command uses.
-LAZY_NUMPY = ("numpy.f2py", "numpy.testing", "numpy.ma")
+#: NumPy submodules that SciPy's namespace clone executes and no command uses. Not
+#: ``numpy.ma`` (0.015 s): NumPy >= 2.3's ``np.unique`` asks ``np.ma.is_masked`` on every call,
+#: so each command loads it anyway, and Python 3.11's LazyLoader is not thread-safe: a first
+#: use from two threads at once met a half-executed module ("module 'numpy.ma' has no attribute
+#: 'isMaskedArray'", 1 run in 12 once SciPy's modules were imported beside gmsh).
+LAZY_NUMPY = ("numpy.f2py", "numpy.testing")
 #: Packages whose ``__init__`` imports far more than the commands use: pyamg's imports every
 #: solver family, its gallery (and through it ``scipy.io``), its plotting helpers and
 #: ``importlib.metadata`` for its version, 0.05 s where the smoothed-aggregation modules the
@@ -75,12 +80,15 @@ def _package_first(name: str) -> bool:
     if spec is None or spec.loader is None or spec.submodule_search_locations is None:
         return False
     module = importlib.util.module_from_spec(spec)
+    lock = threading.Lock()
 
     def __getattr__(attr: str):
         if not attr.startswith("__") and importlib.util.find_spec(f"{name}.{attr}"):
             return importlib.import_module(f"{name}.{attr}")
-        del module.__dict__["__getattr__"]       # the package as its own __init__ makes it
-        spec.loader.exec_module(module)
+        with lock:                               # one thread runs __init__, the others wait
+            if module.__dict__.get("__getattr__") is __getattr__:
+                del module.__dict__["__getattr__"]   # the package as its own __init__ makes it
+                spec.loader.exec_module(module)
         return getattr(module, attr)
 
     module.__getattr__ = __getattr__

@@ -34,7 +34,7 @@ ONLY_FROM = {"cache": "network.conductance"}
 #: below the package (a subpackage name, or the module name for top-level modules)
 LAYERS = {
     "network": [
-        {"_lean", "_air", "_json", "_grains", "packing"},
+        {"_lean", "_deferred", "_air", "_json", "_grains", "packing"},
         {"pores"},
         {"conductance"},
         {"flow"},

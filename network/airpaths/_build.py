@@ -9,8 +9,8 @@ from __future__ import annotations
 import logging
 
 import numpy as np
-from scipy.spatial import cKDTree
 
+from .._deferred import spatial
 from ..pores import axis_index
 from ._geometry import EXIT_FACES, LEFT_BEHIND, as_points, bed_depth, face_areas, plane_axes
 from ._record import path_record
@@ -119,7 +119,7 @@ def build_paths(points, radii, entry_xy, *, kind="widest", axis="z", k_neighbors
         max_steps = int(max(200, 20 * np.ptp(h) / (2 * rbar)))
     sign = 1.0 if kind == "widest" else -1.0
     k = int(min(k_neighbors, ns))
-    tree = cKDTree(x)
+    tree = spatial.cKDTree(x)
 
     aep = np.zeros((n, 3))
     aep[:, plane_axes(ax)] = xy

@@ -12,9 +12,9 @@ import dataclasses
 
 import numpy as np
 from scipy import sparse
-from scipy.sparse import csgraph
 from throats import open_area  # the throats package owns the exact open area
 
+from .._deferred import csgraph
 from ..pores import axis_index
 from ._geometry import plane_axes
 

@@ -10,8 +10,8 @@ import logging
 
 import numpy as np
 from scipy import sparse
-from scipy.sparse import csgraph
 
+from .._deferred import csgraph
 from ..pores import axis_index
 from ._build import build_paths
 from ._faces import MIN_QUALITY, FaceGraph, entry_faces, passable_pores, path_ends

@@ -34,8 +34,8 @@ import time
 
 import numpy as np
 import scipy.sparse as sp
-import scipy.sparse.linalg as spla
-from scipy.sparse.csgraph import reverse_cuthill_mckee
+
+from .._deferred import csgraph, sparse_linalg
 
 __all__ = ["AMGSolver", "SMOOTHERS", "SolveInfo"]
 
@@ -154,8 +154,8 @@ class AMGSolver:
         self.A = A
         self.n = n
         # the solver's unknown k is the caller's order[k], scaled: x[order[k]] = s_k y_k
-        self._order = np.asarray(reverse_cuthill_mckee(sp.csr_matrix(A), symmetric_mode=True),
-                                 dtype=np.int64)
+        rcm = csgraph.reverse_cuthill_mckee(sp.csr_matrix(A), symmetric_mode=True)
+        self._order = np.asarray(rcm, dtype=np.int64)
         self._inverse = np.empty(n, dtype=np.int64)
         self._inverse[self._order] = np.arange(n)
         self._s = (1.0 / np.sqrt(d))[self._order]
@@ -254,8 +254,8 @@ class AMGSolver:
             with one_blas_thread():
                 # pyamg's CG (its residual history) with the project's V-cycle: what
                 # ml.solve(accel='cg') does, less two residual norms per V-cycle
-                M = spla.LinearOperator((self.n, self.n), matvec=self._held_cycle(ml),
-                                        dtype=float)
+                M = sparse_linalg.LinearOperator((self.n, self.n),
+                                                 matvec=self._held_cycle(ml), dtype=float)
                 y, _ = pyamg_cg(ml.levels[0].A, bs, x0=y, tol=tol, maxiter=limit, M=M,
                                 residuals=res_abs)
             solve_t += time.perf_counter() - t1
@@ -279,7 +279,7 @@ class AMGSolver:
                      method, self.n, len(self._ml.levels), len(hist), setup, solve_t)
         return x, info
 
-    def preconditioner(self, A=None) -> spla.LinearOperator:
+    def preconditioner(self, A=None) -> sparse_linalg.LinearOperator:
         r"""The hierarchy as an approximate :math:`A^{-1}` (one V-cycle), in unscaled variables.
 
         :math:`M r = D^{-1/2} V(D^{-1/2} r)`; good for CG on any matrix whose weights are
@@ -307,7 +307,7 @@ class AMGSolver:
         def apply(r):           # callers limit BLAS threads around the whole CG
             return self._back(cycle(self._to(r)))
 
-        return spla.LinearOperator((self.n, self.n), matvec=apply, dtype=float)
+        return sparse_linalg.LinearOperator((self.n, self.n), matvec=apply, dtype=float)
 
     def _held_cycle(self, ml) -> "_VCycle":
         """One V-cycle of hierarchy ``ml`` (scaled variables), built once per hierarchy."""
@@ -331,7 +331,7 @@ class _VCycle:
         self.ops, self.P, self.R = ops, P, R
         self.pre, self.post = (("forward", "backward") if smoother == "forward-backward"
                                else ("symmetric", "symmetric"))
-        self.lu = spla.splu(sp.csc_matrix(ops[-1]))
+        self.lu = sparse_linalg.splu(sp.csc_matrix(ops[-1]))
 
     def __call__(self, b):
         gauss_seidel = self.gs

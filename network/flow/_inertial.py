@@ -46,8 +46,8 @@ from concurrent.futures import ProcessPoolExecutor
 
 import numpy as np
 import scipy.sparse as sp
-import scipy.sparse.linalg as spla
 
+from .._deferred import sparse_linalg
 from ._amg import AMGSolver, one_blas_thread
 from ._conduit_flow import conduit_flow
 
@@ -205,7 +205,7 @@ def solve_inertial(n_pores, conns, g, K, inlet, outlet, flows_m3_s, *, tol: floa
                 def apply(r):
                     yP = (r[nf] - z @ r[:nf]) / schur
                     return np.append(Mf(r[:nf]) - z * yP, yP)
-                return spla.LinearOperator(Jw.shape, matvec=apply, dtype=float)
+                return sparse_linalg.LinearOperator(Jw.shape, matvec=apply, dtype=float)
 
             x, info = _cg(Jw, b, prec(), eta)
             if info[1] > _REBUILD_ITERATIONS:
@@ -349,7 +349,7 @@ def _cg(J, b, M, eta):
     bn = np.linalg.norm(b)
     if bn == 0:
         return np.zeros_like(b), (0, 0)
-    x, flag = spla.cg(sp.csr_array(J), b, rtol=eta, atol=0.0, maxiter=300, M=M,
+    x, flag = sparse_linalg.cg(sp.csr_array(J), b, rtol=eta, atol=0.0, maxiter=300, M=M,
                       callback=count)
     return x, (flag, n_it[0])
 

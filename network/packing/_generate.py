@@ -22,8 +22,8 @@ import logging
 import math
 
 import numpy as np
-from scipy.spatial import cKDTree
 
+from .._deferred import spatial
 from ._packing import Packing
 
 __all__ = ["random_packing", "periodic_copies", "soybean_default_scene", "SOYBEAN_DEFAULT"]
@@ -70,7 +70,7 @@ def _relax(x, r, box, *, periodic, tol, max_sweeps, s0, grow_sweeps):
         if periodic:
             disp -= box * np.round(disp / box)
         if pairs is None or np.max(np.einsum("ij,ij->i", disp, disp)) > (0.5 * skin) ** 2:
-            tree = cKDTree(x, boxsize=box if periodic else None)
+            tree = spatial.cKDTree(x, boxsize=box if periodic else None)
             pairs = tree.query_pairs(2.0 * rs.max() + skin, output_type="ndarray")
             x_ref = x.copy()
         f, worst = _forces(x, rs, box, pairs, periodic)

@@ -12,8 +12,8 @@ import functools
 
 import numpy as np
 import scipy.sparse as sp
-from scipy.sparse.csgraph import connected_components
-from scipy.spatial import cKDTree
+
+from .._deferred import csgraph, spatial
 
 __all__ = ["MIN_SPHERES", "PLAUSIBLE_DIAMETER_M", "Packing", "check_grains", "grain_volumes",
            "scale_warning", "validate_spheres"]
@@ -193,7 +193,7 @@ def check_grains(centers, radii, grain_id, lines, source) -> None:
     c = np.asarray(centers, float)
     r = np.asarray(radii, float)
     g = np.asarray(grain_id).astype(np.int64)
-    pairs = cKDTree(c).query_pairs(2.0 * float(r.max()), output_type="ndarray")
+    pairs = spatial.cKDTree(c).query_pairs(2.0 * float(r.max()), output_type="ndarray")
     if pairs.size:
         i, j = pairs[:, 0], pairs[:, 1]
         keep = (g[i] == g[j]) & (np.linalg.norm(c[i] - c[j], axis=1) < r[i] + r[j])
@@ -202,7 +202,7 @@ def check_grains(centers, radii, grain_id, lines, source) -> None:
         i = j = np.zeros(0, dtype=np.int64)
     n = r.size
     adj = sp.coo_array((np.ones(i.size), (i, j)), shape=(n, n))
-    _, comp = connected_components(adj, directed=False)
+    _, comp = csgraph.connected_components(adj, directed=False)
     pairs_gc = np.unique(np.column_stack([g, comp]), axis=0)
     ids, counts = np.unique(pairs_gc[:, 0], return_counts=True)
     split = ids[counts > 1]

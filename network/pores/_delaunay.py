@@ -16,8 +16,10 @@ missing (1 623 of 124 367 there, all within 0.8 d̄ of the bed's edge). They are
 
 Checked before use: no two centres equal, every centre in a tetrahedron, no face in three
 tetrahedra, the volumes summing to the convex hull's to 1e-9, the unmatched faces on the hull
-(vertices on it, areas summing to its area). A failed check, a side too flat to tell, over
-2**21 centres or a gmsh error sends the input to Qhull (``engine='qhull'``, the reference).
+(vertices on it, areas summing to its area; Qhull's hull is computed on a thread beside gmsh,
+after SciPy's deferred modules, ``network._deferred``). A failed check, a side too flat to
+tell, over 2**21 centres or a gmsh error sends the input to Qhull (``engine='qhull'``, the
+reference).
 Centres in general position give Qhull's tetrahedra exactly (tested); co-spherical groups
 (lattices, tiled copies) get another valid triangulation, which ``tie_groups`` joins.
 """
@@ -26,12 +28,12 @@ from __future__ import annotations
 
 import logging
 import threading
+from concurrent.futures import ThreadPoolExecutor
 
 import numpy as np
 import scipy.sparse as sp
-from scipy.sparse.csgraph import connected_components
-from scipy.spatial import ConvexHull, Delaunay, QhullError
 
+from .._deferred import csgraph, import_now, spatial
 from ._simplex import column_norm, cross_components, edge_determinants
 
 __all__ = ["CHUNK", "ENGINES", "FACES", "GMSH_MIN_CENTRES", "QHULL_OPTIONS", "delaunay"]
@@ -77,8 +79,8 @@ def delaunay(pts: np.ndarray, *, engine: str = "auto",
         except _Unchecked as why:
             log.info("gmsh Delaunay not used (%s): Qhull", why)
     try:
-        dt = Delaunay(pts, qhull_options=qhull_options)
-    except QhullError as e:
+        dt = spatial.Delaunay(pts, qhull_options=qhull_options)
+    except spatial.QhullError as e:
         raise ValueError(f"Delaunay tessellation failed for {pts.shape[0]} centres "
                          f"(coplanar or degenerate input?): {str(e).splitlines()[0]}") from e
     simp = np.ascontiguousarray(dt.simplices, dtype=np.int64)
@@ -181,8 +183,8 @@ def _missing(pts, simp, single, n):
     if s.size < 4:
         return np.zeros((0, 4), dtype=np.int64)
     try:
-        d = Delaunay(pts[s], qhull_options=QHULL_OPTIONS)
-    except QhullError as e:
+        d = spatial.Delaunay(pts[s], qhull_options=QHULL_OPTIONS)
+    except spatial.QhullError as e:
         raise _Unchecked(f"Qhull on the {s.size} gap centres failed") from e
     order = np.argsort(d.simplices, axis=1)           # ascending rows, neighbours alike
     ts = s[np.take_along_axis(d.simplices, order, axis=1)]
@@ -216,12 +218,22 @@ def _missing(pts, simp, single, n):
     link = (nb.ravel() >= 0) & ~barrier
     graph = sp.coo_array((np.ones(int(link.sum())), (t_idx[link], nb.ravel()[link])),
                          shape=(m, m))
-    _, comp = connected_components(graph, directed=False)
+    _, comp = csgraph.connected_components(graph, directed=False)
     gap = np.zeros(comp.max() + 1, dtype=bool)
     gap[comp[q_of[across] // 4]] = True
     if np.any(gap[comp[q_of[~across] // 4]]):
         raise _Unchecked("the gap's flood fill reached gmsh's side of a face")
     return ts[gap[comp]]
+
+
+def _hull(pts: np.ndarray):
+    """Qhull's convex hull of ``pts`` ('Qc': coplanar points kept), after SciPy's deferred
+    modules (the checks use them next); raises _Unchecked where Qhull fails."""
+    import_now()
+    try:
+        return spatial.ConvexHull(pts, qhull_options="Qc")
+    except spatial.QhullError as e:
+        raise _Unchecked("no convex hull") from e
 
 
 def _gmsh_checked(pts: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -232,6 +244,9 @@ def _gmsh_checked(pts: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     o = np.lexsort(pts.T)
     if np.any(np.all(pts[o[1:]] == pts[o[:-1]], axis=1)):
         raise _Unchecked("coincident centres")      # gmsh would join them by flat tetrahedra
+    side = ThreadPoolExecutor(1)
+    hull_job = side.submit(_hull, pts)              # beside gmsh, which releases the GIL
+    side.shutdown(wait=False)
     simp = np.sort(_gmsh_tetrahedra(pts), axis=1)   # ascending rows: faces come out sorted
     used = np.zeros(n, dtype=bool)
     used[simp.ravel()] = True
@@ -249,10 +264,7 @@ def _gmsh_checked(pts: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         single = _match(_keys(_faces(simp, slots), n), slots, neigh)
     volume = sum(np.abs(edge_determinants(pts, simp[a:a + CHUNK])).sum()
                  for a in range(0, simp.shape[0], CHUNK)) / 6.0
-    try:
-        hull = ConvexHull(pts, qhull_options="Qc")
-    except QhullError as e:
-        raise _Unchecked("no convex hull") from e
+    hull = hull_job.result()
     if not abs(volume - hull.volume) <= _VOLUME_TOL * hull.volume:
         raise _Unchecked(f"volumes sum to {volume / hull.volume:.12f} of the hull")
     # the unmatched faces are the hull's: their vertices are hull vertices or lie on a facet

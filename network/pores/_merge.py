@@ -43,8 +43,8 @@ import logging
 
 import numpy as np
 import scipy.sparse as sp
-from scipy.sparse.csgraph import connected_components
 
+from .._deferred import csgraph
 from ._simplex import circumcentres, column_norm
 
 __all__ = ["PoreMerge", "merge_pores", "circumspheres"]
@@ -206,7 +206,7 @@ def merge_pores(tessellation, *, tolerance: float = 0.02, min_quality: float = 0
         mp = np.concatenate([mp, fl[okp]])
         mq = np.concatenate([mq, pick[okp]])
     g = sp.coo_array((np.ones(mp.size), (mp, mq)), shape=(n_p, n_p))
-    n_g, labels = connected_components(g, directed=False)
+    n_g, labels = csgraph.connected_components(g, directed=False)
     size = np.bincount(labels, minlength=n_g)
     # centre: mean of distinct sphere centres of each group's non-sliver tetrahedra (all of
     # them for a group of slivers only)

@@ -24,7 +24,9 @@ from __future__ import annotations
 import logging
 
 import numpy as np
-from scipy.spatial import cKDTree
+
+from .._deferred import spatial
+
 
 __all__ = ["region_porosity", "POROSITY_METHODS", "disk_rectangle_area", "circle_lens_area",
            "sphere_region_volume"]
@@ -206,7 +208,7 @@ def _monte_carlo(packing, region, axis, tree, n_points, rng):
 
 def region_porosity(packing, region, axis: int, *, method: str = "exact",
                     n_points: int = 400_000, rng=0,
-                    tree: cKDTree | None = None) -> tuple[float, float]:
+                    tree: spatial.cKDTree | None = None) -> tuple[float, float]:
     """Porosity of ``region`` (a box, or a cylinder along ``axis``) and its error.
 
     Parameters
@@ -237,7 +239,7 @@ def region_porosity(packing, region, axis: int, *, method: str = "exact",
                          f"{', '.join(POROSITY_METHODS)}")
     if method == "monte-carlo" and n_points < 100:
         raise ValueError(f"n_points must be >= 100, got {n_points}")
-    tree = cKDTree(packing.centers) if tree is None else tree
+    tree = spatial.cKDTree(packing.centers) if tree is None else tree
     if method == "exact" and packing.grain_id is not None and packing.n_grains < packing.n:
         # the spheres of a multi-sphere grain overlap three and more at a time, which the
         # exact method's pairwise lens correction does not count: the union by Monte Carlo

@@ -23,8 +23,8 @@ import logging
 
 import numpy as np
 import scipy.sparse as sp
-from scipy.sparse.csgraph import connected_components
 
+from .._deferred import csgraph
 from ._region import OUTSIDE_BED_DIAMETERS, Region, axis_index
 
 __all__ = ["SampleNetwork", "body_centroids", "select_sample", "prune_disconnected"]
@@ -223,7 +223,7 @@ def prune_disconnected(sample: SampleNetwork, tessellation, g) -> tuple[SampleNe
     live = g > 0
     c = sample.conns[live]
     adj = sp.coo_array((np.ones(c.shape[0]), (c[:, 0], c[:, 1])), shape=(n, n))
-    _, lab = connected_components(adj, directed=False)
+    _, lab = csgraph.connected_components(adj, directed=False)
     ok_lab = np.intersect1d(lab[sample.inlet], lab[sample.outlet])
     keep = np.isin(lab, ok_lab)
     # an inlet pore whose only conducting faces go out of the sample is isolated here too

@@ -31,8 +31,8 @@ from concurrent.futures import ThreadPoolExecutor
 
 import numpy as np
 import scipy.sparse as sp
-from scipy.sparse.csgraph import connected_components
 
+from .._deferred import csgraph
 from ..packing import Packing
 from ._delaunay import CHUNK, ENGINES, FACES, QHULL_OPTIONS, delaunay
 from ._simplex import circumcentres, column_norm, cross_components
@@ -377,7 +377,7 @@ def tie_groups(tessellation: Tessellation) -> tuple[np.ndarray, int]:
         e.append(np.column_stack([fl[ok], chosen[ok]]))
     edges = np.vstack(e) if e else np.zeros((0, 2), dtype=np.int64)
     adj = sp.coo_array((np.ones(edges.shape[0]), (edges[:, 0], edges[:, 1])), shape=(n, n))
-    n_groups, labels = connected_components(adj, directed=False)
+    n_groups, labels = csgraph.connected_components(adj, directed=False)
     if n_groups < n:
         log.info("joined %d tied/flat tetrahedra into %d pore bodies (%d pores remain)",
                  n - n_groups + int((np.bincount(labels) > 1).sum()),

@@ -31,8 +31,8 @@ import time
 from pathlib import Path
 
 import numpy as np
-from scipy.spatial import cKDTree
 
+from .._deferred import spatial
 from ..conductance import ONSET_SLOPE, conduit_law, throat_conductance
 from ..flow import DERIVED_LAW as FLOW_DERIVED_LAW
 from ..flow import (INERTIAL_LAWS, AMGSolver, darcy_permeability, solve_fixed_pressure,
@@ -228,7 +228,7 @@ def finney_inertial_case(reynolds, *, half_side: float = 8.0, axis: int = 0,
 def _box_solid_fraction(packing: Packing, region: Region, n_points: int = 200_000) -> float:
     rng = np.random.default_rng(0)
     pts = region.lo + rng.random((n_points, 3)) * (region.hi - region.lo)
-    d, i = cKDTree(packing.centers).query(pts)
+    d, i = spatial.cKDTree(packing.centers).query(pts)
     return float(np.mean(d <= packing.radii[i]))
 
 

@@ -16,9 +16,8 @@ from __future__ import annotations
 
 import numpy as np
 import scipy.sparse as sp
-from scipy.sparse.linalg import spsolve
-from scipy.spatial import cKDTree
 
+from .._deferred import sparse_linalg, spatial
 from ..conductance import throat_conductance
 from ..packing import Packing, periodic_copies
 from ..pores import axis_index, body_centroids, merge_pores, tessellate
@@ -65,7 +64,7 @@ def periodic_permeability(packing: Packing, side: float, *, axes=("x", "y", "z")
     xyz = body_centroids(t, lab)
     mid = np.all((xyz >= L) & (xyz < 2 * L), axis=1)
     cell = np.flatnonzero(mid)
-    near, j = cKDTree(np.mod(xyz[cell], L), boxsize=L).query(np.mod(xyz, L))
+    near, j = spatial.cKDTree(np.mod(xyz[cell], L), boxsize=L).query(np.mod(xyz, L))
     image = cell[j]
     shift = np.round((xyz - xyz[image]) / L).astype(np.int64)
     # throats between two bodies with one in the cell, each periodic throat once
@@ -108,7 +107,7 @@ def periodic_permeability(packing: Packing, side: float, *, axes=("x", "y", "z")
         jump = -s[:, k] * L                                       # G = 1
         rhs = np.bincount(ia, g * jump, m) - np.bincount(jb, g * jump, m)
         rhs[0] = 0.0
-        p = spsolve(lap, rhs)
+        p = sparse_linalg.spsolve(lap, rhs)
         q = g * (p[ia] - p[jb] - jump)
         dx = (xyz[cell[jb]] + s * L - xyz[cell[ia]])[:, k]
         out["xyz"[k]] = float(np.sum(q * dx) / L**3)

@@ -1,0 +1,48 @@
+"""SciPy submodules imported on first use, so that a command process imports them beside gmsh.
+
+``scipy.sparse.csgraph`` (with ``scipy.sparse.linalg`` and ``scipy.linalg`` behind it) and
+``scipy.spatial`` take 0.10-0.15 s to import, most of what the package's own import costs
+after NumPy and ``scipy.sparse``; the pipeline first needs them after the Delaunay kernel has
+run. :class:`Deferred` stands for such a module: its first attribute access imports it through
+the import system (whose per-module lock makes a concurrent first use from two threads safe)
+and every later one is a dictionary lookup. The gmsh Delaunay path (``network.pores``) imports
+them (:func:`import_now`) on a thread of its own while gmsh, which releases the GIL, runs.
+"""
+
+from __future__ import annotations
+
+import importlib
+
+__all__ = ["Deferred", "csgraph", "import_now", "sparse_linalg", "spatial"]
+
+
+class Deferred:
+    """Module ``name``, imported when one of its attributes is first asked for."""
+
+    __slots__ = ("_name", "_module")
+
+    def __init__(self, name: str):
+        self._name = name
+        self._module = None
+
+    def __getattr__(self, attr: str):
+        module = self._module
+        if module is None:
+            # through the import system, never sys.modules directly: a module that another
+            # thread is importing is there half-executed, and import_module waits for it
+            module = self._module = importlib.import_module(self._name)
+        return getattr(module, attr)
+
+    def __repr__(self) -> str:
+        return f"<deferred module {self._name!r}>"
+
+
+csgraph = Deferred("scipy.sparse.csgraph")
+sparse_linalg = Deferred("scipy.sparse.linalg")
+spatial = Deferred("scipy.spatial")
+
+
+def import_now() -> None:
+    """Import every deferred module now: for a thread with time to spare (beside gmsh)."""
+    for module in (spatial, csgraph, sparse_linalg):
+        module.__name__          # noqa: B018 - any attribute imports it
