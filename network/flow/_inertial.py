@@ -350,7 +350,7 @@ def _cg(J, b, M, eta):
     if bn == 0:
         return np.zeros_like(b), (0, 0)
     x, flag = sparse_linalg.cg(sp.csr_array(J), b, rtol=eta, atol=0.0, maxiter=300, M=M,
-                      callback=count)
+                               callback=count)
     return x, (flag, n_it[0])
 
 
