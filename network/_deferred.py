@@ -6,7 +6,8 @@ after NumPy and ``scipy.sparse``; the pipeline first needs them after the Delaun
 run. :class:`Deferred` stands for such a module: its first attribute access imports it through
 the import system (whose per-module lock makes a concurrent first use from two threads safe)
 and every later one is a dictionary lookup. The gmsh Delaunay path (``network.pores``) imports
-them (:func:`import_now`) on a thread of its own while gmsh, which releases the GIL, runs.
+them (:func:`import_now`) on a thread of its own while gmsh, which releases the GIL, runs
+(``threads`` > 1).
 """
 
 from __future__ import annotations

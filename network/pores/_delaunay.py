@@ -16,10 +16,10 @@ missing (1 623 of 124 367 there, all within 0.8 d̄ of the bed's edge). They are
 
 Checked before use: no two centres equal, every centre in a tetrahedron, no face in three
 tetrahedra, the volumes summing to the convex hull's to 1e-9, the unmatched faces on the hull
-(vertices on it, areas summing to its area; Qhull's hull is computed on a thread beside gmsh,
-after SciPy's deferred modules, ``network._deferred``). A failed check, a side too flat to
-tell, over 2**21 centres or a gmsh error sends the input to Qhull (``engine='qhull'``, the
-reference).
+(vertices on it, areas summing to its area; with ``threads`` > 1 Qhull's hull is computed on
+a thread beside gmsh, after SciPy's deferred modules, ``network._deferred``). A failed check, a
+side too flat to tell, over 2**21 centres or a gmsh error sends the input to Qhull
+(``engine='qhull'``, the reference).
 Centres in general position give Qhull's tetrahedra exactly (tested); co-spherical groups
 (lattices, tiled copies) get another valid triangulation, which ``tie_groups`` joins.
 """
@@ -62,19 +62,20 @@ class _Unchecked(Exception):
     """gmsh's tetrahedra could not be completed and checked: use Qhull."""
 
 
-def delaunay(pts: np.ndarray, *, engine: str = "auto",
-             qhull_options: str = QHULL_OPTIONS) -> tuple[np.ndarray, np.ndarray, str]:
+def delaunay(pts: np.ndarray, *, engine: str = "auto", qhull_options: str = QHULL_OPTIONS,
+             threads: int = 1) -> tuple[np.ndarray, np.ndarray, str]:
     """Delaunay tetrahedra of the points ``pts`` (N, 3) and their neighbours.
 
     Returns ``(simplices (Nt, 4) int64, neighbors (Nt, 4) int64, engine used)``: neighbour k of
     tetrahedron t is the one across the face opposite vertex k, -1 on the convex hull.
+    ``threads`` > 1: gmsh's check computes its convex hull on a second thread while gmsh runs.
     Raises ``ValueError`` when Qhull fails (coplanar or degenerate input).
     """
     if engine not in ENGINES:
         raise ValueError(f"unknown Delaunay engine {engine!r}; choose one of {ENGINES}")
     if engine == "gmsh" or (engine == "auto" and pts.shape[0] >= GMSH_MIN_CENTRES):
         try:
-            simp, neigh = _gmsh_checked(pts)
+            simp, neigh = _gmsh_checked(pts, threads)
             return simp, neigh, "gmsh"
         except _Unchecked as why:
             log.info("gmsh Delaunay not used (%s): Qhull", why)
@@ -236,7 +237,7 @@ def _hull(pts: np.ndarray):
         raise _Unchecked("no convex hull") from e
 
 
-def _gmsh_checked(pts: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+def _gmsh_checked(pts: np.ndarray, threads: int = 1) -> tuple[np.ndarray, np.ndarray]:
     """gmsh's tetrahedra completed at the hull, checked; raises _Unchecked (module docstring)."""
     n = pts.shape[0]
     if n >= 2**21:
@@ -244,9 +245,11 @@ def _gmsh_checked(pts: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     o = np.lexsort(pts.T)
     if np.any(np.all(pts[o[1:]] == pts[o[:-1]], axis=1)):
         raise _Unchecked("coincident centres")      # gmsh would join them by flat tetrahedra
-    side = ThreadPoolExecutor(1)
-    hull_job = side.submit(_hull, pts)              # beside gmsh, which releases the GIL
-    side.shutdown(wait=False)
+    hull_job = None
+    if threads > 1:                                 # beside gmsh, which releases the GIL
+        side = ThreadPoolExecutor(1)
+        hull_job = side.submit(_hull, pts)
+        side.shutdown(wait=False)
     simp = np.sort(_gmsh_tetrahedra(pts), axis=1)   # ascending rows: faces come out sorted
     used = np.zeros(n, dtype=bool)
     used[simp.ravel()] = True
@@ -264,7 +267,7 @@ def _gmsh_checked(pts: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         single = _match(_keys(_faces(simp, slots), n), slots, neigh)
     volume = sum(np.abs(edge_determinants(pts, simp[a:a + CHUNK])).sum()
                  for a in range(0, simp.shape[0], CHUNK)) / 6.0
-    hull = hull_job.result()
+    hull = _hull(pts) if hull_job is None else hull_job.result()
     if not abs(volume - hull.volume) <= _VOLUME_TOL * hull.volume:
         raise _Unchecked(f"volumes sum to {volume / hull.volume:.12f} of the hull")
     # the unmatched faces are the hull's: their vertices are hull vertices or lie on a facet

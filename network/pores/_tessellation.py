@@ -216,7 +216,8 @@ def tessellate(packing: Packing, *, qhull_options: str = QHULL_OPTIONS,
         flagged tied (default 1e-6).
     threads : int, optional
         2 or more: the pore geometry (centroids, volumes, circumcentres) on a second thread
-        beside the faces (numpy releases the GIL; the same bits; default 1).
+        beside the faces (numpy releases the GIL; the same bits), and the gmsh check's convex
+        hull beside gmsh (default 1).
 
     Returns
     -------
@@ -252,7 +253,8 @@ def tessellate(packing: Packing, *, qhull_options: str = QHULL_OPTIONS,
     if not isinstance(packing, Packing):
         raise TypeError(f"packing must be a Packing, got {type(packing).__name__}")
     pts, origin = _local_frame(packing.centers)
-    simp, neigh, used = delaunay(pts, engine=engine, qhull_options=qhull_options)
+    simp, neigh, used = delaunay(pts, engine=engine, qhull_options=qhull_options,
+                                 threads=threads)
     n_p = simp.shape[0]
     dbar = packing.mean_diameter
     if threads > 1:
