@@ -14,16 +14,16 @@ project's commands about 0.15 s of work they never use, a sixth of a 5 000-spher
   ``importlib.metadata``: 0.05 s, where the smoothed-aggregation modules the commands use take
   0.01 s.
 
-:func:`lean_imports` registers ``numpy.f2py`` and ``numpy.testing`` with the standard library's
-:class:`importlib.util.LazyLoader` (the module object exists, its code runs on the first
-attribute access: ``from numpy.testing import ...`` works as before; ``numpy.ma`` is left to
-load, :data:`LAZY_NUMPY`) and, where SciPy's array-API layer has ``xp_capabilities``, replaces it by one that
-leaves functions and their docstrings as they are (the support tables feed SciPy's own test
-suite and documentation only), and registers pyamg with its ``__init__`` deferred to the first
-package-level name asked for (:func:`_package_first`). Computations are untouched. The package
-applies it only when Python was started as ``python -m network.<command>`` (``sys.argv[0]`` is
-``'-m'`` while the package is imported), never when the library is imported into someone's
-session.
+:func:`lean_imports` registers ``numpy.f2py`` and ``numpy.testing`` with the standard
+library's :class:`importlib.util.LazyLoader` (the module object exists, its code runs on the
+first attribute access: ``from numpy.testing import ...`` works as before; ``numpy.ma`` is
+left to load, :data:`LAZY_NUMPY`), replaces SciPy's ``xp_capabilities`` (where its array-API
+layer has one) by one that leaves functions and their docstrings as they are (the support
+tables feed SciPy's own test suite and documentation only), and registers pyamg with its
+``__init__`` deferred to the first package-level name asked for (:func:`_package_first`).
+Computations are untouched. The package applies it only when Python was started as
+``python -m network.<command>`` (``sys.argv[0]`` is ``'-m'`` while the package is imported),
+never when the library is imported into someone's session.
 """
 
 from __future__ import annotations
