@@ -158,7 +158,8 @@ class Packing:
 def validate_spheres(centers, radii, lines, source, *, check_duplicates=True):
     """Check finite values, positive radii, distinct centres and enough spheres.
 
-    ``lines[i]`` is the row sphere i came from, counted as a spreadsheet does: the file line (header = row 1) of a text file, the 1-based array index of a .npz.
+    ``lines[i]`` is the row sphere i came from, counted as a spreadsheet does: the file line
+    (header = row 1) of a text file, the 1-based array index of a .npz.
     """
     n = len(radii)
     if n < MIN_SPHERES:

@@ -372,7 +372,8 @@ def tie_groups(tessellation: Tessellation) -> tuple[np.ndarray, int]:
         valid = nb >= 0
         round_nb = valid & ~flat[np.maximum(nb, 0)]
         # prefer non-flat neighbours, then larger faces
-        score = np.where(round_nb, 2.0, np.where(valid, 1.0, 0.0)) * (1.0 + area / (area.max() + 1e-300))
+        score = (np.where(round_nb, 2.0, np.where(valid, 1.0, 0.0))
+                 * (1.0 + area / (area.max() + 1e-300)))
         pick = np.argmax(score, axis=1)
         chosen = nb[np.arange(fl.size), pick]
         ok = chosen >= 0
