@@ -45,6 +45,7 @@ import numpy as np
 import scipy.sparse as sp
 
 from .._deferred import csgraph
+from ._delaunay import CHUNK
 from ._simplex import circumcentres, column_norm
 
 __all__ = ["PoreMerge", "merge_pores", "circumspheres"]
@@ -185,9 +186,13 @@ def merge_pores(tessellation, *, tolerance: float = 0.02, min_quality: float = 0
     vertex_sum = pv[:, 0] + pv[:, 1] + pv[:, 2] + pv[:, 3]
     vp, vq = vertex_sum[p] - face_sum, vertex_sum[q] - face_sum
     both = ok[p] & ok[q]
+    dq, dp = np.empty(inner.size), np.empty(inner.size)
     with np.errstate(invalid="ignore"):
-        dq = np.abs(column_norm(pts_c[:, vq] - cen_c[:, p]) - rad[p]) / rad[p]
-        dp = np.abs(column_norm(pts_c[:, vp] - cen_c[:, q]) - rad[q]) / rad[q]
+        for a in range(0, inner.size, CHUNK):   # cache-sized pieces: no page-faulted temporaries
+            b = min(a + CHUNK, inner.size)
+            pa, qa = p[a:b], q[a:b]
+            dq[a:b] = np.abs(column_norm(pts_c[:, vq[a:b]] - cen_c[:, pa]) - rad[pa]) / rad[pa]
+            dp[a:b] = np.abs(column_norm(pts_c[:, vp[a:b]] - cen_c[:, qa]) - rad[qa]) / rad[qa]
     thr = max(tol, 1e-9)
     merge = both & (dq <= thr) & (dp <= thr)
     mp, mq = p[merge], q[merge]
@@ -214,10 +219,11 @@ def merge_pores(tessellation, *, tolerance: float = 0.02, min_quality: float = 0
     has_core = np.bincount(labels, weights=core.astype(float), minlength=n_g) > 0
     use = core | ~has_core[labels]
     # singletons: the tetrahedron's centroid; groups: unique vertices of their members
-    center = np.zeros((n_g, 3))
+    center = np.zeros((3, n_g))             # component-major, transposed at the end
     single = size[labels] == 1
-    xs = x[:, :, single]                    # their centroid summed as mean(axis=1) sums it
-    center[labels[single]] = (((xs[:, 0] + xs[:, 1]) + xs[:, 2]) + xs[:, 3]).T / 4.0
+    # the centroid of every tetrahedron summed as mean(axis=1) sums it, kept for singletons
+    total = ((x[:, 0] + x[:, 1]) + x[:, 2]) + x[:, 3]
+    center[:, labels[single]] = total[:, single] / 4.0
     sel = ~single & use
     if sel.any():
         key = np.unique(labels[sel, None].astype(np.int64) * (pts.shape[0] + 1) + pv[sel])
@@ -225,9 +231,10 @@ def merge_pores(tessellation, *, tolerance: float = 0.02, min_quality: float = 0
         vtx = key % (pts.shape[0] + 1)
         cnt = np.bincount(grp, minlength=n_g).astype(float)
         multi = cnt > 0
-        sums = np.stack([np.bincount(grp, weights=pts[vtx, k], minlength=n_g)
-                         for k in range(3)], axis=1)
-        center[multi] = sums[multi] / cnt[multi, None]
+        sums = np.stack([np.bincount(grp, weights=pts_c[k, vtx], minlength=n_g)
+                         for k in range(3)])
+        center[:, multi] = sums[:, multi] / cnt[multi]
+    center = np.ascontiguousarray(center.T)
     internal = np.zeros(tp.shape[0], dtype=bool)
     internal[inner] = labels[p] == labels[q]
     logger.info("merged %d of %d tetrahedra into %d multi-tetrahedron pore bodies "
