@@ -316,8 +316,11 @@ def tessellate(packing: Packing, *, qhull_options: str = QHULL_OPTIONS,
     tied = np.zeros(n_t, dtype=bool)
     p_in, q_in = ft[inner], fn[inner]                # the two pores of each interior face
     circ_c = np.ascontiguousarray(circ.T)            # component rows: contiguous gathers
-    tied[inner] = column_norm(circ_c[:, p_in] - circ_c[:, q_in]) < tie_tol * dbar  # NaN: False
-    tied[inner] |= flat[p_in] | flat[q_in]
+    tie = np.empty(p_in.size, dtype=bool)
+    for a in range(0, p_in.size, CHUNK):             # cache-sized temporaries
+        pa, qa = p_in[a:a + CHUNK], q_in[a:a + CHUNK]
+        tie[a:a + CHUNK] = column_norm(circ_c[:, pa] - circ_c[:, qa]) < tie_tol * dbar  # NaN: no
+    tied[inner] = tie | flat[p_in] | flat[q_in]
 
     in_simplex = np.zeros(packing.n, dtype=bool)
     in_simplex[simp.ravel()] = True
