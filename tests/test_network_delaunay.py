@@ -46,6 +46,15 @@ def test_gmsh_gives_qhulls_tetrahedra_and_neighbours(bed):
     assert shared.all()
 
 
+def test_the_hull_beside_gmsh_changes_nothing(bed, caplog):
+    """threads=2 computes the check's convex hull on a second thread while gmsh runs: the same
+    tetrahedra and neighbours, bit for bit, as one thread (and still gmsh's, checked)."""
+    s1, n1, used1 = delaunay(bed, engine="gmsh", threads=1)
+    s2, n2, used2 = delaunay(bed, engine="gmsh", threads=2)
+    assert used1 == used2 == "gmsh"
+    assert np.array_equal(s1, s2) and np.array_equal(n1, n2)
+
+
 def test_the_hull_gap_is_filled(bed):
     """gmsh alone misses Delaunay tetrahedra at the hull: the completion puts them back and
     the volumes then sum to the convex hull's."""

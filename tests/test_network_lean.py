@@ -68,6 +68,22 @@ print("never reached")
 """
 
 
+CLOSED = """
+import os, sys
+from network._cli import finish
+sys.stdout.write("lost")        # buffered for a stdout that is gone before the exit
+os.close(1)
+finish(2)
+"""
+
+
+def test_finish_with_stdout_gone_keeps_the_status_and_prints_no_traceback():
+    """A stdout that cannot be flushed at the end (the reader gone, the descriptor closed):
+    finish still ends with the command's status, and stderr stays clean."""
+    out = subprocess.run([sys.executable, "-c", CLOSED], capture_output=True, text=True)
+    assert out.returncode == 2 and out.stderr == ""
+
+
 def test_finish_runs_handlers_flushes_and_keeps_the_exit_status():
     """finish() ends the process by os._exit: the atexit handlers still run, buffered output
     (a pipe: block-buffered) still arrives, and the status is the command's."""
