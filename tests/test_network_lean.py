@@ -4,6 +4,7 @@ and ma are deferred, SciPy's docstring tables skipped, and nothing a command com
 from __future__ import annotations
 
 import json
+import os
 import subprocess
 import sys
 
@@ -154,3 +155,41 @@ def test_scipy_modules_are_imported_at_first_use_and_safely_from_threads():
                              check=True)
         got = json.loads(out.stdout)
         assert got == {"before": [], "got": [["cKDTree", "connected_components"]], "n": 8}
+
+
+BLAS = """
+import json, os, sys
+sys.argv = {argv!r}
+import network
+from network._lean import BLAS_SINGLE, user_environment
+import scipy.linalg  # noqa: F401 - SciPy's own OpenBLAS too
+from threadpoolctl import threadpool_info
+threads = sorted({{i["num_threads"] for i in threadpool_info() if i["internal_api"] == "openblas"}})
+print(json.dumps({{"env": os.environ.get("OPENBLAS_NUM_THREADS"), "single": BLAS_SINGLE,
+                  "threads": threads,
+                  "user": user_environment().get("OPENBLAS_NUM_THREADS")}}))
+"""
+
+
+def _blas(argv, preset=None):
+    env = {k: v for k, v in os.environ.items() if k != "OPENBLAS_NUM_THREADS"}
+    if preset is not None:
+        env["OPENBLAS_NUM_THREADS"] = preset
+    out = subprocess.run([sys.executable, "-c", BLAS.format(argv=argv)], capture_output=True,
+                         text=True, check=True, env=env)
+    return json.loads(out.stdout)
+
+
+def test_command_process_starts_openblas_with_one_thread_unless_told_otherwise():
+    """python -m network.<command>: OpenBLAS (NumPy's and SciPy's) starts with one thread, the
+    environment handed to other programs does not carry it; a user's setting is kept; the
+    library imported into a session leaves OpenBLAS alone."""
+    got = _blas(["-m"])
+    if got["threads"]:                                  # NumPy/SciPy built on OpenBLAS
+        assert got == {"env": "1", "single": True, "threads": [1], "user": None}
+    kept = _blas(["-m"], preset="2")
+    assert (kept["env"], kept["single"], kept["user"]) == ("2", False, "2")
+    if got["threads"] and (os.cpu_count() or 1) >= 2:
+        assert kept["threads"] == [2]
+    plain = _blas(["-c"])
+    assert plain["env"] is None and plain["single"] is False and plain["user"] is None

@@ -4,7 +4,8 @@ What a user waits for: a fresh interpreter, the imports, reading the file, every
 printing, exit. Each command runs ``repeats`` times after one warm-up run (which writes the
 bytecode caches and the Q* table's derived arrays, as a user's first run does); the bench
 packings of the scaling part and the bundled scene, ``--stokes`` (file to permeability, the
-target) and the default command (with inertia). The child's environment drops
+target) and the default command (with inertia). The child's environment is the user's (without
+this command process's ``OPENBLAS_NUM_THREADS``, ``network._lean``) and drops
 ``PYTHONDONTWRITEBYTECODE`` so that Python caches bytecode as it does by default.
 
 YADE's FlowEngine on the 5 000-sphere packing (its own triangulation and Cholesky solve):
@@ -28,6 +29,7 @@ import sys
 import time
 from pathlib import Path
 
+from .._lean import user_environment
 from ..packing import default_packing_path
 from ._scaling import packing_file
 
@@ -49,7 +51,7 @@ def yade_run(path: Path) -> tuple[float, float] | None:
     if exe is None or not YADE_SCRIPT.is_file():
         return None
     t0 = time.perf_counter()
-    out = subprocess.run([exe, "-n", "-x", str(YADE_SCRIPT), str(path)],
+    out = subprocess.run([exe, "-n", "-x", str(YADE_SCRIPT), str(path)], env=user_environment(),
                          capture_output=True, text=True, check=False)
     dt = time.perf_counter() - t0
     m = _YADE_FIRST.search(out.stdout + out.stderr)
@@ -81,7 +83,7 @@ def per_packing(sizes, workdir: Path, seed: int, repeats: int = 7,
     bundled scene): one row per packing and mode with min, median and max over ``repeats``;
     with ``yade`` the ``--stokes`` rows of the bench packings carry the :func:`yade_summary`
     of YADE runs interleaved with ours."""
-    env = dict(os.environ)
+    env = user_environment()            # as a user starts it: not this process's additions
     env.pop("PYTHONDONTWRITEBYTECODE", None)
     cases = [(n, packing_file(n, workdir, seed)) for n in sizes]
     if bundled:

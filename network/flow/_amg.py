@@ -36,6 +36,7 @@ import numpy as np
 import scipy.sparse as sp
 
 from .._deferred import csgraph, sparse_linalg
+from .._lean import BLAS_SINGLE
 
 __all__ = ["AMGSolver", "SMOOTHERS", "SolveInfo"]
 
@@ -47,8 +48,11 @@ _BLAS = None
 def one_blas_thread():
     """Context manager limiting BLAS to one thread (threadpoolctl). The loaded BLAS libraries
     are found once per process (a ``ThreadpoolController``): 0.03 ms a call instead of the
-    1.2 ms of ``threadpool_limits``, which searches them again on every call."""
+    1.2 ms of ``threadpool_limits``, which searches them again on every call. Nothing to limit
+    in a command process whose OpenBLAS started with one thread (``network._lean``)."""
     global _BLAS
+    if BLAS_SINGLE:                 # a command process whose OpenBLAS started with one thread
+        return contextlib.nullcontext()
     if _BLAS is None:
         from threadpoolctl import ThreadpoolController
         _BLAS = ThreadpoolController()
