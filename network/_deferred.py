@@ -27,15 +27,19 @@ class Deferred:
         self._module = None
 
     def __getattr__(self, attr: str):
-        module = self._module
-        if module is None:
-            # through the import system, never sys.modules directly: a module that another
-            # thread is importing is there half-executed, and import_module waits for it
-            module = self._module = importlib.import_module(self._name)
-        return getattr(module, attr)
+        return getattr(_load(self), attr)
 
     def __repr__(self) -> str:
         return f"<deferred module {self._name!r}>"
+
+
+def _load(deferred: Deferred):
+    """The module ``deferred`` stands for, imported on the first call."""
+    if deferred._module is None:
+        # through the import system, never sys.modules directly: a module that another thread
+        # is importing is there half-executed, and import_module waits for it
+        deferred._module = importlib.import_module(deferred._name)
+    return deferred._module
 
 
 csgraph = Deferred("scipy.sparse.csgraph")
@@ -45,5 +49,5 @@ spatial = Deferred("scipy.spatial")
 
 def import_now() -> None:
     """Import every deferred module now: for a thread with time to spare (beside gmsh)."""
-    for module in (spatial, csgraph, sparse_linalg):
-        module.__name__          # noqa: B018 - any attribute imports it
+    for deferred in (spatial, csgraph, sparse_linalg):
+        _load(deferred)

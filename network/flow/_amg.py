@@ -29,6 +29,7 @@ from __future__ import annotations
 
 import contextlib
 import dataclasses
+import importlib
 import logging
 import time
 
@@ -57,6 +58,13 @@ def one_blas_thread():
         from threadpoolctl import ThreadpoolController
         _BLAS = ThreadpoolController()
     return _BLAS.limit(limits=1, user_api="blas")
+
+
+def import_pyamg() -> None:
+    """Import the pyamg modules :class:`AMGSolver` uses (smoothed aggregation, Krylov,
+    smoothing): for a thread with time to spare before the first setup."""
+    for name in ("pyamg.aggregation", "pyamg.krylov", "pyamg.relaxation.smoothing"):
+        importlib.import_module(name)
 
 
 @contextlib.contextmanager

@@ -30,6 +30,7 @@ from ..packing import Packing
 from ..pores import (Region, Tessellation, axis_index, default_region, merge_pores,
                      prune_disconnected, region_porosity, select_sample, tessellate, tie_groups)
 from ._darcy import core_permeability, darcy_permeability
+from ._amg import import_pyamg
 from ._inertial import solve_inertial
 from ._linear import solve_fixed_pressure
 from ._result import FlowResult
@@ -318,13 +319,12 @@ def solve_network(packing: Packing, *, axis="z", region: Region | None = None,
 
 def _beside_tessellation(packing, reg, ax, porosity_points, db, kernel=False):
     """The Q* table loaded (``db``; False: none needed), the compiled conduit loop loaded
-    (``kernel``), pyamg imported, and the region's (porosity, standard error) when
+    (``kernel``), pyamg's modules imported, and the region's (porosity, standard error) when
     ``porosity_points`` (else None): what :func:`solve_network` runs beside the tessellation."""
     if db is not False and has_grid(db) and kernel:
         load_conduit_kernel(db)
-    import pyamg.aggregation, pyamg.krylov, pyamg.relaxation.smoothing  # noqa: F401 (solve's)
-    return region_porosity(packing, reg, ax, n_points=porosity_points) if porosity_points \
-        else None
+    import_pyamg()
+    return region_porosity(packing, reg, ax, n_points=porosity_points) if porosity_points else None
 
 
 #: Core margin of :func:`_core_estimate`, in mean sphere diameters.

@@ -34,9 +34,9 @@ import numpy as np
 import scipy.sparse as sp
 
 from .._deferred import csgraph, import_now, spatial
-from ._simplex import column_norm, cross_components, edge_determinants
+from ._simplex import CHUNK, column_norm, cross_components, edge_determinants
 
-__all__ = ["CHUNK", "ENGINES", "FACES", "GMSH_MIN_CENTRES", "QHULL_OPTIONS", "delaunay"]
+__all__ = ["ENGINES", "FACES", "GMSH_MIN_CENTRES", "QHULL_OPTIONS", "delaunay"]
 
 log = logging.getLogger(__name__)
 
@@ -54,8 +54,6 @@ FACES = np.array([[1, 2, 3], [0, 2, 3], [0, 1, 3], [0, 1, 2]])
 # relative tolerance of the volume and area checks
 _VOLUME_TOL = 1e-9
 _GMSH_LOCK = threading.Lock()
-#: rows per chunk of vectorised geometry (bounds the temporaries at a million centres)
-CHUNK = 262_144
 
 
 class _Unchecked(Exception):

@@ -45,8 +45,7 @@ import numpy as np
 import scipy.sparse as sp
 
 from .._deferred import csgraph
-from ._delaunay import CHUNK
-from ._simplex import circumcentres, column_norm
+from ._simplex import circumcentres, column_norm, pair_distances
 
 __all__ = ["PoreMerge", "merge_pores", "circumspheres"]
 
@@ -186,13 +185,13 @@ def merge_pores(tessellation, *, tolerance: float = 0.02, min_quality: float = 0
     vertex_sum = pv[:, 0] + pv[:, 1] + pv[:, 2] + pv[:, 3]
     vp, vq = vertex_sum[p] - face_sum, vertex_sum[q] - face_sum
     both = ok[p] & ok[q]
-    dq, dp = np.empty(inner.size), np.empty(inner.size)
+    # |distance of the fourth vertex from the other circumcentre - its radius| / radius
+    dq, dp = pair_distances(pts_c, vq, cen_c, p), pair_distances(pts_c, vp, cen_c, q)
     with np.errstate(invalid="ignore"):
-        for a in range(0, inner.size, CHUNK):   # cache-sized pieces: no page-faulted temporaries
-            b = min(a + CHUNK, inner.size)
-            pa, qa = p[a:b], q[a:b]
-            dq[a:b] = np.abs(column_norm(pts_c[:, vq[a:b]] - cen_c[:, pa]) - rad[pa]) / rad[pa]
-            dp[a:b] = np.abs(column_norm(pts_c[:, vp[a:b]] - cen_c[:, qa]) - rad[qa]) / rad[qa]
+        for d, r in ((dq, rad[p]), (dp, rad[q])):
+            d -= r
+            np.abs(d, out=d)
+            d /= r
     thr = max(tol, 1e-9)
     merge = both & (dq <= thr) & (dp <= thr)
     mp, mq = p[merge], q[merge]

@@ -34,8 +34,8 @@ import scipy.sparse as sp
 
 from .._deferred import csgraph
 from ..packing import Packing
-from ._delaunay import CHUNK, ENGINES, FACES, QHULL_OPTIONS, delaunay
-from ._simplex import circumcentres, column_norm, cross_components
+from ._delaunay import ENGINES, FACES, QHULL_OPTIONS, delaunay
+from ._simplex import CHUNK, circumcentres, column_norm, cross_components, pair_distances
 
 __all__ = ["ENGINES", "Tessellation", "tessellate", "QHULL_OPTIONS", "tie_groups"]
 
@@ -316,10 +316,7 @@ def tessellate(packing: Packing, *, qhull_options: str = QHULL_OPTIONS,
     tied = np.zeros(n_t, dtype=bool)
     p_in, q_in = ft[inner], fn[inner]                # the two pores of each interior face
     circ_c = np.ascontiguousarray(circ.T)            # component rows: contiguous gathers
-    tie = np.empty(p_in.size, dtype=bool)
-    for a in range(0, p_in.size, CHUNK):             # cache-sized temporaries
-        pa, qa = p_in[a:a + CHUNK], q_in[a:a + CHUNK]
-        tie[a:a + CHUNK] = column_norm(circ_c[:, pa] - circ_c[:, qa]) < tie_tol * dbar  # NaN: no
+    tie = pair_distances(circ_c, p_in, circ_c, q_in) < tie_tol * dbar   # NaN: False
     tied[inner] = tie | flat[p_in] | flat[q_in]
 
     in_simplex = np.zeros(packing.n, dtype=bool)
