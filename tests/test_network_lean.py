@@ -21,10 +21,19 @@ print(json.dumps({{"state": state, "count": int(masked.count()), "sum": float(ma
 """
 
 
+def _python(code, env=None, check=True):
+    """``code`` run by a fresh interpreter (``-c``): the completed process, text output."""
+    return subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
+                          check=check, env=env)
+
+
+def _json(code, env=None):
+    """What ``code`` prints as JSON in a fresh interpreter."""
+    return json.loads(_python(code, env).stdout)
+
+
 def _probe(argv):
-    out = subprocess.run([sys.executable, "-c", PROBE.format(argv=argv)], capture_output=True,
-                         text=True, check=True)
-    return json.loads(out.stdout)
+    return _json(PROBE.format(argv=argv))
 
 
 def test_command_process_defers_numpy_submodules_until_used():
@@ -81,7 +90,7 @@ finish(2)
 def test_finish_with_stdout_gone_keeps_the_status_and_prints_no_traceback():
     """A stdout that cannot be flushed at the end (the reader gone, the descriptor closed):
     finish still ends with the command's status, and stderr stays clean."""
-    out = subprocess.run([sys.executable, "-c", CLOSED], capture_output=True, text=True)
+    out = _python(CLOSED, check=False)
     assert out.returncode == 2 and out.stderr == ""
 
 
@@ -89,8 +98,7 @@ def test_finish_runs_handlers_flushes_and_keeps_the_exit_status():
     """finish() ends the process by os._exit: the atexit handlers still run, buffered output
     (a pipe: block-buffered) still arrives, and the status is the command's."""
     for code in (0, 1, 2):
-        out = subprocess.run([sys.executable, "-c", FINISH.format(code=code)],
-                             capture_output=True, text=True)
+        out = _python(FINISH.format(code=code), check=False)
         assert (out.returncode, out.stdout, out.stderr) == (code, "unflushed, handler ran\n",
                                                             "no newline")
 
@@ -116,9 +124,7 @@ def test_command_process_runs_pyamg_init_only_when_a_package_name_is_asked_for()
     from importlib.metadata import version
     runs = {}
     for argv in (["-m"], ["-c"]):
-        out = subprocess.run([sys.executable, "-c", PYAMG.format(argv=argv)],
-                             capture_output=True, text=True, check=True)
-        runs[argv[0]] = json.loads(out.stdout)
+        runs[argv[0]] = _json(PYAMG.format(argv=argv))
     assert runs["-m"]["gallery_before"] is False and runs["-c"]["gallery_before"] is True
     for got in runs.values():
         assert got["gallery_after"] is True and got["version"] == version("pyamg")
@@ -151,9 +157,7 @@ def test_scipy_modules_are_imported_at_first_use_and_safely_from_threads():
     (network._deferred); eight threads using them first at once all get the real functions
     (the import system's lock, not a half-executed module)."""
     for _ in range(3):
-        out = subprocess.run([sys.executable, "-c", DEFERRED], capture_output=True, text=True,
-                             check=True)
-        got = json.loads(out.stdout)
+        got = _json(DEFERRED)
         assert got == {"before": [], "got": [["cKDTree", "connected_components"]], "n": 8}
 
 
@@ -175,9 +179,7 @@ def _blas(argv, preset=None):
     env = {k: v for k, v in os.environ.items() if k != "OPENBLAS_NUM_THREADS"}
     if preset is not None:
         env["OPENBLAS_NUM_THREADS"] = preset
-    out = subprocess.run([sys.executable, "-c", BLAS.format(argv=argv)], capture_output=True,
-                         text=True, check=True, env=env)
-    return json.loads(out.stdout)
+    return _json(BLAS.format(argv=argv), env)
 
 
 def test_command_process_starts_openblas_with_one_thread_unless_told_otherwise():
