@@ -46,10 +46,7 @@ import threading
 #: use from two threads at once met a half-executed module ("module 'numpy.ma' has no attribute
 #: 'isMaskedArray'", 1 run in 12 once SciPy's modules were imported beside gmsh).
 LAZY_NUMPY = ("numpy.f2py", "numpy.testing")
-#: Packages whose ``__init__`` imports far more than the commands use: pyamg's imports every
-#: solver family, its gallery (and through it ``scipy.io``), its plotting helpers and
-#: ``importlib.metadata`` for its version, 0.05 s where the smoothed-aggregation modules the
-#: commands use take 0.01 s.
+#: Packages whose ``__init__`` imports far more than the commands use (module docstring).
 LAZY_INIT = ("pyamg",)
 
 
