@@ -26,6 +26,7 @@ import warnings
 from pathlib import Path
 
 from ._air import MU_AIR_PA_S, RHO_AIR_KG_M3, check_positive
+from ._lean import keep_heap
 from .packing import UNITS, default_packing_path, read_container, read_packing, scale_warning
 from .flow import DEFAULT_INERTIAL_LAW, INERTIAL_LAWS
 
@@ -281,6 +282,7 @@ def load_packing(args):
     path = Path(args.packing) if args.packing else default_packing_path()
     packing = read_packing(path, units=args.units)
     read_container(path)
+    keep_heap(packing.n)
     msg = scale_warning(packing)
     if msg:
         warn(msg)

@@ -17,7 +17,10 @@ project's commands about 0.15 s of work they never use, a sixth of a 5 000-spher
   use; the commands have no dense algebra large enough to gain from them (the AMG solves ran
   under a one-thread limit already): started with one thread, 5 000 spheres 1.010 -> 0.900 s,
   20 000 2.400 -> 2.180 s (16 interleaved pairs each). ``OPENBLAS_NUM_THREADS`` set by the
-  user is left as it is.
+  user is left as it is;
+- glibc's malloc returns every large freed block to the kernel, so that each NumPy temporary
+  of the pipeline is page-faulted afresh: :func:`keep_heap` (called once the packing is read)
+  keeps it for the next one.
 
 :func:`lean_imports` registers ``numpy.f2py`` and ``numpy.testing`` with the standard
 library's :class:`importlib.util.LazyLoader` (the module object exists, its code runs on the
@@ -35,6 +38,7 @@ never when the library is imported into someone's session.
 
 from __future__ import annotations
 
+import ctypes
 import importlib.util
 import os
 import sys
@@ -101,6 +105,20 @@ def _package_first(name: str) -> bool:
     return True
 
 
+#: glibc's malloc kept from handing memory back between the pipeline's stages
+#: (:func:`keep_heap`): ``mallopt`` parameter number -> bytes. M_MMAP_THRESHOLD (-3): blocks
+#: below it come from the heap instead of a fresh ``mmap``; M_TRIM_THRESHOLD (-1): free memory
+#: at the heap's top kept up to this; M_TOP_PAD (-2): extra taken per heap extension.
+HEAP_KEPT = {-3: 256 << 20, -1: 512 << 20, -2: 64 << 20}
+#: Largest packing (spheres) :func:`keep_heap` acts on: measured faster up to 300 000 spheres
+#: (peak memory +3-7 %); at 1e6 no faster and 0.77 GB more (docs/network-bench.md, session 16).
+HEAP_KEPT_MAX_SPHERES = 300_000
+#: The environment variables through which a user sets the same parameters (left alone then).
+MALLOC_ENV = ("MALLOC_MMAP_THRESHOLD_", "MALLOC_TRIM_THRESHOLD_", "MALLOC_TOP_PAD_",
+              "GLIBC_TUNABLES")
+#: True in a command process (:func:`lean_imports` has run).
+COMMAND = False
+
 #: True once :func:`lean_imports` has started OpenBLAS with one thread (``OPENBLAS_NUM_THREADS``
 #: unset before NumPy's import, and NumPy built on OpenBLAS): then no call needs limiting.
 BLAS_SINGLE = False
@@ -123,7 +141,8 @@ def lean_imports() -> list[str]:
     ``xp_capabilities`` plain, and start OpenBLAS with one thread where the environment does
     not say otherwise (:data:`BLAS_SINGLE`); the names of what was changed (an empty list
     where everything was already imported)."""
-    global BLAS_SINGLE
+    global BLAS_SINGLE, COMMAND
+    COMMAND = True
     changed = []
     if "numpy" not in sys.modules and "OPENBLAS_NUM_THREADS" not in os.environ:
         os.environ["OPENBLAS_NUM_THREADS"] = ADDED_ENV["OPENBLAS_NUM_THREADS"] = "1"
@@ -144,3 +163,28 @@ def lean_imports() -> list[str]:
             api.xp_capabilities = _plain_capabilities
             changed.append("scipy xp_capabilities")
     return changed
+
+
+def keep_heap(n_spheres: int) -> bool:
+    """In a command process on glibc, keep freed memory in the heap for the next stage.
+
+    glibc's malloc serves blocks above its ``mmap`` threshold (128 kB, raised on the fly to at
+    most 32 MB) with fresh mappings and returns them at ``free``: every large NumPy temporary of
+    the pipeline is then paid again in page faults, zeroed by the kernel, 4 kB at a time (1e5
+    faults, 0.3-0.7 s of kernel time in a 20 000-sphere ``network.solve``). With
+    :data:`HEAP_KEPT` (blocks up to 256 MB from the heap, up to 512 MB of free heap kept) a
+    freed block is re-used by the next one. Acts on packings of at most
+    :data:`HEAP_KEPT_MAX_SPHERES` spheres, only where the user set none of :data:`MALLOC_ENV`
+    and Python was started as a command (:data:`COMMAND`); True where it changed the setting.
+    Results are untouched (where memory comes from, not what is computed).
+    """
+    if not COMMAND or n_spheres > HEAP_KEPT_MAX_SPHERES or any(v in os.environ
+                                                                for v in MALLOC_ENV):
+        return False
+    try:
+        os.confstr("CS_GNU_LIBC_VERSION")        # ValueError / OSError where not glibc
+        mallopt = ctypes.CDLL(None).mallopt
+    except (ValueError, OSError, AttributeError):
+        return False
+    mallopt.argtypes = (ctypes.c_int, ctypes.c_int)
+    return all([mallopt(param, value) == 1 for param, value in HEAP_KEPT.items()])

@@ -8,6 +8,8 @@ import os
 import subprocess
 import sys
 
+from network._lean import HEAP_KEPT_MAX_SPHERES, MALLOC_ENV
+
 PROBE = """
 import json, sys
 sys.argv = {argv!r}
@@ -195,3 +197,54 @@ def test_command_process_starts_openblas_with_one_thread_unless_told_otherwise()
         assert kept["threads"] == [2]
     plain = _blas(["-c"])
     assert plain["env"] is None and plain["single"] is False and plain["user"] is None
+
+
+HEAP = """
+import json, resource, sys
+sys.argv = {argv!r}
+import numpy as np
+from network import _lean
+
+
+def faults(nbytes):
+    '''Minor page faults of filling and freeing an nbytes block, twice.'''
+    out = []
+    for _ in range(2):
+        f0 = resource.getrusage(resource.RUSAGE_SELF).ru_minflt
+        block = np.ones(nbytes // 8)
+        del block
+        out.append(resource.getrusage(resource.RUSAGE_SELF).ru_minflt - f0)
+    return out
+
+
+kept = _lean.keep_heap({n})
+print(json.dumps({{"kept": kept, "faults": faults(64 << 20)}}))
+"""
+
+
+def _heap(argv, n, **env):
+    base = {k: v for k, v in os.environ.items() if k not in MALLOC_ENV}
+    # 4 kB pages throughout: NumPy's huge-page advice would hide the faults being counted
+    return _json(HEAP.format(argv=argv, n=n), env={**base, "NUMPY_MADVISE_HUGEPAGE": "0", **env})
+
+
+def test_command_process_keeps_freed_heap_for_the_next_block_on_glibc():
+    """A 64 MB block (16 384 pages, above glibc's largest automatic mmap threshold, 32 MB) filled
+    and freed twice: in a command process with a packing of at most HEAP_KEPT_MAX_SPHERES the
+    second fill re-uses the first one's pages; for a larger packing, in a library session or
+    with the user's own MALLOC_* setting, each fill faults every page again."""
+    try:
+        glibc = bool(os.confstr("CS_GNU_LIBC_VERSION"))
+    except (ValueError, OSError):
+        glibc = False
+    pages = (64 << 20) // 4096
+    got = _heap(["-m"], 5000)
+    assert got["kept"] is glibc
+    if glibc:
+        assert got["faults"][0] > 0.9 * pages and got["faults"][1] < 0.05 * pages
+    for argv, n, env in ((["-m"], HEAP_KEPT_MAX_SPHERES + 1, {}), (["-c"], 5000, {}),
+                         (["-m"], 5000, {"MALLOC_TOP_PAD_": "131072"})):
+        other = _heap(argv, n, **env)
+        assert other["kept"] is False, (argv, n, env)
+        if glibc:
+            assert min(other["faults"]) > 0.9 * pages, (argv, n, env)
