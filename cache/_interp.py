@@ -203,16 +203,11 @@ class GridTable:
         self.spec = spec
         self.safety = float(safety)
         shape = spec.shape
-        q = np.asarray(qstar, dtype=float).reshape(shape)
-        self.qstar = q
-        good = np.isfinite(q) & (q > 0)
-        self.node_ok = good
-        with np.errstate(divide="ignore", invalid="ignore"):
-            v = np.where(good, np.log(np.where(good, q, 1.0)), np.nan)
-        self.values = fill_nan(v) if derived is None else derived["values"].reshape(shape)
-        fe = np.zeros(shape) if fe_error is None else np.asarray(fe_error, float).reshape(shape)
-        fe = np.where(np.isfinite(fe), np.abs(fe), 0.0)
-        self.fe_error = fe
+        self.qstar = np.asarray(qstar, dtype=float).reshape(shape)
+        self._fe_given = fe_error
+        self._fe = self._log_q = None      # whole-grid passes a lookup without errors never needs
+        self.values = (fill_nan(self._node_log()[1]) if derived is None
+                       else derived["values"].reshape(shape))
         self._axes = [np.ascontiguousarray(a) for a in spec.axes]
         self._strides = np.array([int(np.prod(shape[d + 1:])) for d in range(5)], dtype=np.int64)
         self._uniform = [False, False, False, True, True]
@@ -232,10 +227,33 @@ class GridTable:
         # the per-cell error estimate is built on first use (:attr:`cell_error`): a lookup that
         # needs only which cells serve (``errors=False``) skips it (0.1-0.2 s on g1)
         self._estimate = bool(estimate)
-        self._log_q = v
-        self.cell_ok = cell_all(good) if derived is None else derived["cell_ok"].reshape(shape)
+        self.cell_ok = (cell_all(self.node_ok) if derived is None
+                        else derived["cell_ok"].reshape(shape))
         self._cell_error = None
         self._flat_values = np.ascontiguousarray(self.values.ravel())
+
+    def _node_log(self):
+        """(node_ok, ln Q* with NaN at the invalid nodes), computed on the first call."""
+        if self._log_q is None:
+            q = self.qstar
+            good = np.isfinite(q) & (q > 0)
+            with np.errstate(divide="ignore", invalid="ignore"):
+                self._log_q = (good, np.where(good, np.log(np.where(good, q, 1.0)), np.nan))
+        return self._log_q
+
+    @property
+    def node_ok(self):
+        """Nodes with a finite positive Q* (bool, ``spec.shape``)."""
+        return self._node_log()[0]
+
+    @property
+    def fe_error(self):
+        """|relative FE error| at the nodes (0 where unknown), ``spec.shape``."""
+        if self._fe is None:
+            given = np.zeros(self.spec.shape) if self._fe_given is None else self._fe_given
+            fe = np.asarray(given, float).reshape(self.spec.shape)
+            self._fe = np.where(np.isfinite(fe), np.abs(fe), 0.0)
+        return self._fe
 
     def derived(self):
         """The arrays a lookup needs that cost a whole-grid pass to make (``derived=``)."""
@@ -267,7 +285,7 @@ class GridTable:
                 k_size += np.abs(self._k[d].reshape(shape)) / 4
         self._estimated = np.zeros(shape, dtype=bool)
         if self._estimate:
-            dnode = self._coarse_difference(self._log_q)
+            dnode = self._coarse_difference(self._node_log()[1])
             # third order when the coarse sub-grid has its curvature terms in every direction
             # (>= 3 nodes); else it is partly multilinear and its error shrinks only as h^2
             cs = self.coarse_spec().shape
