@@ -39,6 +39,10 @@ from .pores import (QHULL_OPTIONS, Region, SampleNetwork, Tessellation, default_
                     tessellate, tie_groups)
 from .validation import beetstra_permeability, kozeny_carman_permeability, lattice_permeability
 
+if _sys.argv[:1] == ["-m"]:
+    from ._lean import imports_done as _imports_done
+    _imports_done()
+
 __all__ = [
     "Packing", "read_packing", "write_packing_csv", "default_packing_path", "read_container",
     "Tessellation", "tessellate", "tie_groups", "QHULL_OPTIONS",

@@ -248,3 +248,22 @@ def test_command_process_keeps_freed_heap_for_the_next_block_on_glibc():
         assert other["kept"] is False, (argv, n, env)
         if glibc:
             assert min(other["faults"]) > 0.9 * pages, (argv, n, env)
+
+
+GC_PROBE = """
+import gc, json, sys
+sys.argv = {argv!r}
+import network
+print(json.dumps({{"enabled": gc.isenabled(), "frozen": gc.get_freeze_count(),
+                  "modules": len(sys.modules)}}))
+"""
+
+
+def test_command_process_imports_without_collections_then_freezes_them():
+    """python -m network.<command>: the collector is on again after the package's import, with
+    the imported objects (at least one per module loaded) frozen out of its passes; a library
+    session's collector is untouched."""
+    got = _json(GC_PROBE.format(argv=["-m"]))
+    assert got["enabled"] is True and got["frozen"] > got["modules"]
+    plain = _json(GC_PROBE.format(argv=["-c"]))
+    assert plain["enabled"] is True and plain["frozen"] == 0
