@@ -32,6 +32,10 @@ def test_saved_arrays_rebuild_the_same_table(tmp_path):
         np.testing.assert_array_equal(q1, q2)
         np.testing.assert_array_equal(e1, e2)
     np.testing.assert_array_equal(fresh.cell_error, again.cell_error)
+    # the node passes the derived table makes on first use only
+    np.testing.assert_array_equal(fresh.node_ok, again.node_ok)
+    np.testing.assert_array_equal(fresh.fe_error, again.fe_error)
+    assert again.fe_error.shape == spec.shape and np.all(again.fe_error >= 0)
     # one copy per table file: a newer one replaces it
     assert [p.name for p in tmp_path.iterdir()] == [saved.name]
 

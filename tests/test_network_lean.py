@@ -229,25 +229,27 @@ def _heap(argv, n, **env):
 
 
 def test_command_process_keeps_freed_heap_for_the_next_block_on_glibc():
-    """A 64 MB block (16 384 pages, above glibc's largest automatic mmap threshold, 32 MB) filled
-    and freed twice: in a command process with a packing of at most HEAP_KEPT_MAX_SPHERES the
-    second fill re-uses the first one's pages; for a larger packing, in a library session or
-    with the user's own MALLOC_* setting, each fill faults every page again."""
+    """A 64 MB block (above glibc's largest automatic mmap threshold, 32 MB) filled and freed
+    twice: in a command process with a packing of at most HEAP_KEPT_MAX_SPHERES the second fill
+    re-uses the first one's pages (no fault); for a larger packing, in a library session or with
+    the user's own MALLOC_* setting, the second fill faults as many pages as the first (16 384
+    with 4 kB pages; fewer where the kernel gives huge pages unasked)."""
     try:
         glibc = bool(os.confstr("CS_GNU_LIBC_VERSION"))
     except (ValueError, OSError):
         glibc = False
-    pages = (64 << 20) // 4096
     got = _heap(["-m"], 5000)
     assert got["kept"] is glibc
     if glibc:
-        assert got["faults"][0] > 0.9 * pages and got["faults"][1] < 0.05 * pages
+        first, second = got["faults"]
+        assert first >= 16 and second <= 0.05 * first
     for argv, n, env in ((["-m"], HEAP_KEPT_MAX_SPHERES + 1, {}), (["-c"], 5000, {}),
                          (["-m"], 5000, {"MALLOC_TOP_PAD_": "131072"})):
         other = _heap(argv, n, **env)
         assert other["kept"] is False, (argv, n, env)
         if glibc:
-            assert min(other["faults"]) > 0.9 * pages, (argv, n, env)
+            first, second = other["faults"]
+            assert first >= 16 and second >= 0.9 * first, (argv, n, env)
 
 
 GC_PROBE = """
