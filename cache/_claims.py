@@ -12,9 +12,8 @@ blocks nobody for long; a run releases its claims when it ends.  Details and mea
 from __future__ import annotations
 
 import os
-import socket
+import platform
 import time
-import uuid
 
 import numpy as np
 
@@ -30,12 +29,12 @@ _SCHEMA = ("CREATE TABLE IF NOT EXISTS claims (k1 INTEGER, k2 INTEGER, k3 INTEGE
 
 def new_owner():
     """``host:pid:random`` naming one run."""
-    return f"{socket.gethostname()}:{os.getpid()}:{uuid.uuid4().hex[:8]}"
+    return f"{platform.node()}:{os.getpid()}:{os.urandom(4).hex()}"
 
 
 def _alive(owner):
     host, pid, _ = (owner.split(":") + ["", "", ""])[:3]
-    if host != socket.gethostname():
+    if host != platform.node():
         return True            # another machine: only the lease can tell
     try:
         os.kill(int(pid), 0)

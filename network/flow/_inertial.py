@@ -40,9 +40,7 @@ from __future__ import annotations
 
 import dataclasses
 import logging
-import multiprocessing as mp
 import time
-from concurrent.futures import ProcessPoolExecutor
 
 import numpy as np
 import scipy.sparse as sp
@@ -329,7 +327,13 @@ def _run_chains(chain, chains):
     forked processes (they inherit the network and the AMG hierarchy; POSIX only: where
     ``fork`` is not available the chains run one after the other here)."""
     global _CHAIN
-    if len(chains) == 1 or "fork" not in mp.get_all_start_methods():
+    if len(chains) == 1:
+        return chain(chains[0])
+    # the process machinery (0.02 s of imports) only where several chains run
+    import multiprocessing as mp
+    from concurrent.futures import ProcessPoolExecutor
+
+    if "fork" not in mp.get_all_start_methods():
         return [kp for ks in chains for kp in chain(ks)]
     _CHAIN = chain
     try:
