@@ -277,6 +277,18 @@ sys.argv = {argv!r}
 import numpy as np
 import network
 import scipy.spatial as sps
+import threading
+names, barrier = [], threading.Barrier(8)
+
+def first_use():
+    barrier.wait()                       # eight threads ask the package at once
+    names.append((sps.Delaunay.__name__, sps.cKDTree.__name__, sps.QhullError.__name__))
+
+threads = [threading.Thread(target=first_use) for _ in range(8)]
+for t in threads:
+    t.start()
+for t in threads:
+    t.join()
 from scipy.spatial._qhull import Delaunay
 hull = sps.ConvexHull(np.array([[0, 0, 0], [1, 0, 0], [0, 1, 0], [0, 0, 1.0]]))
 pairs = sps.cKDTree(np.array([[0, 0, 0], [0.5, 0, 0], [3, 0, 0.0]])).query_pairs(1.0)
@@ -286,6 +298,7 @@ before = [m for m in ("scipy.spatial.distance", "scipy.special", "scipy.spatial.
 d = float(sps.minkowski_distance([0, 0], [3, 4]))      # a name only the package's __init__ has
 print(json.dumps({{"volume": hull.volume, "pairs": sorted(map(sorted, pairs)),
                   "tets": tri.simplices.shape[0], "same": sps.Delaunay is Delaunay,
+                  "threads": sorted(set(names)), "n": len(names),
                   "before": before, "d": d,
                   "after": "scipy.spatial.distance" in sys.modules}}))
 """
@@ -293,12 +306,14 @@ print(json.dumps({{"volume": hull.volume, "pairs": sorted(map(sorted, pairs)),
 
 def test_command_process_serves_qhull_and_kdtree_without_scipy_spatial_init():
     """A command takes Delaunay, ConvexHull and cKDTree from their own modules without
-    scipy.spatial's __init__ (distance, scipy.special, transform); any other package-level
-    name runs it; the answers and objects are a plain import's."""
+    scipy.spatial's __init__ (distance, scipy.special, transform), eight threads asking at once
+    included; any other package-level name runs it; the answers and objects are a plain
+    import's."""
     lean = _json(SPATIAL.format(argv=["-m"]))
     plain = _json(SPATIAL.format(argv=["-c"]))
     assert lean["before"] == [] and len(plain["before"]) == 3
     for got in (lean, plain):
         assert abs(got["volume"] - 1.0 / 6.0) < 1e-15 and got["pairs"] == [[0, 1]]
         assert got["tets"] == 1 and got["same"] is True
+        assert got["n"] == 8 and got["threads"] == [["Delaunay", "cKDTree", "QhullError"]]
         assert got["d"] == 5.0 and got["after"] is True
