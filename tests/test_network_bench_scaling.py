@@ -120,6 +120,13 @@ def test_per_packing_yade_where_installed(run, monkeypatch):
         assert here["ratio_to_flowengine_median"] == 1.25
         assert here["faster_than_flowengine_runs"] == 1
         assert here["flowengine_median_s"] == engine and here["command_median_s"] == whole
+        # the run of ours right after YADE's is timed apart; the counted one follows ours
+        row = _per_packing.per_packing([SIZES[0]], tmp, 1, repeats=1, bundled=False,
+                                       yade=True)[0]
+        apart = row["yade_here"]["ours_after_yade_s"]
+        assert len(apart) == 1 and apart[0] > 0 and row["times_s"][0] > 0
+        assert row["yade_here"]["ours_after_yade_median_s"] == apart[0]
+        assert "ours right after a YADE run" in _per_packing.per_packing_line(row)
     monkeypatch.setattr(_per_packing.shutil, "which", lambda name: None)
     assert _per_packing.yade_run(path) is None
     rows = _per_packing.per_packing([SIZES[0]], tmp, 1, repeats=1, bundled=False, yade=True)

@@ -15,7 +15,9 @@ on this machine (``docs/scripts/yade_flowengine.py`` through ``yade -n -x``; Deb
 package): its first ``emulateAction`` (FlowEngine's triangulation, factorisation and solve,
 without YADE's start-up) and its whole command, one YADE run right after each of ours on the
 ``--stokes`` rows, so that each pair sees the same host speed (a shared host's speed moves by
-25 % within an hour): the row carries the paired ratio ours / FlowEngine.
+25 % within an hour): the row carries the paired ratio ours / FlowEngine. Our counted runs
+follow one of ours, as without ``--yade``; the run right after each YADE run is timed apart
+(``ours_after_yade_s``), since YADE leaves the caches full of its own code and data.
 """
 
 from __future__ import annotations
@@ -44,12 +46,17 @@ YADE_SCRIPT = Path(__file__).resolve().parents[2] / "docs" / "scripts" / "yade_f
 _YADE_FIRST = re.compile(r"first emulateAction ([0-9.]+) s")
 
 
+def yade_available() -> bool:
+    """Whether the ``yade`` program and the FlowEngine script are here."""
+    return shutil.which("yade") is not None and YADE_SCRIPT.is_file()
+
+
 def yade_run(path: Path) -> tuple[float, float] | None:
     """One YADE run on ``path``: (FlowEngine's first solve, the whole command) in s, or None
     where ``yade`` or the script is missing."""
-    exe = shutil.which("yade")
-    if exe is None or not YADE_SCRIPT.is_file():
+    if not yade_available():
         return None
+    exe = shutil.which("yade")
     t0 = time.perf_counter()
     out = subprocess.run([exe, "-n", "-x", str(YADE_SCRIPT), str(path)], env=user_environment(),
                          capture_output=True, text=True, check=False)
@@ -82,7 +89,10 @@ def per_packing(sizes, workdir: Path, seed: int, repeats: int = 7,
     """Wall times of ``python -m network.solve`` on the bench packings of ``sizes`` (and the
     bundled scene): one row per packing and mode with min, median and max over ``repeats``;
     with ``yade`` the ``--stokes`` rows of the bench packings carry the :func:`yade_summary`
-    of YADE runs interleaved with ours."""
+    of YADE runs interleaved with ours: each run of ours that the row counts follows another
+    of ours (as without YADE) and is followed by YADE's; that other run, the one right after
+    YADE's, is timed apart (``ours_after_yade_s``: 10-30 % slower on this host, its caches
+    holding YADE's code and data)."""
     env = user_environment()            # as a user starts it: not this process's additions
     env.pop("PYTHONDONTWRITEBYTECODE", None)
     cases = [(n, packing_file(n, workdir, seed)) for n in sizes]
@@ -92,15 +102,16 @@ def per_packing(sizes, workdir: Path, seed: int, repeats: int = 7,
     for n, path in cases:
         for mode, extra in MODES.items():
             cmd = [sys.executable, "-m", "network.solve", str(path), "--quiet", *extra]
-            times, yade_runs = [], []
+            times, yade_runs, after_yade = [], [], []
             beside = yade and mode == "stokes" and n is not None
+            apart = beside and yade_available()
             for i in range(repeats + 1):
-                t0 = time.perf_counter()
-                out = subprocess.run(cmd, env=env, capture_output=True, text=True, check=False)
-                dt = time.perf_counter() - t0
-                if out.returncode != 0:
-                    raise RuntimeError(f"{' '.join(cmd)} exited {out.returncode}: "
-                                       f"{out.stderr.strip()[-200:]}")
+                dt = _timed(cmd, env)
+                if i and apart:
+                    # this run came right after YADE's (its caches hold YADE's code and data):
+                    # kept apart; the timed run follows one of ours, as without YADE
+                    after_yade.append(dt)
+                    dt = _timed(cmd, env)
                 if i:                                   # the first run is the warm-up
                     times.append(dt)
                     if beside:              # YADE right after each run: the same host speed
@@ -115,9 +126,23 @@ def per_packing(sizes, workdir: Path, seed: int, repeats: int = 7,
                 row["met"] = row["median_s"] <= row["target_s"]
             if beside:
                 row["yade_here"] = yade_summary(yade_runs, times)
+                if after_yade:
+                    row["yade_here"]["ours_after_yade_s"] = after_yade
+                    row["yade_here"]["ours_after_yade_median_s"] = statistics.median(after_yade)
             rows.append(row)
             print("  " + per_packing_line(row), flush=True)
     return rows
+
+
+def _timed(cmd, env) -> float:
+    """Wall seconds of one run of ``cmd``; RuntimeError naming it where it fails."""
+    t0 = time.perf_counter()
+    out = subprocess.run(cmd, env=env, capture_output=True, text=True, check=False)
+    dt = time.perf_counter() - t0
+    if out.returncode != 0:
+        raise RuntimeError(f"{' '.join(cmd)} exited {out.returncode}: "
+                           f"{out.stderr.strip()[-200:]}")
+    return dt
 
 
 def per_packing_line(row: dict) -> str:
@@ -135,6 +160,8 @@ def per_packing_line(row: dict) -> str:
                  f"{here['command_median_s']:.2f} s (medians of {len(here['command_s'])}); "
                  f"ours / FlowEngine {here['ratio_to_flowengine_median']:.2f} (faster in "
                  f"{here['faster_than_flowengine_runs']} of {len(here['command_s'])} pairs)")
+        if here.get("ours_after_yade_median_s") is not None:
+            tail += f"; ours right after a YADE run: median {here['ours_after_yade_median_s']:.3f} s"
     elif "yade_here" in row:
         tail += "; YADE here: not installed"
     return (f"{name:>16s} {row['mode']:>8s}: median {row['median_s']:.3f} s, min "
