@@ -160,8 +160,9 @@ def per_packing_line(row: dict) -> str:
                  f"{here['command_median_s']:.2f} s (medians of {len(here['command_s'])}); "
                  f"ours / FlowEngine {here['ratio_to_flowengine_median']:.2f} (faster in "
                  f"{here['faster_than_flowengine_runs']} of {len(here['command_s'])} pairs)")
-        if here.get("ours_after_yade_median_s") is not None:
-            tail += f"; ours right after a YADE run: median {here['ours_after_yade_median_s']:.3f} s"
+        after = here.get("ours_after_yade_median_s")
+        if after is not None:
+            tail += f"; ours right after a YADE run: median {after:.3f} s"
     elif "yade_here" in row:
         tail += "; YADE here: not installed"
     return (f"{name:>16s} {row['mode']:>8s}: median {row['median_s']:.3f} s, min "
