@@ -13,8 +13,9 @@ them (:func:`import_now`) on a thread of its own while gmsh, which releases the 
 from __future__ import annotations
 
 import importlib
+from concurrent.futures import Future, ThreadPoolExecutor
 
-__all__ = ["Deferred", "csgraph", "import_now", "sparse_linalg", "spatial"]
+__all__ = ["Deferred", "beside", "csgraph", "import_now", "sparse_linalg", "spatial"]
 
 
 class Deferred:
@@ -51,3 +52,12 @@ def import_now() -> None:
     """Import every deferred module now: for a thread with time to spare (beside gmsh)."""
     for deferred in (spatial, csgraph, sparse_linalg):
         _load(deferred)
+
+
+def beside(fn, *args) -> Future:
+    """``fn(*args)`` started on a thread of its own, which ends with it: its future. For work
+    that overlaps a GIL-free stretch of the caller (gmsh, Qhull, large NumPy passes)."""
+    side = ThreadPoolExecutor(1)
+    job = side.submit(fn, *args)
+    side.shutdown(wait=False)
+    return job

@@ -17,12 +17,12 @@ from __future__ import annotations
 import logging
 import time
 import tracemalloc
-from concurrent.futures import ThreadPoolExecutor
 from typing import Callable
 
 import numpy as np
 
 from .._air import MU_AIR_PA_S, RHO_AIR_KG_M3, check_density, check_positive, check_viscosity
+from .._deferred import beside
 from ..conductance import (CHAIN_ONSET_SLOPE, CHAIN_RECOVERY, KERNEL_MIN_THROATS, PORE_ONSET_SLOPE,
                            PORE_RECOVERY, check_model, check_policy, conduit_law, has_grid,
                            load_conduit_kernel, throat_conductance)
@@ -196,13 +196,12 @@ def solve_network(packing: Packing, *, axis="z", region: Region | None = None,
         # work that needs no tessellation, on a second core while gmsh or Qhull (which release
         # the GIL) runs: the Q* table's load (and the compiled conduit loop's for a large
         # packing), pyamg's import, the porosity; the thread ends with its job
-        side, own = ThreadPoolExecutor(1), conductance is None
-        eps_job = side.submit(_beside_tessellation, packing, reg, ax,
-                              porosity_points if porosity is None else 0,
-                              db if own and policy != "shape-factor" else False,
-                              own and conductance_model == "conduit" and policy == "table-only"
-                              and qstar_fn is None and 10 * packing.n >= KERNEL_MIN_THROATS)
-        side.shutdown(wait=False)
+        own = conductance is None
+        eps_job = beside(_beside_tessellation, packing, reg, ax,
+                         porosity_points if porosity is None else 0,
+                         db if own and policy != "shape-factor" else False,
+                         own and conductance_model == "conduit" and policy == "table-only"
+                         and qstar_fn is None and 10 * packing.n >= KERNEL_MIN_THROATS)
     with stage("tessellate"):
         tess = tessellate(packing, threads=threads) if tessellation is None else tessellation
     with stage("sample"):

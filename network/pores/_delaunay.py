@@ -28,12 +28,11 @@ from __future__ import annotations
 
 import logging
 import threading
-from concurrent.futures import ThreadPoolExecutor
 
 import numpy as np
 import scipy.sparse as sp
 
-from .._deferred import csgraph, import_now, spatial
+from .._deferred import beside, csgraph, import_now, spatial
 from ._simplex import CHUNK, column_norm, cross_components, edge_determinants
 
 __all__ = ["ENGINES", "FACES", "GMSH_MIN_CENTRES", "QHULL_OPTIONS", "delaunay"]
@@ -243,11 +242,8 @@ def _gmsh_checked(pts: np.ndarray, threads: int = 1) -> tuple[np.ndarray, np.nda
     o = np.lexsort(pts.T)
     if np.any(np.all(pts[o[1:]] == pts[o[:-1]], axis=1)):
         raise _Unchecked("coincident centres")      # gmsh would join them by flat tetrahedra
-    hull_job = None
-    if threads > 1:                                 # beside gmsh, which releases the GIL
-        side = ThreadPoolExecutor(1)
-        hull_job = side.submit(_hull, pts)
-        side.shutdown(wait=False)
+    # beside gmsh, which releases the GIL
+    hull_job = beside(_hull, pts) if threads > 1 else None
     simp = np.sort(_gmsh_tetrahedra(pts), axis=1)   # ascending rows: faces come out sorted
     used = np.zeros(n, dtype=bool)
     used[simp.ravel()] = True

@@ -27,12 +27,11 @@ from __future__ import annotations
 
 import dataclasses
 import logging
-from concurrent.futures import ThreadPoolExecutor
 
 import numpy as np
 import scipy.sparse as sp
 
-from .._deferred import csgraph
+from .._deferred import beside, csgraph
 from ..packing import Packing
 from ._delaunay import ENGINES, FACES, QHULL_OPTIONS, delaunay
 from ._simplex import CHUNK, circumcentres, column_norm, cross_components, pair_distances
@@ -258,9 +257,7 @@ def tessellate(packing: Packing, *, qhull_options: str = QHULL_OPTIONS,
     n_p = simp.shape[0]
     dbar = packing.mean_diameter
     if threads > 1:
-        side = ThreadPoolExecutor(1)
-        pores = side.submit(_pore_geometry, pts, simp)
-        side.shutdown(wait=False)
+        pores = beside(_pore_geometry, pts, simp)
     else:
         pores = None
         centroid, volume, circ = _pore_geometry(pts, simp)
