@@ -39,9 +39,9 @@ from .pores import (QHULL_OPTIONS, Region, SampleNetwork, Tessellation, default_
                     tessellate, tie_groups)
 from .validation import beetstra_permeability, kozeny_carman_permeability, lattice_permeability
 
-if _sys.argv[:1] == ["-m"]:
-    from ._lean import imports_done as _imports_done
-    _imports_done()
+from ._lean import imports_done as _imports_done
+
+_imports_done()                 # a command process's collector back on (no-op otherwise)
 
 __all__ = [
     "Packing", "read_packing", "write_packing_csv", "default_packing_path", "read_container",

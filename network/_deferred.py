@@ -7,7 +7,7 @@ run. :class:`Deferred` stands for such a module: its first attribute access impo
 the import system (whose per-module lock makes a concurrent first use from two threads safe)
 and every later one is a dictionary lookup. The gmsh Delaunay path (``network.pores``) imports
 them (:func:`import_now`) on a thread of its own while gmsh, which releases the GIL, runs
-(``threads`` > 1).
+(``threads`` > 1); :func:`beside` starts such a side job.
 """
 
 from __future__ import annotations

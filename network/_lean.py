@@ -139,6 +139,8 @@ MALLOC_ENV = ("MALLOC_MMAP_THRESHOLD_", "MALLOC_TRIM_THRESHOLD_", "MALLOC_TOP_PA
               "GLIBC_TUNABLES")
 #: True in a command process (:func:`lean_imports` has run).
 COMMAND = False
+#: True once :func:`keep_heap` has set :data:`HEAP_KEPT` in this process.
+HEAP_SET = False
 
 #: True once :func:`lean_imports` has started OpenBLAS with one thread (``OPENBLAS_NUM_THREADS``
 #: unset before NumPy's import, and NumPy built on OpenBLAS): then no call needs limiting.
@@ -208,9 +210,13 @@ def keep_heap(n_spheres: int) -> bool:
     :data:`HEAP_KEPT` (blocks up to 256 MB from the heap, up to 512 MB of free heap kept) a
     freed block is re-used by the next one. Acts on packings of at most
     :data:`HEAP_KEPT_MAX_SPHERES` spheres, only where the user set none of :data:`MALLOC_ENV`
-    and Python was started as a command (:data:`COMMAND`); True where it changed the setting.
-    Results are untouched (where memory comes from, not what is computed).
+    and Python was started as a command (:data:`COMMAND`); True where the setting is in
+    effect (set by this call or an earlier one, :data:`HEAP_SET`). Results are untouched (where
+    memory comes from, not what is computed).
     """
+    global HEAP_SET
+    if HEAP_SET:
+        return True
     if not COMMAND or n_spheres > HEAP_KEPT_MAX_SPHERES or any(v in os.environ
                                                                 for v in MALLOC_ENV):
         return False
@@ -220,4 +226,5 @@ def keep_heap(n_spheres: int) -> bool:
     except (ValueError, OSError, AttributeError):
         return False
     mallopt.argtypes = (ctypes.c_int, ctypes.c_int)
-    return all([mallopt(param, value) == 1 for param, value in HEAP_KEPT.items()])
+    HEAP_SET = all([mallopt(param, value) == 1 for param, value in HEAP_KEPT.items()])
+    return HEAP_SET

@@ -55,9 +55,9 @@ def yade_available() -> bool:
 def yade_run(path: Path) -> tuple[float, float] | None:
     """One YADE run on ``path``: (FlowEngine's first solve, the whole command) in s, or None
     where ``yade`` or the script is missing."""
-    if not yade_available():
-        return None
     exe = shutil.which("yade")
+    if exe is None or not YADE_SCRIPT.is_file():
+        return None
     t0 = time.perf_counter()
     out = subprocess.run([exe, "-n", "-x", str(YADE_SCRIPT), str(path)], env=user_environment(),
                          capture_output=True, text=True, check=False)

@@ -81,15 +81,17 @@ def _seeded_numpy_random(seed: int = 0):
         np.random.set_state(state)
 
 
-def gershgorin_bound(A) -> float:
-    r"""Gershgorin's bound on the spectral radius of :math:`D^{-1}A` (D = diag A > 0):
-    :math:`\max_i \sum_j |a_{ij}| / a_{ii}`; 2 for a weakly diagonally dominant matrix with
-    one row in balance (a Laplacian's interior row), less when every row is strictly dominant.
+def gershgorin_bound(A, diagonal=None) -> float:
+    r"""Gershgorin's bound on the spectral radius of :math:`D^{-1}A` (D = diag A > 0, given as
+    ``diagonal`` where the caller has it): :math:`\max_i \sum_j |a_{ij}| / a_{ii}`; 2 for a
+    weakly diagonally dominant matrix with one row in balance (a Laplacian's interior row), less
+    when every row is strictly dominant.
     """
     A = sp.csr_array(A)
     if A.shape[0] == 0:
         return 0.0
-    return float(np.max(abs(A) @ np.ones(A.shape[1]) / A.diagonal()))
+    d = A.diagonal() if diagonal is None else diagonal
+    return float(np.max(abs(A) @ np.ones(A.shape[1]) / d))
 
 
 #: Largest Gershgorin bound used as the finest level's rho: 2, and the round-off of a
@@ -173,7 +175,7 @@ class AMGSolver:
         self._s = (1.0 / np.sqrt(d))[self._order]
         self._As = self._scaled(A)
         self._B = np.sqrt(d)[self._order][:, None]
-        bound = gershgorin_bound(A)
+        bound = gershgorin_bound(A, d)
         self.rho = bound if bound <= _DOMINANT else None
         self._ml = None
         self.strength = "symmetric"

@@ -28,7 +28,6 @@ import numpy as np
 
 from .._deferred import spatial
 
-
 __all__ = ["region_porosity", "POROSITY_METHODS", "disk_rectangle_area", "circle_lens_area",
            "sphere_region_volume"]
 
