@@ -456,8 +456,13 @@ def packing_curve(phi, n, seed, resolution, reynolds, *, u_max=0.02, tau_stokes=
                   on_update=None, log=print):
     """k/k_app(Re) of one periodic packing (module notes). ``packing``: (centers, radii, side)
     instead of generating it; ``time_budget`` (s): no new Re is started after it; ``on_update``
-    is called with the result so far after every Re (incremental JSON)."""
+    is called with the result so far after every Re (incremental JSON). ``u_max``: one
+    superficial lattice velocity limit for every Re, or one per entry of ``reynolds``."""
     laws = _laws()
+    limits = np.broadcast_to(np.asarray(u_max, float), (len(reynolds),))
+    if not np.all(limits > 0):
+        raise ValueError(f"u_max must be > 0 and one value or one per Reynolds number: {u_max}")
+    u_limit = dict(zip(reynolds, limits))
     if packing is None:
         centers, radii, side = packing_box(phi, n, seed)
     else:
@@ -484,7 +489,7 @@ def packing_curve(phi, n, seed, resolution, reynolds, *, u_max=0.02, tau_stokes=
         if time_budget is not None and time.perf_counter() - t0 > time_budget:
             log(f"# time budget {time_budget:.0f} s spent: Re {re} and above not run")
             break
-        tau, u_t = plan(re, d_lu, u_max=u_max, tau_stokes=tau_stokes)
+        tau, u_t = plan(re, d_lu, u_max=float(u_limit[re]), tau_stokes=tau_stokes)
         nu = (tau - 0.5) / 3.0
         k_use = k_stokes if k_stokes is not None else k_guess
         ratio_guess = float(laws[1]("beetstra", phi, re)) if laws else 1.0 + 0.01 * re
@@ -502,6 +507,7 @@ def packing_curve(phi, n, seed, resolution, reynolds, *, u_max=0.02, tau_stokes=
             res["k_stokes_d2"] = k_stokes / d_lu**2
         ok = bool(np.isfinite(re_got))
         row = {"re_target": re, "re": re_got, "tau": tau, "nu": nu, "g": gx, "U_lu": u,
+               "u_max": float(u_limit[re]),
                "k_app_lu2": k_app, "k_ratio": k_stokes / k_app,
                "beetstra": float(laws[1]("beetstra", phi, re_got)) if laws and ok else None,
                "hill_koch_ladd": (float(laws[1]("hill_koch_ladd", phi, re_got))
@@ -562,8 +568,9 @@ def main(argv=None):
     p.add_argument("--seed", type=int, default=1)
     p.add_argument("--resolution", type=float, default=24)
     p.add_argument("--reynolds", type=float, nargs="+", default=[0.1, 1, 5, 10, 20, 50])
-    p.add_argument("--u-max", type=float, default=0.02,
-                   help="largest superficial lattice velocity (default 0.02)")
+    p.add_argument("--u-max", type=float, nargs="+", default=[0.02],
+                   help="largest superficial lattice velocity (default 0.02); one value, or "
+                        "one per --reynolds value")
     p.add_argument("--tau-stokes", type=float, default=1.0,
                    help="tau while the velocity limit allows it (default 1.0)")
     p.add_argument("--max-steps", type=int, default=30000)
