@@ -133,23 +133,33 @@ def test_command_process_runs_pyamg_init_only_when_a_package_name_is_asked_for()
         assert (got["solver"], got["core"]) == ("smoothed_aggregation_solver", "pyamg.amg_core")
 
 
-DEFERRED = """
-import json, sys, threading
+#: Probe prelude: ``at_once(ask)`` calls ``ask()`` from eight threads released together
+#: (a barrier) and returns their answers. No braces: probes ``str.format`` after it.
+AT_ONCE = """
+import threading
+
+def at_once(ask, n=8):
+    answers, barrier = [], threading.Barrier(n)
+
+    def first_use():
+        barrier.wait()
+        answers.append(ask())
+
+    threads = [threading.Thread(target=first_use) for _ in range(n)]
+    for t in threads:
+        t.start()
+    for t in threads:
+        t.join()
+    return answers
+"""
+
+DEFERRED = AT_ONCE + """
+import json, sys
 import network
 from network._deferred import csgraph, spatial
 before = [m for m in ("scipy.spatial", "scipy.sparse.csgraph", "scipy.sparse.linalg")
           if m in sys.modules]
-got, barrier = [], threading.Barrier(8)
-
-def first_use():
-    barrier.wait()                       # eight threads ask at once
-    got.append((spatial.cKDTree.__name__, csgraph.connected_components.__name__))
-
-threads = [threading.Thread(target=first_use) for _ in range(8)]
-for t in threads:
-    t.start()
-for t in threads:
-    t.join()
+got = at_once(lambda: (spatial.cKDTree.__name__, csgraph.connected_components.__name__))
 print(json.dumps({"before": before, "got": sorted(set(got)), "n": len(got)}))
 """
 
@@ -271,24 +281,13 @@ def test_command_process_imports_without_collections_then_freezes_them():
     assert plain["enabled"] is True and plain["frozen"] == 0
 
 
-SPATIAL = """
+SPATIAL = AT_ONCE + """
 import json, sys
 sys.argv = {argv!r}
 import numpy as np
 import network
 import scipy.spatial as sps
-import threading
-names, barrier = [], threading.Barrier(8)
-
-def first_use():
-    barrier.wait()                       # eight threads ask the package at once
-    names.append((sps.Delaunay.__name__, sps.cKDTree.__name__, sps.QhullError.__name__))
-
-threads = [threading.Thread(target=first_use) for _ in range(8)]
-for t in threads:
-    t.start()
-for t in threads:
-    t.join()
+names = at_once(lambda: (sps.Delaunay.__name__, sps.cKDTree.__name__, sps.QhullError.__name__))
 from scipy.spatial._qhull import Delaunay
 hull = sps.ConvexHull(np.array([[0, 0, 0], [1, 0, 0], [0, 1, 0], [0, 0, 1.0]]))
 pairs = sps.cKDTree(np.array([[0, 0, 0], [0.5, 0, 0], [3, 0, 0.0]])).query_pairs(1.0)
