@@ -142,13 +142,16 @@ def main(argv=None) -> int:
         print(json.dumps(row))
         return 0
 
+    workdir = Path(args.workdir or Path.home() / ".cache" / "grainflow" / "bench")
+    workdir.mkdir(parents=True, exist_ok=True)
     if args.inertial:
         report = {"machine_start": machine()}
         print(f"inertial curve on {args.inertial_spheres} spheres and drag laws:", flush=True)
         report["inertial_speed"] = inertial_speed(args.inertial_spheres, seed=args.seed,
                                                   db=args.db, workers=args.inertial_workers)
         report["inertial_validation"] = inertial_validation(n_spheres=args.ref_spheres,
-                                                            seed=args.ref_seed, db=args.db)
+                                                            seed=args.ref_seed, db=args.db,
+                                                            workdir=workdir)
         print("\n".join(inertial_lines(report["inertial_speed"],
                                        report["inertial_validation"])), flush=True)
         report["machine_end"] = machine()
@@ -157,8 +160,6 @@ def main(argv=None) -> int:
         print(f"load average {report['machine_end']['loadavg']}; wrote {args.json_out}")
         return 0
 
-    workdir = Path(args.workdir or Path.home() / ".cache" / "grainflow" / "bench")
-    workdir.mkdir(parents=True, exist_ok=True)
     report = {"machine_start": machine()}
     if args.per_packing:
         print(f"per packing: python -m network.solve FILE, wall time ({args.repeats} runs "

@@ -7,13 +7,16 @@ centre, solid fraction 0.638) at the commit that added this file; tables in
 ``docs/inertial-flow.md``.
 """
 
+from pathlib import Path
+
 import numpy as np
 import pytest
 
 from network.conductance import expansion_coefficient
 from network.flow import conduit_flow
-from network.validation import (FINNEY_PATH, beetstra_drag, beetstra_stokes_drag, drag_ratio,
-                                finney_inertial_case, hill_koch_ladd_drag)
+from network.validation import (FINNEY_PATH, bed_inertial_case, beetstra_drag,
+                                beetstra_stokes_drag, drag_ratio, finney_inertial_case,
+                                hill_koch_ladd_drag)
 
 
 def test_beetstra_stokes_limit_is_the_stokes_law_of_references():
@@ -106,3 +109,29 @@ def test_finney_onset_law_at_three_reynolds_numbers():
     excess = case.k_ratio - 1.0
     assert excess[1] / excess[0] == pytest.approx(4.0, rel=0.15)
     np.testing.assert_allclose(case.error["beetstra"], [0.0002, 0.0001, -0.0388], atol=0.002)
+
+
+BUNDLED = Path(__file__).resolve().parents[1] / "network" / "data" / "soybean_default.csv"
+
+
+def test_bed_case_cuts_the_interior_box_and_solves_both_axes():
+    # the bundled scene (walls, 5.5-7.5 mm): the box 2.5 d32 inside the walls and floor, 3 d32
+    # below the highest centre; the default law's k/k_app recorded at the commit that added
+    # this test (session 17), vertical and horizontal
+    from network.flow import DEFAULT_INERTIAL_LAW, INERTIAL_LAWS
+
+    law = INERTIAL_LAWS[DEFAULT_INERTIAL_LAW]
+    z = bed_inertial_case(BUNDLED, [1.0, 5.0, 10.0], axis=2, **law)
+    x = bed_inertial_case(BUNDLED, [1.0, 5.0, 10.0], axis=0, **law)
+    assert z.converged and x.converged and z.solid_fraction == x.solid_fraction
+    # 0.595 by quadrature (200 000 points, +-0.0011); network.solve's box 1.5 d in: 0.601
+    assert z.solid_fraction == pytest.approx(0.595, abs=0.003)
+    np.testing.assert_allclose(z.k_ratio, [1.00352, 1.05752, 1.15024], rtol=3e-4)
+    np.testing.assert_allclose(x.k_ratio, [1.00358, 1.05745, 1.14841], rtol=3e-4)
+    # as the random packings: a few % above Beetstra at Re_p 5-10
+    assert np.all(np.diff(z.error["beetstra"]) > 0) and 0.02 < z.error["beetstra"][2] < 0.08
+
+
+def test_bed_case_refuses_margins_that_leave_no_box():
+    with pytest.raises(ValueError, match="no sample box"):
+        bed_inertial_case(BUNDLED, [1.0], margin=6.0)

@@ -5,8 +5,9 @@ periodic random benchmark packing (``random_packing(n, rng=seed, periodic=True,
 solid_fraction=0.60)``, as the scaling part makes it; the sample is the default region):
 tessellation, conductances, the Stokes solve and the Newton curve each timed, with Newton
 iterations per velocity and the 1-minute load average. :func:`inertial_validation` runs the
-drag-law cases of :mod:`network.validation` (Finney's packing and periodic random packings)
-for the conduit laws of :data:`INERTIAL_LAWS` (quadratic, onset, derived, pore, chain,
+drag-law cases of :mod:`network.validation` (Finney's packing, periodic random packings and,
+given a work folder, settled beds of our DEM packer, :data:`DEM_BEDS`, flow vertical and
+horizontal) for the conduit laws of :data:`INERTIAL_LAWS` (quadratic, onset, derived, pore, chain,
 window),
 and :func:`inertial_lines` prints both. Measurements: ``docs/inertial-flow.md``.
 """
@@ -14,7 +15,10 @@ and :func:`inertial_lines` prints both. Measurements: ``docs/inertial-flow.md``.
 from __future__ import annotations
 
 import os
+import subprocess
+import sys
 import time
+from pathlib import Path
 
 import numpy as np
 
@@ -22,14 +26,45 @@ from .._cli import available_cores
 from ..packing import random_packing
 from ..pores import default_region
 from ..flow import DEFAULT_INERTIAL_LAW, INERTIAL_LAWS as FLOW_LAWS
-from ..validation import (DERIVED_LAW, finney_inertial_case, random_inertial_case,
-                          solve_sample_curve)
+from ..validation import (DERIVED_LAW, bed_inertial_case, finney_inertial_case,
+                          random_inertial_case, solve_sample_curve)
 
-__all__ = ["INERTIAL_LAWS", "INERTIAL_REYNOLDS", "inertial_lines", "inertial_speed",
-           "inertial_validation"]
+__all__ = ["DEM_BEDS", "INERTIAL_LAWS", "INERTIAL_REYNOLDS", "dem_bed_file", "inertial_lines",
+           "inertial_speed", "inertial_validation"]
 
 #: Reynolds numbers of the validation table.
 INERTIAL_REYNOLDS = (1.0, 2.0, 5.0, 10.0, 20.0, 50.0, 100.0, 200.0)
+
+
+#: Settled beds of equal 6 mm spheres from the project's DEM packer (issue 14 item 5's "DEM
+#: packings of your own"): name -> ``python -m dem.pack`` options beside :data:`DEM_BED_BOX`.
+#: 'dense': frictionless sedimentation and taps (solid fraction 0.635 in the sample box);
+#: 'lid': grown under a lid with friction 0.47, then settled (0.595); 'loose': friction 1.0
+#: throughout, more headroom (0.577; no looser bed came from these levers).
+DEM_BEDS = {"dense": ("--procedure", "sediment", "--porosity", "0.40"),
+            "lid": ("--procedure", "lid", "--porosity", "0.42"),
+            "loose": ("--procedure", "lid", "--porosity", "0.47", "--packing-friction", "1.0",
+                      "--friction", "1.0", "--lid-headroom", "0.5")}
+#: The bin of every :data:`DEM_BEDS` bed: 90 x 90 mm, filled 90 mm, sphere radius 3 mm, seed 1.
+DEM_BED_BOX = ("--scene", "box", "--size", "0.09", "0.09", "--height", "0.09", "--r-min",
+               "0.003", "--r-max", "0.003", "--seed", "1")
+
+
+def dem_bed_file(name: str, workdir) -> Path:
+    """CSV of the :data:`DEM_BEDS` bed ``name`` in ``workdir``, packed by ``python -m dem.pack``
+    on first use (3 500-3 900 spheres, 45-90 s here)."""
+    path = Path(workdir) / f"dem_bed_{name}.csv"
+    if not path.exists():
+        t0 = time.perf_counter()
+        cmd = [sys.executable, "-m", "dem.pack", *DEM_BED_BOX, *DEM_BEDS[name], "--quiet",
+               "--out", str(path)]
+        done = subprocess.run(cmd, capture_output=True, text=True)
+        if done.returncode != 0 or not path.exists():
+            raise RuntimeError(f"dem.pack for the {name!r} bed failed (exit {done.returncode}): "
+                               f"{done.stderr.strip().splitlines()[-1:] or ''}")
+        print(f"  packed the DEM bed {name!r} in {time.perf_counter() - t0:.0f} s -> {path}",
+              flush=True)
+    return path
 
 
 def _load() -> float:
@@ -88,15 +123,20 @@ INERTIAL_LAWS = ({"quadratic": FLOW_LAWS["quadratic"], "onset": FLOW_LAWS["onset
 
 def inertial_validation(*, reynolds=INERTIAL_REYNOLDS, solid_fractions=(0.55, 0.60, 0.64),
                         n_spheres: int = 800, seed: int = 1, policy: str = "table-only",
-                        db=None, laws=tuple(INERTIAL_LAWS)) -> list[dict]:
+                        db=None, laws=tuple(INERTIAL_LAWS), workdir=None,
+                        beds=tuple(DEM_BEDS)) -> list[dict]:
     """Rows (law, case, Re, network k/k_app, each drag law's ratio and error) for Finney's
-    packing and the random packings, per conduit law of :data:`INERTIAL_LAWS`."""
+    packing, the random packings and (``workdir`` given) the DEM ``beds`` with vertical and
+    horizontal flow, per conduit law of :data:`INERTIAL_LAWS`."""
+    paths = [dem_bed_file(name, workdir) for name in beds] if workdir is not None else []
     rows = []
     for law in laws:
         kw = dict(policy=policy, db=db, **INERTIAL_LAWS[law])
         cases = [finney_inertial_case(reynolds, **kw)]
         cases += [random_inertial_case(phi, reynolds, n_spheres=n_spheres, rng=seed, **kw)
                   for phi in solid_fractions]
+        cases += [bed_inertial_case(path, reynolds, axis=axis, **kw)
+                  for path in paths for axis in (2, 0)]
         rows += [{"law": law} | r for c in cases for r in c.rows()]
     return rows
 

@@ -17,6 +17,8 @@ law; :data:`DERIVED_LAW`: the law derived from single-constriction Navier-Stokes
   :func:`random_sample_permeability` does;
 * :func:`finney_inertial_case`: a cube from the centre of Finney's (1970) measured random dense
   packing (``shared/data/finney`` beside the checkout, packing fraction about 0.636);
+* :func:`bed_inertial_case`: the interior box of a settled bed of our own DEM packer
+  (``dem.pack``: gravity, walls, friction), flow vertical or horizontal;
 * :func:`lattice_inertial_case`: simple-cubic / BCC / FCC arrays (no reference ratio: Hill,
   Koch & Ladd's ordered-array numbers were not found in the stored references).
 
@@ -42,7 +44,7 @@ from ..pores import Region, merge_pores, prune_disconnected, select_sample, tess
 from ._drag_laws import DRAG_LAWS, drag_ratio
 
 __all__ = ["CHAIN_LAW", "DERIVED_LAW", "FINNEY_PATH", "PORE_LAW", "WINDOW_LAW", "InertialCase",
-           "finney_inertial_case", "lattice_inertial_case", "random_inertial_case",
+           "bed_inertial_case", "finney_inertial_case", "lattice_inertial_case", "random_inertial_case",
            "solve_sample_curve"]
 
 #: Conduit law from single-constriction Navier-Stokes + the turning momentum balance
@@ -223,6 +225,29 @@ def finney_inertial_case(reynolds, *, half_side: float = 8.0, axis: int = 0,
     return _run(f"finney cube {2 * h:g} r, phi={phi:.3f}", packing, region,
                 float(2 * packing.radii.mean()), phi, reynolds, axis=axis, policy=policy,
                 db=db, laws=laws, law=law)
+
+
+def bed_inertial_case(path, reynolds, *, axis: int = 2, margin: float = 2.5,
+                      top_margin: float = 3.0, policy: str = "table-only", db=None,
+                      laws=tuple(DRAG_LAWS), **law) -> InertialCase:
+    """A settled bed (a ``dem.pack`` CSV, walls and a free surface): the box ``margin``
+    Sauter diameters d32 inside the spheres' extent at the walls and the floor and
+    ``top_margin`` d32 below the highest centre; flow along ``axis`` (2: vertical), the law at
+    the box's solid fraction (quadrature as Finney's) and d32."""
+    packing = read_packing(Path(path))
+    d = packing.radii * 2.0
+    d32 = float((d**3).sum() / (d**2).sum())
+    lo = (packing.centers - packing.radii[:, None]).min(axis=0) + margin * d32
+    hi = (packing.centers + packing.radii[:, None]).max(axis=0) - margin * d32
+    hi[2] = packing.centers[:, 2].max() - top_margin * d32
+    if np.any(hi - lo < 2.0 * d32):
+        raise ValueError(f"{path}: the bed leaves no sample box of 2 d32 inside its margins "
+                         f"(box {np.round((hi - lo) / d32, 2)} d32)")
+    region = Region(lo, hi)
+    phi = _box_solid_fraction(packing, region)
+    size = "x".join(f"{v:.1f}" for v in (hi - lo) / d32)
+    return _run(f"bed {Path(path).stem} {size} d, phi={phi:.3f}, axis {'xyz'[axis]}", packing,
+                region, d32, phi, reynolds, axis=axis, policy=policy, db=db, laws=laws, law=law)
 
 
 def _box_solid_fraction(packing: Packing, region: Region, n_points: int = 200_000) -> float:
