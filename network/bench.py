@@ -16,7 +16,9 @@ Three parts (issue 4, item 10; issue 7, item 4), each a module of ``network.benc
 4. **Inertial** (``--inertial``, run alone) — a 12-point resistance curve on the
    ``--inertial-spheres`` benchmark packing, timed per stage against the Stokes pipeline with
    Newton iterations per velocity, and k/k_app against the Beetstra and Hill-Koch-Ladd drag
-   laws on Finney's packing and periodic random packings (``docs/inertial-flow.md``).
+   laws on Finney's packing, periodic random packings and three settled beds of ``dem.pack``
+   (packed into ``--workdir`` on first use, flow vertical and horizontal;
+   ``docs/inertial-flow.md``).
 
 Prints a table and writes JSON with the load average, platform, CPU count and a timestamp.
 ``--skip-references`` leaves part 3 out; ``--references-only`` runs part 3 alone. What each
@@ -29,7 +31,7 @@ Examples
         --json bench.json
     python -m network.bench --references-only --json references.json
     python -m network.bench --references-only --fe-random 0.36 0.40 0.45   # ~30 min
-    python -m network.bench --inertial --json inertial.json                 # ~4 min
+    python -m network.bench --inertial --json inertial.json                 # ~7 min
     python -m network.bench --per-packing --json per_packing.json           # ~1 min
 """
 
