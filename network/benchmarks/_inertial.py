@@ -39,8 +39,8 @@ INERTIAL_REYNOLDS = (1.0, 2.0, 5.0, 10.0, 20.0, 50.0, 100.0, 200.0)
 #: Settled beds of equal 6 mm spheres from the project's DEM packer (issue 14 item 5's "DEM
 #: packings of your own"): name -> ``python -m dem.pack`` options beside :data:`DEM_BED_BOX`.
 #: 'dense': frictionless sedimentation and taps (solid fraction 0.635 in the sample box);
-#: 'lid': grown under a lid with friction 0.47, then settled (0.595); 'loose': friction 1.0
-#: throughout, more headroom (0.577; friction 2.0 and headroom 1.0 gave 0.584, no looser).
+#: 'lid': grown under a lid with friction 0.47, then settled (0.593); 'loose': friction 1.0
+#: throughout, more headroom (0.575; friction 2.0 and headroom 1.0 gave 0.584, no looser).
 DEM_BEDS = {"dense": ("--procedure", "sediment", "--porosity", "0.40"),
             "lid": ("--procedure", "lid", "--porosity", "0.42"),
             "loose": ("--procedure", "lid", "--porosity", "0.47", "--packing-friction", "1.0",

@@ -232,14 +232,21 @@ def bed_inertial_case(path, reynolds, *, axis: int = 2, margin: float = 2.5,
                       laws=tuple(DRAG_LAWS), **law) -> InertialCase:
     """A settled bed (a ``dem.pack`` CSV, walls and a free surface): the box ``margin``
     Sauter diameters d32 inside the spheres' extent at the walls and the floor and
-    ``top_margin`` d32 below the highest centre; flow along ``axis`` (2: vertical), the law at
-    the box's solid fraction (quadrature as Finney's) and d32."""
+    ``top_margin`` d32 below the surface (the lowest of the highest centres of 2 d32 wide
+    columns, so that a sphere left on top does not lift it); flow along ``axis`` (2:
+    vertical), the law at the box's solid fraction (quadrature as Finney's) and d32."""
     packing = read_packing(Path(path))
+    c = packing.centers
     d = packing.radii * 2.0
     d32 = float((d**3).sum() / (d**2).sum())
-    lo = (packing.centers - packing.radii[:, None]).min(axis=0) + margin * d32
-    hi = (packing.centers + packing.radii[:, None]).max(axis=0) - margin * d32
-    hi[2] = packing.centers[:, 2].max() - top_margin * d32
+    lo = (c - packing.radii[:, None]).min(axis=0) + margin * d32
+    hi = (c + packing.radii[:, None]).max(axis=0) - margin * d32
+    n_col = np.maximum(np.floor((hi[:2] - lo[:2]) / (2.0 * d32)).astype(int), 1)
+    col = np.floor((c[:, :2] - lo[:2]) / (2.0 * d32)).astype(int)
+    inside = np.all((col >= 0) & (col < n_col), axis=1)
+    tops = np.full(int(n_col.prod()), -np.inf)
+    np.maximum.at(tops, col[inside, 0] * n_col[1] + col[inside, 1], c[inside, 2])
+    hi[2] = tops.min() - top_margin * d32
     if np.any(hi - lo < 2.0 * d32):
         raise ValueError(f"{path}: the bed leaves no sample box of 2 d32 inside its margins "
                          f"(box {np.round((hi - lo) / d32, 2)} d32)")
