@@ -116,8 +116,8 @@ BUNDLED = Path(__file__).resolve().parents[1] / "network" / "data" / "soybean_de
 
 def test_bed_case_cuts_the_interior_box_and_solves_both_axes():
     # the bundled scene (walls, 5.5-7.5 mm): the box 2.5 d32 inside the walls and floor, 3 d32
-    # below the surface (the lowest column top); the default law's k/k_app recorded at the commit that added
-    # this test (session 17), vertical and horizontal
+    # below the surface (the lowest column top); the default law's k/k_app recorded at the
+    # commit that added this test (session 17), vertical and horizontal
     from network.flow import DEFAULT_INERTIAL_LAW, INERTIAL_LAWS
 
     law = INERTIAL_LAWS[DEFAULT_INERTIAL_LAW]

@@ -7,9 +7,8 @@ tessellation, conductances, the Stokes solve and the Newton curve each timed, wi
 iterations per velocity and the 1-minute load average. :func:`inertial_validation` runs the
 drag-law cases of :mod:`network.validation` (Finney's packing, periodic random packings and,
 given a work folder, settled beds of our DEM packer, :data:`DEM_BEDS`, flow vertical and
-horizontal) for the conduit laws of :data:`INERTIAL_LAWS` (quadratic, onset, derived, pore, chain,
-window),
-and :func:`inertial_lines` prints both. Measurements: ``docs/inertial-flow.md``.
+horizontal) for the conduit laws of :data:`INERTIAL_LAWS` (quadratic, onset, derived, pore,
+chain, window), and :func:`inertial_lines` prints both. Measurements: ``docs/inertial-flow.md``.
 """
 
 from __future__ import annotations
@@ -52,7 +51,7 @@ DEM_BED_BOX = ("--scene", "box", "--size", "0.09", "0.09", "--height", "0.09", "
 
 def dem_bed_file(name: str, workdir) -> Path:
     """CSV of the :data:`DEM_BEDS` bed ``name`` in ``workdir``, packed by ``python -m dem.pack``
-    on first use (3 500-3 900 spheres, 45-90 s here)."""
+    on first use (3 400-3 900 spheres, 23-47 s here)."""
     path = Path(workdir) / f"dem_bed_{name}.csv"
     if not path.exists():
         t0 = time.perf_counter()
@@ -60,8 +59,9 @@ def dem_bed_file(name: str, workdir) -> Path:
                "--out", str(path)]
         done = subprocess.run(cmd, capture_output=True, text=True)
         if done.returncode != 0 or not path.exists():
+            last = (done.stderr.strip().splitlines() or ["no message"])[-1]
             raise RuntimeError(f"dem.pack for the {name!r} bed failed (exit {done.returncode}): "
-                               f"{done.stderr.strip().splitlines()[-1:] or ''}")
+                               f"{last}")
         print(f"  packed the DEM bed {name!r} in {time.perf_counter() - t0:.0f} s -> {path}",
               flush=True)
     return path

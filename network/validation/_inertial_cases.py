@@ -44,8 +44,8 @@ from ..pores import Region, merge_pores, prune_disconnected, select_sample, tess
 from ._drag_laws import DRAG_LAWS, drag_ratio
 
 __all__ = ["CHAIN_LAW", "DERIVED_LAW", "FINNEY_PATH", "PORE_LAW", "WINDOW_LAW", "InertialCase",
-           "bed_inertial_case", "finney_inertial_case", "lattice_inertial_case", "random_inertial_case",
-           "solve_sample_curve"]
+           "bed_inertial_case", "finney_inertial_case", "lattice_inertial_case",
+           "random_inertial_case", "solve_sample_curve"]
 
 #: Conduit law from single-constriction Navier-Stokes + the turning momentum balance
 #: (``docs/inertial-flow.md``): keyword options of :func:`solve_sample_curve` and the cases;
