@@ -190,8 +190,7 @@ def test_beetstra_holds_on_its_own_kind_of_packing_and_the_network_follows_the_l
     law = INERTIAL_LAWS[DEFAULT_INERTIAL_LAW]
     for name, x in (("grown", x0), ("mc", x1)):
         re, lbm = (np.array(v) for v in LBM100[name])
-        mc.RE = tuple(re)
-        ratio, beet_err, _, converged = mc.network_ratio(x, side, 0.55, law)
+        ratio, beet_err, _, converged = mc.network_ratio(x, side, 0.55, law, reynolds=re)
         lbm_vs_beet = lbm / np.asarray(drag_ratio("beetstra", 0.55, re)) - 1.0
         np.testing.assert_allclose(ratio, NETWORK100[name], rtol=3e-4)
         assert converged and np.all(np.abs(ratio / lbm - 1.0) < 0.026)

@@ -3,7 +3,8 @@
 from ._drag_laws import DRAG_LAWS, beetstra_drag, drag_ratio, hill_koch_ladd_drag
 from ._inertial_cases import (CHAIN_LAW, DERIVED_LAW, FINNEY_PATH, PORE_LAW, WINDOW_LAW,
                               InertialCase, bed_inertial_case, finney_inertial_case,
-                              lattice_inertial_case, random_inertial_case, solve_sample_curve)
+                              lattice_inertial_case, periodic_inertial_case, random_inertial_case,
+                              solve_sample_curve)
 from ._cases import ESTIMATORS, lattice_sample_permeability, random_sample_permeability
 from ._periodic import periodic_permeability
 from ._references import (STOKES_CELL_BCC, STOKES_CELL_FCC, ZICK_HOMSY_SC, beetstra_permeability,
@@ -18,6 +19,7 @@ __all__ = ["CHAIN_LAW", "DERIVED_LAW", "DRAG_LAWS", "ESTIMATORS", "FINNEY_PATH",
            "drag_ratio", "drag_to_permeability", "ergun_viscous_permeability",
            "bed_inertial_case", "finney_inertial_case",
            "hill_koch_ladd_drag", "kozeny_carman_permeability", "lattice_inertial_case",
-           "lattice_permeability", "lattice_sample_permeability", "periodic_permeability",
+           "lattice_permeability", "lattice_sample_permeability", "periodic_inertial_case",
+           "periodic_permeability",
            "PORE_LAW", "random_inertial_case", "random_sample_permeability",
            "sangani_acrivos_sc_drag", "solve_sample_curve", "WINDOW_LAW", "zick_homsy_sc_drag"]

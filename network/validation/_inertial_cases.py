@@ -45,7 +45,7 @@ from ._drag_laws import DRAG_LAWS, drag_ratio
 
 __all__ = ["CHAIN_LAW", "DERIVED_LAW", "FINNEY_PATH", "PORE_LAW", "WINDOW_LAW", "InertialCase",
            "bed_inertial_case", "finney_inertial_case", "lattice_inertial_case",
-           "random_inertial_case", "solve_sample_curve"]
+           "periodic_inertial_case", "random_inertial_case", "solve_sample_curve"]
 
 #: Conduit law from single-constriction Navier-Stokes + the turning momentum balance
 #: (``docs/inertial-flow.md``): keyword options of :func:`solve_sample_curve` and the cases;
@@ -203,12 +203,22 @@ def random_inertial_case(solid_fraction: float, reynolds, *, n_spheres: int = 80
         raise ValueError(f"solid_fraction must lie in (0, 0.64], got {solid_fraction!r}")
     base = random_packing(int(n_spheres), diameter_range_m=(1.0, 1.0), solid_fraction=phi,
                           periodic=True, rng=rng)
-    side = (math.pi / 6.0 * int(n_spheres) / phi) ** (1.0 / 3.0)
+    return periodic_inertial_case(base, phi, reynolds, name=f"random phi={phi:.3f} "
+                                  f"n={n_spheres} seed={rng}", copies=copies, axis=axis,
+                                  policy=policy, db=db, laws=laws, **law)
+
+
+def periodic_inertial_case(base: Packing, solid_fraction: float, reynolds, *, name: str = "",
+                           copies: int = 3, axis: int = 0, policy: str = "table-only",
+                           db=None, laws=tuple(DRAG_LAWS), **law) -> InertialCase:
+    """A periodic packing of unit spheres in the cube of side L = (pi n / (6 phi))^(1/3),
+    copied ``copies``³ times; sample = all but half a period at every face (module notes)."""
+    phi = float(solid_fraction)
+    side = (math.pi / 6.0 * base.n / phi) ** (1.0 / 3.0)
     packing = periodic_copies(base, side, int(copies))
     region = Region(np.full(3, 0.5 * side), np.full(3, (copies - 0.5) * side))
-    return _run(f"random phi={phi:.3f} n={n_spheres} seed={rng}", packing, region, 1.0, phi,
-                reynolds, axis=axis, policy=policy, db=db, laws=laws,
-                law=law)
+    return _run(name or f"periodic phi={phi:.3f} n={base.n}", packing, region, 1.0, phi,
+                reynolds, axis=axis, policy=policy, db=db, laws=laws, law=law)
 
 
 def finney_inertial_case(reynolds, *, half_side: float = 8.0, axis: int = 0,
@@ -237,10 +247,8 @@ def bed_inertial_case(path, reynolds, *, axis: int = 2, margin: float = 2.5,
     vertical), the law at the box's solid fraction (quadrature as Finney's) and d32."""
     packing = read_packing(Path(path))
     c = packing.centers
-    d = packing.radii * 2.0
-    d32 = float((d**3).sum() / (d**2).sum())
-    lo = (c - packing.radii[:, None]).min(axis=0) + margin * d32
-    hi = (c + packing.radii[:, None]).max(axis=0) - margin * d32
+    d32 = packing.sauter_diameter
+    lo, hi = packing.extent() + [[margin * d32], [-margin * d32]]
     n_col = np.maximum(np.floor((hi[:2] - lo[:2]) / (2.0 * d32)).astype(int), 1)
     col = np.floor((c[:, :2] - lo[:2]) / (2.0 * d32)).astype(int)
     inside = np.all((col >= 0) & (col < n_col), axis=1)
