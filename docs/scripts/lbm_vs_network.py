@@ -9,9 +9,13 @@ LBM obtained, with the package's current constants, with the laws ``onset`` (the
 session 7), ``DERIVED_LAW``, ``pore`` (the CLI's in session 7), ``chain`` (sessions 8-10) and
 ``window`` (since session 11; ``--laws`` picks). Printed per row: LBM, Beetstra, HKL, the
 network laws, and the relative differences in % of the pressure gradient. ``--json`` writes
-the rows.
+the rows. ``--packing NPZ ...`` (one per LBM file, in order; the NPZ that ``lbm_periodic.py
+--packing`` ran, e.g. a Monte Carlo configuration of ``mc_ensemble.py --export``) takes the
+network's packing from the file instead of rebuilding it (``periodic_inertial_case``, the same
+sample).
 
     python docs/scripts/lbm_vs_network.py /tmp/lbm/ens_*.json --json rows.json
+    python docs/scripts/lbm_vs_network.py mc.json --packing .lbm/mc800_0.55_s1.npz
     python docs/scripts/lbm_vs_network.py docs/data/lbm_n800_reference.json --laws pore chain
 
 A stored table of ordered arrays (``docs/data/lbm_arrays_reference.json``: rows with ``kind``
@@ -58,16 +62,34 @@ def _law_options():
     return dict(INERTIAL_LAWS, derived=DERIVED_LAW)
 
 
-def compare(data, laws=LAW_NAMES):
-    """Rows of a loaded LBM JSON of random packings beside the network's k/k_app."""
-    from network.validation import random_inertial_case
+def _npz_packing(path, phi, n):
+    """The unit-sphere packing of an NPZ of ``lbm_periodic.py --packing`` (checked against the
+    LBM run's phi and n)."""
+    from network.packing import Packing
+
+    z = np.load(path)
+    if int(z["n"]) != n or not np.isclose(float(z["phi"]), phi):
+        raise SystemExit(f"{path}: phi {float(z['phi'])} n {int(z['n'])}, the LBM run has "
+                         f"phi {phi} n {n}")
+    return Packing(z["centers"], z["radii"], source=str(path))
+
+
+def compare(data, laws=LAW_NAMES, packing=None):
+    """Rows of a loaded LBM JSON of random packings beside the network's k/k_app; ``packing``:
+    the NPZ the LBM ran, else the packing is rebuilt from (phi, n, seed)."""
+    from network.validation import periodic_inertial_case, random_inertial_case
 
     options = _law_options()
     out = []
     for phi, n, seed, resolution, k_d2, rows in _runs(data):
         re = np.array([r["re"] for r in rows])
-        net = {name: random_inertial_case(phi, re, n_spheres=n, rng=seed,
-                                          **options[name]).k_ratio for name in laws}
+        if packing is None:
+            net = {name: random_inertial_case(phi, re, n_spheres=n, rng=seed,
+                                              **options[name]).k_ratio for name in laws}
+        else:
+            base = _npz_packing(packing, phi, n)
+            net = {name: periodic_inertial_case(base, phi, re, **options[name]).k_ratio
+                   for name in laws}
         for i, r in enumerate(rows):
             out.append({"phi": phi, "seed": seed, "resolution": r.get("resolution", resolution),
                         "n": n,
@@ -117,15 +139,19 @@ def main(argv=None):
     p.add_argument("files", nargs="+")
     p.add_argument("--laws", nargs="+", default=list(LAW_NAMES), choices=LAW_NAMES)
     p.add_argument("--json", default=None)
+    p.add_argument("--packing", nargs="+", default=None, metavar="NPZ",
+                   help="the packing each LBM file ran (one per file, in order)")
     a = p.parse_args(argv)
+    if a.packing is not None and len(a.packing) != len(a.files):
+        p.error(f"{len(a.packing)} --packing files for {len(a.files)} LBM files")
     rows, arrays = [], []
-    for f in a.files:
+    for i, f in enumerate(a.files):
         with open(f) as fh:
             data = json.load(fh)
         if "rows" in data and data["rows"] and "kind" in data["rows"][0]:
             arrays += compare_arrays(data, a.laws)
         else:
-            rows += compare(data, a.laws)
+            rows += compare(data, a.laws, a.packing[i] if a.packing else None)
     if arrays:
         _print_arrays(arrays, a.laws)
     if rows:
