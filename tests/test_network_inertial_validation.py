@@ -198,3 +198,34 @@ def test_beetstra_holds_on_its_own_kind_of_packing_and_the_network_follows_the_l
             assert np.all(np.abs(lbm_vs_beet) < 0.008) and np.all(np.abs(beet_err) < 0.02)
         else:
             assert lbm_vs_beet[1] > 0.03 and beet_err[1] > 0.05
+
+
+#: Resolved flow (lattice-Boltzmann, D 40, H200, session 18; docs/data/lbm_mc800_reference.json)
+#: of the 800-sphere phi 0.55 seed 1 packing's Monte Carlo configuration (2 000 sweeps at d = 1)
+LBM800_MC = ([4.9431, 9.9378, 20.2394, 51.5422], [1.0391, 1.1053, 1.2535, 1.6804])
+#: the network's k/k_app on that configuration, recorded when the test was added
+NETWORK800_MC = [1.0437, 1.1217, 1.2960, 1.8111]
+
+
+def test_network_on_an_800_sphere_monte_carlo_configuration_against_its_resolved_flow():
+    # issue 14 item 5: on a Beetstra-type configuration of 800 spheres the resolved flow is
+    # within 1.2 % of the law at Re_p <= 10 and the network within 1.6 % of the resolved flow;
+    # at Re_p 50 the network is 7.8 % above it (the known overshoot on contact-poor packings,
+    # docs/inertial-flow.md "Session 18"; 2.7 % on the grown packing of the same seed)
+    from network.flow import DEFAULT_INERTIAL_LAW, INERTIAL_LAWS
+    from network.packing import random_packing
+
+    mc = _mc_script()
+    side = (np.pi / 6.0 * 800 / 0.55) ** (1.0 / 3.0)
+    x0 = np.mod(random_packing(800, diameter_range_m=(1.0, 1.0), solid_fraction=0.55,
+                               periodic=True, rng=1).centers, side)
+    x1, sweeps = mc.monte_carlo(x0, side, equilibrate=2000, seed=1, log=lambda *_: None)
+    assert sweeps == 3068 and abs(mc._gaps(x1, side)[0] - 1.1975) < 1e-9
+    re, lbm = (np.array(v) for v in LBM800_MC)
+    ratio, _, _, converged = mc.network_ratio(x1, side, 0.55, INERTIAL_LAWS[DEFAULT_INERTIAL_LAW],
+                                              reynolds=re)
+    np.testing.assert_allclose(ratio, NETWORK800_MC, rtol=3e-4)
+    lbm_vs_beet = lbm / np.asarray(drag_ratio("beetstra", 0.55, re)) - 1.0
+    assert converged and np.all(np.abs(lbm_vs_beet[:2]) < 0.013)
+    assert np.all(np.abs(ratio[:2] / lbm[:2] - 1.0) < 0.016)
+    assert 0.06 < ratio[3] / lbm[3] - 1.0 < 0.08

@@ -18,6 +18,9 @@ Network: ``solve_sample_curve`` on the packing copied 3 x 3 x 3 (the middle two 
 default law, U = Re/d with mu = rho = 1, as ``random_inertial_case``.
 
     python docs/scripts/mc_ensemble.py --phi 0.55 0.60 --seed 1 2 --json mc.json --export .lbm
+
+The resolved flow of ``docs/data/lbm_mc800_reference.json`` ran the configurations of
+``--equilibrate 2000`` (the NPZ records ``equilibrate`` and ``sweeps``).
 """
 
 from __future__ import annotations
@@ -155,7 +158,8 @@ def main(argv=None):
             x1, sweeps = monte_carlo(x0, side, equilibrate=a.equilibrate, seed=seed)
             if a.export:
                 np.savez(f"{a.export}/mc{a.n}_{phi:.2f}_s{seed}.npz", centers=x1,
-                         radii=np.full(a.n, 0.5), side=side, phi=phi, n=a.n, seed=seed)
+                         radii=np.full(a.n, 0.5), side=side, phi=phi, n=a.n, seed=seed,
+                         equilibrate=a.equilibrate, sweeps=sweeps)
             row = {"phi": phi, "seed": seed, "n": a.n, "sweeps": sweeps,
                    "equilibrate": a.equilibrate, "re": list(RE)}
             for tag, x in (("grown", x0), ("mc", x1)):
