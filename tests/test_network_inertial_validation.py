@@ -149,18 +149,25 @@ def _mc_script():
     return module
 
 
+def _mc_pair(n, phi, seed, equilibrate):
+    """(script module, box side, grown centres, their MC configuration, sweeps) of the
+    periodic random packing (n unit spheres, phi, seed), as ``mc_ensemble.py`` makes them."""
+    from network.packing import random_packing
+
+    mc = _mc_script()
+    side = (np.pi / 6.0 * n / phi) ** (1.0 / 3.0)
+    x0 = np.mod(random_packing(n, diameter_range_m=(1.0, 1.0), solid_fraction=phi,
+                               periodic=True, rng=seed).centers, side)
+    x1, sweeps = mc.monte_carlo(x0, side, equilibrate=equilibrate, seed=seed,
+                                log=lambda *_: None)
+    return mc, side, x0, x1, sweeps
+
+
 def test_monte_carlo_configuration_is_overlap_free_at_diameter_one_and_opens_contacts():
     # docs/scripts/mc_ensemble.py (the packing-ensemble study of docs/inertial-flow.md): from
     # a grown periodic packing (overlaps up to ~1 %), hard-sphere moves reach diameter 1 with
     # no pair closer than 1, fewer pairs near contact, and the same result for the same seed
-    from network.packing import random_packing
-
-    mc = _mc_script()
-    n, phi = 100, 0.55
-    side = (np.pi / 6.0 * n / phi) ** (1.0 / 3.0)
-    x0 = np.mod(random_packing(n, diameter_range_m=(1.0, 1.0), solid_fraction=phi,
-                               periodic=True, rng=3).centers, side)
-    x1, sweeps = mc.monte_carlo(x0, side, equilibrate=300, seed=3, log=lambda *_: None)
+    mc, side, x0, x1, sweeps = _mc_pair(100, 0.55, 3, 300)
     assert np.sqrt(mc._min_dist2(x0, side)) < 1.0 <= np.sqrt(mc._min_dist2(x1, side))
     assert x1.min() >= 0.0 and x1.max() < side and sweeps > 300
     assert mc._gaps(x1, side)[0] < 0.7 * mc._gaps(x0, side)[0]     # 4.66 -> 2.76 per sphere
@@ -182,13 +189,8 @@ def test_beetstra_holds_on_its_own_kind_of_packing_and_the_network_follows_the_l
     # 0.8 % and the network is within 2 % of both; on the contact-rich grown packing the
     # resolved flow itself is 3.2 % above the law at Re_p 10
     from network.flow import DEFAULT_INERTIAL_LAW, INERTIAL_LAWS
-    from network.packing import random_packing
 
-    mc = _mc_script()
-    side = (np.pi / 6.0 * 100 / 0.55) ** (1.0 / 3.0)
-    x0 = np.mod(random_packing(100, diameter_range_m=(1.0, 1.0), solid_fraction=0.55,
-                               periodic=True, rng=1).centers, side)
-    x1, _ = mc.monte_carlo(x0, side, equilibrate=8000, seed=1, log=lambda *_: None)
+    mc, side, x0, x1, _ = _mc_pair(100, 0.55, 1, 8000)
     law = INERTIAL_LAWS[DEFAULT_INERTIAL_LAW]
     for name, x in (("grown", x0), ("mc", x1)):
         re, lbm = (np.array(v) for v in LBM100[name])
@@ -215,13 +217,8 @@ def test_network_on_an_800_sphere_monte_carlo_configuration_against_its_resolved
     # at Re_p 50 the network is 7.8 % above it (the known overshoot on contact-poor packings,
     # docs/inertial-flow.md "Session 18"; 2.7 % on the grown packing of the same seed)
     from network.flow import DEFAULT_INERTIAL_LAW, INERTIAL_LAWS
-    from network.packing import random_packing
 
-    mc = _mc_script()
-    side = (np.pi / 6.0 * 800 / 0.55) ** (1.0 / 3.0)
-    x0 = np.mod(random_packing(800, diameter_range_m=(1.0, 1.0), solid_fraction=0.55,
-                               periodic=True, rng=1).centers, side)
-    x1, sweeps = mc.monte_carlo(x0, side, equilibrate=2000, seed=1, log=lambda *_: None)
+    mc, side, _, x1, sweeps = _mc_pair(800, 0.55, 1, 2000)
     assert sweeps == 3068 and abs(mc._gaps(x1, side)[0] - 1.1975) < 1e-9
     re, lbm = (np.array(v) for v in LBM800_MC)
     ratio, _, _, converged = mc.network_ratio(x1, side, 0.55, INERTIAL_LAWS[DEFAULT_INERTIAL_LAW],
