@@ -325,6 +325,10 @@ def lookup_qstar(radii, sides, *, db=None, policy="table+fe", rtol=1e-3, workers
     counts = np.bincount(src, minlength=len(SOURCES))
     for name, count in zip(SOURCES, counts):
         stats[f"n_{name.replace('-', '_')}"] = int(count)
+    # the estimate's rows with a deep overlap (its own constants, within a few % of FE) apart
+    # from the others, which outside the table may be 2x too open (docs/throats-shape-factor.md)
+    sf_rows = np.flatnonzero(src == SHAPE_FACTOR)
+    stats["n_shape_factor_deep"] = int(throats.deep_overlap(r[sf_rows], s[sf_rows]).sum())
     n_valid = max(n - stats["n_failed"], 1)
     stats["hit_rate"] = (stats["n_exact"] + stats["n_interp"]) / n_valid
     stats["seconds"] = time.perf_counter() - t0

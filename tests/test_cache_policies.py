@@ -158,3 +158,14 @@ def test_invalid_rows_fail_alone(heldout, tmp_path):
     assert list(both.source[n:]) == ["failed"] * 6
     assert np.isnan(both.qstar[n:]).all() and all(m for m in both.message[n:])
     assert both.stats["n_failed"] == 6
+
+
+def test_table_only_counts_the_estimates_deep_overlap_rows(tmp_path):
+    # outside the table's gap range (-0.2 r̄): a deep overlap of two spheres of one grain takes
+    # the estimate with its own constants and is counted apart; an in-range shape is served
+    r = np.ones((3, 3))
+    s = np.array([[1.5, 2.3, 2.3], [0.9, 2.3, 2.3], [2.1, 2.1, 2.1]])
+    res = cache.lookup_qstar(r, s, policy="table-only", db=tmp_path / "t.sqlite")
+    assert list(res.source) == ["shape-factor", "shape-factor", "interp"]
+    assert res.stats["n_shape_factor"] == 2 and res.stats["n_shape_factor_deep"] == 2
+    assert throats.deep_overlap(r, s).tolist() == [True, True, False]

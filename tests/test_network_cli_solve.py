@@ -130,3 +130,22 @@ def test_no_traceback_as_a_subprocess(tmp_path):
         assert run.returncode == code, run.stderr
         assert run.stdout == "" and "Traceback" not in run.stderr
         assert run.stderr.count("\n") == 1 and run.stderr.startswith("error: ")
+
+
+def test_windows_outside_the_table_are_counted_and_named(tmp_path, capsys):
+    # spheres of 2-6 mm: most windows have radius ratios beyond the Q* table's +-0.25 and take
+    # the shape-factor estimate (about 2x too open there, docs/throats-shape-factor.md): the
+    # run says so; the bundled scene (5.5-7.5 mm, all inside the table) does not
+    pk = random_packing(400, diameter_range_m=(0.002, 0.006), solid_fraction=0.55, rng=2)
+    bed = tmp_path / "poly.csv"
+    np.savetxt(bed, np.column_stack([pk.centers, pk.radii]), delimiter=",", header="x,y,z,r",
+               comments="")
+    js = tmp_path / "o.json"
+    assert solve_cli.main([str(bed), "-q", "--stokes", "--json", str(js)]) == 0
+    out = capsys.readouterr().out
+    st = json.loads(js.read_text())["qstar"]["qstar_stats"]
+    loose = st["n_shape_factor"] - st["n_shape_factor_deep"]
+    assert st["n_shape_factor_deep"] == 0 and loose > 0.3 * st["n"]
+    assert f"note: {loose} of {st['n']} windows lie outside the Q* table" in out
+    assert solve_cli.main(["-q", "--stokes"]) == 0
+    assert "note:" not in capsys.readouterr().out

@@ -15,9 +15,10 @@ open_area, triangle_area, triangle_vertices
     Exact open area (also for overlapping disks and disks covering the triangle); the triangle.
 validate_throats, as_throats
     Row checks ``(ok_mask, messages)``; shape check at the door (two float (N, 3) arrays).
-shape_factor_qstar
+shape_factor_qstar, deep_overlap
     Fast Q* estimate c_t A² G (Patzek & Silin 2001) fitted per contact type, over 1e6
-    throats/s; median error about 20 % against FE (``docs/throats-shape-factor.md``).
+    throats/s; median error about 20 % against FE (``docs/throats-shape-factor.md``); the rows
+    with a deep overlap (two spheres of one grain) that take their own constants.
 solve_fem, ThroatSolution, SOLVER_VERSION
     Q* by finite elements (gmsh + scikit-fem), batch, ``rtol``-driven, with an error estimate;
     the version string is bumped whenever results could change.
@@ -34,9 +35,10 @@ Lagrange P3/P4, the error estimate, and what each was measured to cost) in
 from ._area import open_area
 from ._geometry import (as_throats, canonical_form, contact_type, triangle_area, triangle_vertices,
                         validate_throats)
-from ._shape_factor import shape_factor_qstar
+from ._shape_factor import deep_overlap, shape_factor_qstar
 from ._solve import SOLVER_VERSION, ThroatSolution, solve_fem
 
-__all__ = ["SOLVER_VERSION", "as_throats", "ThroatSolution", "canonical_form", "contact_type", "open_area",
+__all__ = ["SOLVER_VERSION", "as_throats", "ThroatSolution", "canonical_form", "contact_type",
+           "deep_overlap", "open_area",
            "shape_factor_qstar", "solve_fem", "triangle_area", "triangle_vertices",
            "validate_throats"]

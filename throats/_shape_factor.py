@@ -30,7 +30,7 @@ import numpy as np
 from ._area import area_perimeter_columns
 from ._geometry import as_throats, contact_count
 
-__all__ = ["FIT", "shape_factor_qstar"]
+__all__ = ["FIT", "deep_overlap", "shape_factor_qstar"]
 
 #: fitted constants c_t per contact type and the record of the fit (``throats.bench --fit``)
 FIT = {
@@ -113,13 +113,33 @@ def shape_factor_qstar(radii, sides):
     area, per = area_perimeter_columns(np.ascontiguousarray(r.T), np.ascontiguousarray(s.T))
     kind = contact_count(r, s, 1.0)
     c = np.array([FIT["c"][t] for t in "abcd"])[kind]
-    deep = FIT["deep"]
-    gap = np.minimum(np.minimum(s[:, 0] - r[:, 0] - r[:, 1], s[:, 1] - r[:, 0] - r[:, 2]),
-                     s[:, 2] - r[:, 1] - r[:, 2])
-    for t, ct in deep["c"].items():
-        c = np.where((gap < deep["gap"]) & (kind == "abcd".index(t)), ct, c)
+    deep = _deep(r, s)
+    for t, ct in FIT["deep"]["c"].items():
+        c = np.where(deep & (kind == "abcd".index(t)), ct, c)
     with np.errstate(invalid="ignore", divide="ignore"):
         q = np.where(area > 0, c * area**3 / per**2, 0.0)
     out = np.full(ok.shape[0], np.nan)
     out[ok] = q
     return out
+
+
+def deep_overlap(radii, sides):
+    r"""True where a pair of the throat's disks overlaps deeper than ``FIT["deep"]["gap"]``
+    (:math:`l_{ij} - r_i - r_j < -0.2\,\bar r`: two spheres of one multi-sphere grain), the
+    rows whose estimate uses the deep-overlap constants. (N,) bool; False for invalid rows.
+
+    >>> deep_overlap([[1, 1, 1], [1, 1, 1]], [[1.5, 2.3, 2.3], [1.99, 2.3, 2.3]]).tolist()
+    [True, False]
+    """
+    r, s = as_throats(radii, sides)
+    with np.errstate(invalid="ignore", divide="ignore"):
+        rbar = (r[:, 0] + r[:, 1] + r[:, 2]) / 3.0
+        out = _deep(r / rbar[:, None], s / rbar[:, None])
+    return out & np.isfinite(rbar) & (rbar > 0)
+
+
+def _deep(r, s):
+    """Deep-overlap rows of radii and sides in units of r̄ (float (N, 3) arrays)."""
+    gap = np.minimum(np.minimum(s[:, 0] - r[:, 0] - r[:, 1], s[:, 1] - r[:, 0] - r[:, 2]),
+                     s[:, 2] - r[:, 1] - r[:, 2])
+    return gap < FIT["deep"]["gap"]
