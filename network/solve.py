@@ -125,14 +125,6 @@ def _print_result(res, out):
     if src:
         print("  Q* sources: " + ", ".join(f"{k} {v}" for k, v in src.items())
               + f" ({s['qstar'].get('seconds', float('nan')):.2f} s)", file=out)
-    windows = s.get("qstar", {}).get("qstar_stats", s.get("qstar", {}))
-    loose = windows.get("n_shape_factor", 0) - windows.get("n_shape_factor_deep", 0)
-    if windows.get("policy") == "table-only" and loose > 0.01 * windows.get("n", 0):
-        # outside the table and not a deep overlap: the estimate may be 2x too open there
-        print(f"  note: {loose} of {windows['n']} windows lie outside the Q* table (radius "
-              f"ratios or gaps) and took the shape-factor estimate, about 2x too open there\n"
-              f"  (corn and barley beds: k 17-22 % high); --policy table+fe solves them by FE "
-              f"(docs/throats-shape-factor.md)", file=out)
     sv, mb = s["solver"], s["mass_balance"]
     print(f"  solver {sv['method']}: {sv['iterations']} it, residual {sv['residual']:.1e}; "
           f"inlet/outlet mismatch {mb['balance_error']:.1e} ({'ok' if mb['ok'] else 'FAILED'})",

@@ -216,6 +216,13 @@ def conduit_conductance(tessellation, throats_idx=None, *, viscosity_pa_s: float
                       "section_qstar_stats": section_stats, "seconds": seconds})
     logger.info("conduit conductance of %d throats (%d inside merged bodies) in %.2f s",
                 idx.size, int(internal.sum()), seconds)
+    loose = qstats.get("n_shape_factor", 0) - qstats.get("n_shape_factor_deep", 0)
+    if policy == "table-only" and qstar_fn is None and loose > 0.01 * qstats.get("n", 0):
+        # outside the table and no deep overlap: there the estimate is about 2x too open
+        logger.warning("%d of %d windows lie outside the Q* table (radius ratios or gaps) and "
+                       "took the shape-factor estimate, about 2x too open there (corn and "
+                       "barley beds: k 17-22 %% high); --policy table+fe solves them by FE "
+                       "(docs/throats-shape-factor.md)", loose, qstats["n"])
     return ConductanceResult(g, "conduit", qstar, stats, h_m=h, internal=internal)
 
 
