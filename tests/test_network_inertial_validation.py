@@ -152,12 +152,8 @@ def _mc_script():
 def _mc_pair(n, phi, seed, equilibrate):
     """(script module, box side, grown centres, their MC configuration, sweeps) of the
     periodic random packing (n unit spheres, phi, seed), as ``mc_ensemble.py`` makes them."""
-    from network.packing import random_packing
-
     mc = _mc_script()
-    side = (np.pi / 6.0 * n / phi) ** (1.0 / 3.0)
-    x0 = np.mod(random_packing(n, diameter_range_m=(1.0, 1.0), solid_fraction=phi,
-                               periodic=True, rng=seed).centers, side)
+    side, x0 = mc.grown_configuration(n, phi, seed)
     x1, sweeps = mc.monte_carlo(x0, side, equilibrate=equilibrate, seed=seed,
                                 log=lambda *_: None)
     return mc, side, x0, x1, sweeps

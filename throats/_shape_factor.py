@@ -112,10 +112,9 @@ def shape_factor_qstar(radii, sides):
     s = s / rbar[:, None]
     area, per = area_perimeter_columns(np.ascontiguousarray(r.T), np.ascontiguousarray(s.T))
     kind = contact_count(r, s, 1.0)
-    c = np.array([FIT["c"][t] for t in "abcd"])[kind]
-    deep = _deep(r, s)
-    for t, ct in FIT["deep"]["c"].items():
-        c = np.where(deep & (kind == "abcd".index(t)), ct, c)
+    plain = np.array([FIT["c"][t] for t in "abcd"])
+    deep = np.array([FIT["deep"]["c"].get(t, FIT["c"][t]) for t in "abcd"])
+    c = np.where(_deep(r, s), deep[kind], plain[kind])
     with np.errstate(invalid="ignore", divide="ignore"):
         q = np.where(area > 0, c * area**3 / per**2, 0.0)
     out = np.full(ok.shape[0], np.nan)

@@ -34,7 +34,7 @@ from cache import lookup_qstar
 from network.flow import solve_network
 from network.packing import read_packing
 from network.pores import default_region, merge_pores, select_sample, tessellate
-from throats import contact_type, shape_factor_qstar
+from throats import contact_type, deep_overlap, shape_factor_qstar
 from throats._shape_factor import FIT
 
 DATA = Path(__file__).resolve().parents[2] / "network" / "data"
@@ -66,10 +66,8 @@ def old_estimate(r, s):
 
 
 def _deep(r, s):
-    rb = r.mean(axis=1)
-    gap = np.min(s - np.column_stack([r[:, 0] + r[:, 1], r[:, 0] + r[:, 2], r[:, 1] + r[:, 2]]),
-                 axis=1) / rb
-    return gap < FIT["deep"]["gap"], np.asarray(contact_type(r, s))
+    """(deep-overlap rows, contact type) of the throats."""
+    return deep_overlap(r, s), np.asarray(contact_type(r, s))
 
 
 def errors(q_est, q_fe):

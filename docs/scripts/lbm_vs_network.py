@@ -65,13 +65,13 @@ def _law_options():
 def _npz_packing(path, phi, n):
     """The unit-sphere packing of an NPZ of ``lbm_periodic.py --packing`` (checked against the
     LBM run's phi and n)."""
+    from lbm_periodic import load_packing
     from network.packing import Packing
 
-    z = np.load(path)
-    if int(z["n"]) != n or not np.isclose(float(z["phi"]), phi):
-        raise SystemExit(f"{path}: phi {float(z['phi'])} n {int(z['n'])}, the LBM run has "
-                         f"phi {phi} n {n}")
-    return Packing(z["centers"], z["radii"], source=str(path))
+    centers, radii, _, phi_z, n_z, _ = load_packing(path)
+    if n_z != n or not np.isclose(phi_z, phi):
+        raise SystemExit(f"{path}: phi {phi_z} n {n_z}, the LBM run has phi {phi} n {n}")
+    return Packing(centers, radii, source=str(path))
 
 
 def compare(data, laws=LAW_NAMES, packing=None):

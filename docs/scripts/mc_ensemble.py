@@ -123,6 +123,15 @@ def monte_carlo(x, side, *, equilibrate=8000, max_sweeps=200_000, seed=0, log=pr
     return x, sweeps
 
 
+def grown_configuration(n, phi, seed):
+    """(box side L = (pi n / (6 phi))^(1/3), centres in [0, L)) of ``random_packing``'s periodic
+    packing of n unit spheres at solid fraction phi: the start of :func:`monte_carlo`."""
+    side = (math.pi / 6.0 * n / phi) ** (1.0 / 3.0)
+    pk = random_packing(n, diameter_range_m=(1.0, 1.0), solid_fraction=phi, periodic=True,
+                        rng=seed)
+    return side, np.mod(np.asarray(pk.centers, float), side)
+
+
 def network_ratio(centers, side, phi, law, reynolds=RE):
     """(k/k_app, its error against Beetstra, Stokes k/d^2, converged) of the default law at
     ``reynolds`` (:func:`network.validation.periodic_inertial_case`, the sample of
@@ -150,10 +159,7 @@ def main(argv=None):
     out = []
     for phi in a.phi:
         for seed in a.seed:
-            side = (math.pi / 6.0 * a.n / phi) ** (1.0 / 3.0)
-            pk = random_packing(a.n, diameter_range_m=(1.0, 1.0), solid_fraction=phi,
-                                periodic=True, rng=seed)
-            x0 = np.mod(np.asarray(pk.centers, float), side)
+            side, x0 = grown_configuration(a.n, phi, seed)
             print(f"phi {phi} seed {seed}: n {a.n}, side {side:.4f} d", flush=True)
             x1, sweeps = monte_carlo(x0, side, equilibrate=a.equilibrate, seed=seed)
             if a.export:
