@@ -31,7 +31,7 @@ def derived_path(path, directory):
         where = hashlib.blake2b(str(Path(path).resolve()).encode(), digest_size=6)
         st = Path(path).stat()
         what = hashlib.blake2b(f"{st.st_size}:{st.st_mtime_ns}".encode(), digest_size=8)
-        for mod in ("_interp.py", "_cells.py"):
+        for mod in ("_interp.py", "_cells.py", "_orbits.py"):
             what.update(Path(__file__).with_name(mod).read_bytes())
         return (Path(directory)
                 / f"{Path(path).stem}.derived-{where.hexdigest()}-{what.hexdigest()}.npy")

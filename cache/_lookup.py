@@ -5,8 +5,8 @@ Policies
 ==============  ===============================================================================
 ``table-only``  an exact hit where ``db`` stores the shape (an FE solve with tolerance
                 <= ``rtol``), else interpolation in the grid table for every row it covers,
-                with its error estimate; rows the grid cannot serve (outside the box, next
-                to invalid or closed nodes) take the shape-factor estimate
+                with its error estimate; rows it cannot serve go to the shipped extension grid
+                (:mod:`cache._orbits`), then to the shape-factor estimate
                 (``source='shape-factor'``).  Never runs FE.
 ``table+fe``    as ``table-only``, but every interpolated row whose error estimate exceeds
                 ``rtol`` is solved by FE (``throats.solve_fem``) and stored.
@@ -37,6 +37,7 @@ from . import _build
 from ._build import precompute_throats, resolve_solver
 from ._derived import derived_path, load_derived, save_derived
 from ._interp import GridSpec, GridTable
+from ._orbits import EXTENSION_GRID, compact, expand, toward_extension
 from ._signature import as_throats, match_keys, shape_keys, signature
 from ._store import open_store
 
@@ -129,17 +130,36 @@ def grid_from_store(store, name, solver_version):
     return table
 
 
-def export_grid(store, name, path, *, solver_version):
-    """Write grid ``name`` of ``store`` as a compact ``.npz`` (spec, node Q*, node FE errors)."""
+def export_grid(store, name, path, *, solver_version, orbits=False):
+    """Write grid ``name`` of ``store`` as a compressed ``.npz`` (spec, node Q*, node FE errors);
+    ``orbits``: one value per vertex-permutation orbit (``orbit_qstar``, ``orbit_fe_error``,
+    :mod:`cache._orbits`), about a sixth of the nodes."""
     import json
 
     table = grid_from_store(store, name, solver_version)
     if table is None:
         raise ValueError(f"{store.path} holds no grid named {name!r} (grids: {store.grid_names()})")
     spec = dict(store.grid(name))
-    np.savez_compressed(path, spec=json.dumps(spec), qstar=table.qstar, fe_error=table.fe_error,
-                        solver_version=str(solver_version))
+    values = {"qstar": table.qstar, "fe_error": table.fe_error}
+    if orbits:
+        values = dict(zip(("orbit_qstar", "orbit_fe_error"), compact(table.spec, *values.values())))
+    np.savez_compressed(path, spec=json.dumps(spec), solver_version=str(solver_version), **values)
     return Path(path)
+
+
+def read_grid_file(path):
+    """(GridSpec, solver version, ``values()``) of an exported grid ``.npz`` (either form of
+    :func:`export_grid`); ``values()`` reads the node Q* and FE errors, (``spec.shape``) each."""
+    import json
+
+    z = np.load(path, allow_pickle=False)
+    spec = GridSpec.from_dict(json.loads(str(z["spec"])))
+
+    def values():
+        if "orbit_qstar" in z:
+            return expand(spec, z["orbit_qstar"]), expand(spec, z["orbit_fe_error"])
+        return z["qstar"], z["fe_error"]
+    return spec, str(z["solver_version"]), values
 
 
 def load_grid_table(db=None, *, grid=None, solver_version=None):
@@ -180,30 +200,27 @@ def _load_grid_table(db, grid, solver_version):
 
 
 def _shipped_table(name, solver_version):
-    import json
-
     path = shipped_grid_path(name)
     if not path.exists():
         return None
     key = (str(path), name, solver_version, path.stat().st_mtime_ns)
     if key not in _TABLES:
-        z = np.load(path, allow_pickle=False)
-        if str(z["solver_version"]) != str(solver_version):
+        spec, built, values = read_grid_file(path)
+        if built != str(solver_version):
             logger.warning("shipped grid %s was built with solver %s, the current one is %s: not "
                            "used (rebuild: python -m cache.precompute --grid %s --export ...)",
-                           path, z["solver_version"], solver_version, name)
+                           path, built, solver_version, name)
             _TABLES[key] = None
         else:
-            spec = GridSpec.from_dict(json.loads(str(z["spec"])))
             # the whole-grid passes of GridTable (0.1-0.2 s) are done once per table and code
             # version, then read back from a memory map (docs/scale.md)
             saved = derived_path(path, default_db_path().parent)
             rows = load_derived(saved, spec.shape)
             if rows is None:
-                table = GridTable(spec, z["qstar"], z["fe_error"])
+                qstar, fe_error = values()
+                table = GridTable(spec, qstar, fe_error)
                 if saved is not None:
-                    save_derived(saved, dict(table.derived(), qstar=z["qstar"],
-                                             fe_error=z["fe_error"]))
+                    save_derived(saved, dict(table.derived(), qstar=qstar, fe_error=fe_error))
             else:
                 table = GridTable(spec, rows["qstar"], rows["fe_error"], derived=rows)
             table.n_missing = 0
@@ -296,6 +313,7 @@ def lookup_qstar(radii, sides, *, db=None, policy="table+fe", rtol=1e-3, workers
             # FE values already stored in the table beat interpolation (issue 13 item 3)
             pending = _stored_first(r, s, pending, q, err, src, msg, db=db, rtol=rtol,
                                     solver_version=solver_version)
+            injected = table is not None
             if table is None:
                 table = load_grid_table(db, grid=grid, solver_version=solver_version)
             if table is None:
@@ -312,6 +330,9 @@ def lookup_qstar(radii, sides, *, db=None, policy="table+fe", rtol=1e-3, workers
                 ei = err[pending]
                 good = (ei <= rtol) if policy == "table+fe" else ~np.isinf(ei)
                 pending = pending[~good]
+                if not injected and len(pending):
+                    pending = _extension_rows(r, s, pending, q, err, src, stats, policy=policy,
+                                              rtol=rtol, errors=errors, version=solver_version)
         # rows the table did not settle: exact hits, then FE or shape factor
         if len(pending):
             _settle(r, s, pending, q, err, src, msg, stats, db=db, policy=policy, rtol=rtol,
@@ -333,6 +354,22 @@ def lookup_qstar(radii, sides, *, db=None, policy="table+fe", rtol=1e-3, workers
     stats["hit_rate"] = (stats["n_exact"] + stats["n_interp"]) / n_valid
     stats["seconds"] = time.perf_counter() - t0
     return Lookup(q, err, np.asarray(SOURCES)[src], stats, msg)
+
+
+def _extension_rows(r, s, rows, q, err, src, stats, *, policy, rtol, errors, version):
+    """Interpolate ``rows`` the grid table does not serve in the shipped extension grid, each
+    reordered to put its vertex of largest radius deviation third (in place); the rest back."""
+    ext = _shipped_table(EXTENSION_GRID, version)
+    todo = rows[np.isinf(err[rows])]       # table+fe: rows the grid serves too roughly go to FE
+    if ext is None or not len(todo):
+        return rows
+    rp, sp = toward_extension(r[todo], s[todo])
+    qe, ee = ext.at_throats(rp, sp, errors=errors)
+    good = (ee <= rtol) if policy == "table+fe" else ~np.isinf(ee)
+    done = todo[good]
+    q[done], err[done], src[done] = qe[good], ee[good], INTERP
+    stats["n_interp_extension"] = int(done.size)
+    return np.setdiff1d(rows, done, assume_unique=True)
 
 
 def _stored_first(r, s, rows, q, err, src, msg, *, db, rtol, solver_version):

@@ -73,6 +73,9 @@ def build_parser():
     p.add_argument("--export", metavar="NPZ",
                    help="after a complete --grid run, write the grid as .npz; its folder must "
                         "exist (default: not written)")
+    p.add_argument("--orbits", action="store_true",
+                   help="with --export: one value per vertex-permutation orbit of the nodes, "
+                        "about a sixth of the file (default: every node)")
     p.add_argument("--quiet", action="store_true", help="no progress bar (default: a bar)")
     return p
 
@@ -101,6 +104,8 @@ def _check(args):
         if not args.grid:
             raise ValueError("--export needs --grid")
         check_output(args.export, "--export")
+    elif args.orbits:
+        raise ValueError("--orbits needs --export")
     if not args.csv:
         return None, None
     errors = {}
@@ -152,7 +157,8 @@ def _main(argv):
         out.update(db=str(args.db), solver_version=version, rtol=args.rtol, rows=store.count(),
                    dask=args.dask)
         if args.grid and args.export and not out.get("interrupted"):
-            export_grid(store, args.grid, args.export, solver_version=version)
+            export_grid(store, args.grid, args.export, solver_version=version,
+                        orbits=args.orbits)
             out["exported"] = args.export
     print(json.dumps(out, indent=1))
     if out.get("interrupted"):

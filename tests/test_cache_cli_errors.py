@@ -36,6 +36,7 @@ PRECOMPUTE = [
     (["--csv", "good.csv", "--workers", "0"], "--workers and --batch-size must be >= 1"),
     (["--csv", "good.csv", "--max-hours", "-1"], "--max-hours must be > 0"),
     (["--csv", "good.csv", "--export", "g.npz"], "--export needs --grid"),
+    (["--grid", "tiny", "--orbits"], "--orbits needs --export"),
     (["--csv", "good.csv", "--rtol", "x"], "invalid float value: 'x'"),
 ]
 

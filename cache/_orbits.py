@@ -1,0 +1,85 @@
+r"""Vertex-permutation orbits of a grid's nodes: compact storage and the extension grid's lookup.
+
+A permutation of a throat's three vertices permutes its gaps and radius deviations; on a grid
+whose three gap axes share one node set and whose radius lattice is symmetric it maps a node
+:math:`(\delta_{12}, \delta_{13}, \delta_{23}, \rho_1, \rho_2)` to another node of the same
+lattice, which lies in the grid box when its two first deviations do (:math:`\rho_3 =
+-\rho_1 - \rho_2`). Precomputation solves each distinct shape once, so the node values repeat
+over each orbit: :func:`compact` keeps the value of each orbit's first node in C order (about a
+sixth of the nodes), :func:`expand` rebuilds the whole grid from them, bit for bit.
+
+The extension grid (``x1``: g1's nodes, radius deviations to ±0.375, gaps to 4.6) serves rows the
+shipped g1 does not: :func:`toward_extension` reorders each throat so that its vertex of largest
+|ρ| comes third, where the box reaches ±0.75 (``docs/cache-table.md``).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+__all__ = ["EXTENSION_GRID", "compact", "expand", "orbit_representatives", "toward_extension"]
+
+#: grid shipped to serve the rows the default grid cannot (``cache/data/grid_x1.npz``)
+EXTENSION_GRID = "x1"
+
+_PERMS = ((0, 1, 2), (0, 2, 1), (1, 0, 2), (1, 2, 0), (2, 0, 1), (2, 1, 0))
+
+
+def orbit_representatives(spec):
+    """Flat index (n_nodes,) int64 of each node's orbit representative: the smallest flat index
+    among the node's vertex permutations that lie in the box of ``spec`` (a GridSpec)."""
+    shape = spec.shape
+    ng, nr = shape[0], shape[3]
+    c = (nr - 1) // 2
+    idx = np.indices(shape, dtype=np.int64).reshape(5, -1)
+    gap = {(0, 1): idx[0], (0, 2): idx[1], (1, 2): idx[2]}
+    rho = (idx[3], idx[4], 3 * c - idx[3] - idx[4])     # rho_3 = -rho_1 - rho_2 on the lattice
+    rep = np.arange(idx.shape[1], dtype=np.int64)
+    for a, b, d in _PERMS:
+        pa, pb = rho[a], rho[b]
+        inbox = (pa >= 0) & (pa < nr) & (pb >= 0) & (pb < nr)
+        flat = (((gap[tuple(sorted((a, b)))] * ng + gap[tuple(sorted((a, d)))]) * ng
+                 + gap[tuple(sorted((b, d)))]) * nr + pa) * nr + pb
+        np.minimum(rep, np.where(inbox, flat, rep), out=rep)
+    return rep
+
+
+def compact(spec, *arrays):
+    """The values of each orbit's representative node, one (n_orbits,) array per (``spec.shape``)
+    array; ValueError when an orbit holds unequal values (NaN equals NaN)."""
+    rep = orbit_representatives(spec)
+    own = rep == np.arange(rep.size)
+    out = []
+    for a in arrays:
+        flat = np.asarray(a, dtype=float).ravel()
+        back = flat[own][np.cumsum(own)[rep] - 1]
+        if not np.array_equal(back, flat, equal_nan=True):
+            raise ValueError(f"grid {spec.name!r}: {int(np.sum(~((back == flat) | np.isnan(flat))))} "
+                             "nodes differ from their orbit's value: not a permutation-symmetric grid")
+        out.append(flat[own])
+    return out
+
+
+def expand(spec, values):
+    """The grid (``spec.shape``) from its orbit representatives' values (:func:`compact`)."""
+    rep = orbit_representatives(spec)
+    own = rep == np.arange(rep.size)
+    values = np.asarray(values, dtype=float)
+    if values.shape != (int(own.sum()),):
+        raise ValueError(f"grid {spec.name!r} has {int(own.sum())} orbits, got {values.shape}")
+    return values[np.cumsum(own)[rep] - 1].reshape(spec.shape)
+
+
+def toward_extension(radii, sides):
+    """Throats (N, 3) reordered so that the vertex with the largest |r_i - r̄| is the third:
+    radii ``[r1, r2, r3]`` and sides ``[l12, l13, l23]`` of the same shape (N, 3)."""
+    r = np.asarray(radii, dtype=float)
+    s = np.asarray(sides, dtype=float)
+    dev = np.abs(r - r.mean(axis=1, keepdims=True))
+    m = np.argmax(dev, axis=1)
+    # vertex 1 to the end: order (2, 3, 1), sides (l23, l12, l13); vertex 2: order (1, 3, 2),
+    # sides (l13, l12, l23); vertex 3 stays
+    r_order = np.array([[1, 2, 0], [0, 2, 1], [0, 1, 2]])[m]
+    s_order = np.array([[2, 0, 1], [1, 0, 2], [0, 1, 2]])[m]
+    rows = np.arange(len(r))[:, None]
+    return r[rows, r_order], s[rows, s_order]
