@@ -196,6 +196,8 @@ class GridTable:
         recomputing the filled values, curvature coefficients and served cells.
     """
 
+    single = True      # False: gathers from the float64 arrays, no float32 copies (few rows)
+
     def __init__(self, spec, qstar, fe_error=None, *, safety=None, curvature=True,
                  estimate=True, derived=None):
         if safety is None:
@@ -353,23 +355,22 @@ class GridTable:
             v[lo:hi], err[lo:hi] = self._eval(cols(lo, hi), errors)
         if _log:
             return v, err
-        # only clamped extrapolation outside the grid (rel_error = inf, never served) can
-        # overflow: inside the box ln Q* stays within the tabulated values and their curvature
+        # only the clamped extrapolation outside the box (rel_error = inf) can overflow
         with np.errstate(over="ignore"):
             return np.exp(v, out=v), err
 
     def _prepare(self):
-        """float32 copies of the tables and offset views (built on first use)."""
+        """float32 copies (``single``) or the float64 arrays, and offset views (on first use)."""
         if getattr(self, "_f32", None) is not None:
             return
-        vals = self._flat_values.astype(np.float32)
+        vals = self._flat_values.astype(np.float32 if self.single else np.float64, copy=False)
         dims = [d for d in range(5) if len(self._axes[d]) > 1]
         offsets = [0]
         for d in dims:
             offsets = [o + b * int(self._strides[d]) for o in offsets for b in (0, 1)]
         # vals[o:] is a view: take(base) from it gathers v[base + o] without an index array
         self._f32 = {"views": [vals[o:] for o in offsets], "dims": dims,
-                     "k": [None if (k is None or not self.curvature) else k.astype(np.float32)
+                     "k": [None if (k is None or not self.curvature) else k.astype(vals.dtype, copy=False)
                            for k in self._k],
                      "ok": self.cell_ok.ravel(), "err": None}
 
@@ -378,7 +379,7 @@ class GridTable:
         radius axis (first, last, 1/step, count), strides, float32 values, and per node its
         five float32 curvatures and whether its cell is served (one row, (n, 6), one cache
         line per lookup); None for a grid the kernel cannot take (a one-node axis)."""
-        if any(len(a) < 2 for a in self._axes):
+        if any(len(a) < 2 for a in self._axes) or not self.single:
             return None
         rho = self._axes[3]
         if not np.array_equal(rho, self._axes[4]) or not all(self._uniform[3:]):
@@ -416,14 +417,13 @@ class GridTable:
                 td = fd - i
                 i = i.astype(np.int64)
             else:
-                # a point just below a node (a tiny overlap, x = -1e-3) uses the cell above it,
-                # extrapolating by at most GAP_SNAP: its corners are further from closure
+                # just below a node (x = -1e-3): the cell above it, extrapolating <= GAP_SNAP
                 i = np.searchsorted(a, xd + GAP_SNAP, side="right") - 1
                 np.clip(i, 0, len(a) - 2, out=i)
                 lo = a[i]
                 td = (xd - lo) / (a[i + 1] - lo)
             outside |= (xd < a[0] - 1e-9) | (xd > a[-1] + 1e-9)
-            t[d] = td.astype(np.float32)
+            t[d] = td.astype(f["views"][0].dtype)
             if self._strides[d] != 1:
                 i *= self._strides[d]
             base += i

@@ -22,6 +22,7 @@ Rows with NaN/inf, a non-positive length or sides that are not a triangle are re
 
 from __future__ import annotations
 
+import json
 import logging
 import os
 import threading
@@ -134,8 +135,6 @@ def export_grid(store, name, path, *, solver_version, orbits=False):
     """Write grid ``name`` of ``store`` as a compressed ``.npz`` (spec, node Q*, node FE errors);
     ``orbits``: one value per vertex-permutation orbit (``orbit_qstar``, ``orbit_fe_error``,
     :mod:`cache._orbits`), about a sixth of the nodes."""
-    import json
-
     table = grid_from_store(store, name, solver_version)
     if table is None:
         raise ValueError(f"{store.path} holds no grid named {name!r} (grids: {store.grid_names()})")
@@ -150,8 +149,6 @@ def export_grid(store, name, path, *, solver_version, orbits=False):
 def read_grid_file(path):
     """(GridSpec, solver version, ``values()``) of an exported grid ``.npz`` (either form of
     :func:`export_grid`); ``values()`` reads the node Q* and FE errors, (``spec.shape``) each."""
-    import json
-
     z = np.load(path, allow_pickle=False)
     spec = GridSpec.from_dict(json.loads(str(z["spec"])))
 
@@ -224,6 +221,7 @@ def _shipped_table(name, solver_version):
             else:
                 table = GridTable(spec, rows["qstar"], rows["fe_error"], derived=rows)
             table.n_missing = 0
+            table.single = name != EXTENSION_GRID      # served to few rows: no float32 pass
             _TABLES[key] = table
     return _TABLES[key]
 
@@ -296,7 +294,7 @@ def lookup_qstar(radii, sides, *, db=None, policy="table+fe", rtol=1e-3, workers
     err = np.full(n, np.nan)
     src = np.full(n, FAILED, dtype=np.int8)
     msg = np.full(n, "", dtype=object)
-    stats = {"n": n, "policy": policy, "rtol": rtol, "n_fe": 0}
+    stats = {"n": n, "policy": policy, "rtol": rtol, "n_fe": 0, "n_interp_extension": 0}
 
     ok = _quick_valid(r, s)
     pending = np.flatnonzero(ok)

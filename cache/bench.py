@@ -14,6 +14,9 @@
 4. Throughput: ``lookup_qstar(policy='table-only')`` and 'shape-factor' on one batch of
    ``--n-batch`` throats (the held-out set tiled and shuffled), wall and CPU seconds, repeated.
 5. Table size on disk and the precompute time recorded in the table.
+6. The extension grid (``cache.EXTENSION_GRID``, x1) on ``--n-extension`` held-out random
+   shapes that g1 cannot serve (two radius deviations within ±0.375 r̄ after reordering, gaps
+   uniform in -0.2..4.6 r̄; FE at ``rtol=1e-4``): its error and the shape-factor estimate's.
 
 Prints a table and writes JSON (with load average, platform, CPU count, timestamp).
 """
@@ -36,8 +39,10 @@ import numpy as np
 import network
 import throats
 
-from ._interp import GridSpec, GridTable, grid_coordinates
-from ._lookup import default_db_path, grid_from_store, lookup_qstar, shipped_grid_path
+from ._interp import GridTable, grid_coordinates
+from ._lookup import (default_db_path, grid_from_store, load_grid_table, lookup_qstar,
+                      read_grid_file, shipped_grid_path)
+from ._orbits import EXTENSION_GRID, toward_extension
 from ._store import open_store
 
 
@@ -71,6 +76,8 @@ def build_parser():
     p.add_argument("--rtols", default="3e-2,1e-2,3e-3,1e-3", help="rtol values for table+fe")
     p.add_argument("--reference", default=None,
                    help="npz to cache the held-out FE reference in (reused when it exists)")
+    p.add_argument("--n-extension", type=int, default=200,
+                   help="held-out shapes for the extension grid, 0: none (default 200)")
     p.add_argument("--out", default="cache_bench.json", help="output JSON path (default cache_bench.json)")
     return p
 
@@ -125,10 +132,9 @@ def main(argv=None) -> int:
     for name in ("g1", "g2"):
         sp = shipped_grid_path(name)
         if sp.exists():
-            z = np.load(sp)
-            if str(z["solver_version"]) == version:
-                tables[f"{name} (shipped)"] = GridTable(
-                    GridSpec.from_dict(json.loads(str(z["spec"]))), z["qstar"], z["fe_error"])
+            spec, built, values = read_grid_file(sp)
+            if built == version:
+                tables[f"{name} (shipped)"] = GridTable(spec, *values())
                 res[f"shipped_{name}_bytes"] = sp.stat().st_size
     x = grid_coordinates(r, s)
     res["tables"] = {}
@@ -194,6 +200,9 @@ def main(argv=None) -> int:
         _, walls, cpus = _timed(lambda: throats.shape_factor_qstar(rb, sb), args.repeat)
         res["throughput_shape_factor"] = {"n": args.n_batch, "wall_s": walls, "cpu_s": cpus,
                                           "rows_per_s_cpu_best": args.n_batch / min(cpus)}
+    if args.n_extension > 0:
+        res["extension"] = _extension(args.n_extension, args.seed, tables.get("g1 (shipped)"),
+                                      version)
     res["loadavg_end"] = os.getloadavg()
 
     # report ---------------------------------------------------------------------------------
@@ -216,6 +225,14 @@ def main(argv=None) -> int:
             print(f"{key}: {v['n']} rows, wall {min(v['wall_s']):.3f} s (median "
                   f"{np.median(v['wall_s']):.3f}), cpu {min(v['cpu_s']):.3f} s -> "
                   f"{v['n'] / min(v['cpu_s']):.3g} rows/s per core (cpu)")
+    ext = res.get("extension")
+    if ext:
+        print(f"\nextension grid {EXTENSION_GRID} ({ext['bytes']} bytes) on {ext['n']} held-out shapes "
+              f"outside g1 (FE rtol=1e-4): served {ext['served']}")
+        for k in ("x1", "shape_factor"):
+            e = ext[k]
+            print(f"  {k:14s} median {e['median']:.2e}  p90 {e['p90']:.2e}  p99 {e['p99']:.2e}  "
+                  f"max {e['max']:.2e}")
     for k in ("db_bytes", "shipped_g1_bytes", "shipped_g2_bytes", "table_rows",
               "precompute_solve_seconds"):
         if k in res:
@@ -224,6 +241,37 @@ def main(argv=None) -> int:
         json.dump(res, fh, indent=1, default=float)
     print(f"wrote {args.out}")
     return 0
+
+
+def _extension(n, seed, g1, version):
+    """x1 and the shape-factor estimate against FE (rtol 1e-4) on ``n`` random shapes that g1
+    does not serve: radii r̄(1 + ρ) with ρ1, ρ2 uniform in ±0.375, gaps uniform in -0.2..4.6."""
+    ext = load_grid_table(grid=EXTENSION_GRID, solver_version=version)
+    if ext is None or g1 is None:
+        return None
+    rng = np.random.default_rng(seed + 1)
+    r, s = np.empty((0, 3)), np.empty((0, 3))
+    while len(r) < n:
+        rho = rng.uniform(-0.375, 0.375, (4 * n, 2))
+        rr = np.column_stack([1 + rho, 1 - rho.sum(axis=1)])
+        g = rng.uniform(-0.2, 4.6, (4 * n, 3))
+        ss = np.column_stack([rr[:, 0] + rr[:, 1] + g[:, 0], rr[:, 0] + rr[:, 2] + g[:, 1],
+                              rr[:, 1] + rr[:, 2] + g[:, 2]])
+        ok = throats.validate_throats(rr, ss)[0] & np.isinf(g1(grid_coordinates(rr, ss))[1])
+        r, s = np.vstack([r, rr[ok]]), np.vstack([s, ss[ok]])
+    p = rng.permutation(3)                         # any vertex order: the lookup reorders
+    pair = {(0, 1): 0, (0, 2): 1, (1, 2): 2}
+    cols = [pair[tuple(sorted((p[a], p[b])))] for a, b in ((0, 1), (0, 2), (1, 2))]
+    r, s = r[:n][:, p], s[:n][:, cols]
+    ref = throats.solve_fem(r, s, rtol=1e-4).qstar
+    q, e = ext.at_throats(*toward_extension(r, s), errors=False)
+    good = np.isfinite(ref) & (ref > 0)
+    served = good & ~np.isinf(e)
+    return {"n": int(good.sum()), "served": int(served.sum()),
+            "x1": _pct(np.abs(q[served] / ref[served] - 1)),
+            "shape_factor": _pct(np.abs(throats.shape_factor_qstar(r[served], s[served])
+                                        / ref[served] - 1)),
+            "bytes": shipped_grid_path(EXTENSION_GRID).stat().st_size}
 
 
 if __name__ == "__main__":

@@ -60,3 +60,44 @@ def test_reordering_keeps_the_shape_and_puts_the_odd_radius_third():
     np.testing.assert_allclose(cache.signature(rp, sp), cache.signature(r, s), rtol=0, atol=1e-12)
     dev = np.abs(rp - rp.mean(axis=1, keepdims=True))
     assert np.all(dev[:, 2] >= dev.max(axis=1))
+
+
+# windows of the shelled-corn clump bed (session 18's 2028-grain cube) that g1 cannot serve, in
+# units of r̄: radius deviations to -0.373 (a half-size end sphere) and gaps to 3.2 r̄
+#: x1 against FE (rtol 1e-4) on these: within 0.07 % (the estimate: +29 %, +191 %, +130 %)
+TOL_X1 = 0.01
+
+CORN_WINDOWS = {
+    "radii beyond g1": ([0.627139, 1.112045, 1.260816], [2.460587, 1.89567, 2.948195]),
+    "gap beyond g1": ([0.795081, 0.795081, 1.409839], [4.819171, 3.50186, 4.576066]),
+    "both": ([0.627139, 1.112045, 1.260816], [4.489564, 2.534915, 3.674316]),
+}
+
+
+@pytest.mark.parametrize("name", CORN_WINDOWS)
+def test_extension_serves_clump_windows_outside_g1_against_fe(name, tmp_path):
+    r, s = (np.array([v]) for v in CORN_WINDOWS[name])
+    spec, _, values = read_grid_file(shipped_grid_path("g1"))
+    g1 = cache.GridTable(spec, *values())
+    alone = lookup_qstar(r, s, policy="table-only", table=g1, db=tmp_path / "t.sqlite")
+    assert list(alone.source) == ["shape-factor"]
+    res = lookup_qstar(r[:, ::-1], s[:, ::-1], policy="table-only", db=tmp_path / "t.sqlite")
+    assert list(res.source) == ["interp"] and res.stats["n_interp_extension"] == 1
+    fe = throats.solve_fem(r, s, rtol=1e-4).qstar[0]
+    assert res.qstar[0] == pytest.approx(fe, rel=TOL_X1)
+    assert abs(alone.qstar[0] / fe - 1) > 0.25         # what the estimate gave
+
+
+def test_rows_g1_serves_keep_their_bits(tmp_path):
+    rng = np.random.default_rng(11)
+    r = rng.uniform(0.85, 1.15, (500, 3))
+    s = np.column_stack([r[:, 0] + r[:, 1], r[:, 0] + r[:, 2], r[:, 1] + r[:, 2]])
+    s += rng.uniform(-0.15, 2.1, (500, 3))
+    spec, _, values = read_grid_file(shipped_grid_path("g1"))
+    g1 = cache.GridTable(spec, *values())
+    both = lookup_qstar(r, s, policy="table-only", db=tmp_path / "t.sqlite")
+    alone = lookup_qstar(r, s, policy="table-only", db=tmp_path / "t.sqlite", table=g1)
+    inside = np.asarray(alone.source) == "interp"
+    assert inside.mean() > 0.9 and both.stats.get("n_interp_extension", 0) <= (~inside).sum()
+    np.testing.assert_array_equal(both.qstar[inside], alone.qstar[inside])
+    assert EXTENSION_GRID == "x1" and shipped_grid_path(EXTENSION_GRID).exists()

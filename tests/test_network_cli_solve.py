@@ -133,9 +133,9 @@ def test_no_traceback_as_a_subprocess(tmp_path):
 
 
 def test_windows_outside_the_table_are_counted_and_named(tmp_path, capsys, caplog):
-    # spheres of 2-6 mm: most windows have radius ratios beyond the Q* table's +-0.25 and take
-    # the shape-factor estimate (about 2x too open there, docs/throats-shape-factor.md): the
-    # run says so; the bundled scene (5.5-7.5 mm, all inside the table) does not
+    # spheres of 2-6 mm: windows with radius deviations beyond the Q* tables' +-0.375 take the
+    # shape-factor estimate (2-4x too open there, docs/cache-table.md): the run says so; the
+    # bundled scene (5.5-7.5 mm, all inside the tables) does not
     pk = random_packing(400, diameter_range_m=(0.002, 0.006), solid_fraction=0.55, rng=2)
     bed = tmp_path / "poly.csv"
     np.savetxt(bed, np.column_stack([pk.centers, pk.radii]), delimiter=",", header="x,y,z,r",
@@ -144,8 +144,9 @@ def test_windows_outside_the_table_are_counted_and_named(tmp_path, capsys, caplo
     assert solve_cli.main([str(bed), "-q", "--stokes", "--json", str(js)]) == 0
     st = json.loads(js.read_text())["qstar"]["qstar_stats"]
     loose = st["n_shape_factor"] - st["n_shape_factor_deep"]
-    assert st["n_shape_factor_deep"] == 0 and loose > 0.3 * st["n"]
-    assert f"{loose} of {st['n']} windows lie outside the Q* table" in caplog.text
+    assert st["n_shape_factor_deep"] == 0 and loose > 0.03 * st["n"]
+    assert st["n_interp_extension"] > loose          # the extension grid serves most of them
+    assert f"{loose} of {st['n']} windows lie outside the Q* tables" in caplog.text
     caplog.clear()
     assert solve_cli.main(["-q", "--stokes"]) == 0
-    assert "outside the Q* table" not in caplog.text
+    assert "outside the Q* tables" not in caplog.text
