@@ -32,8 +32,8 @@ point_kernel() / GridTable.kernel_arrays()
 Command lines: ``python -m cache.precompute``, ``python -m cache.lookup``, ``python -m cache.bench``.
 
 The shipped table ``cache/data/grid_g1.npz`` (Q* at the 390 625 nodes of grid ``g1``, solved
-by ``throats.solve_fem`` at rtol 1e-3) and, for rows it cannot serve, ``EXTENSION_GRID``'s
-(radius deviations to ±0.375, gaps to 4.6 r̄) are served only while ``throats.SOLVER_VERSION``
+by ``throats.solve_fem`` at rtol 1e-3) and, for rows it cannot serve, ``EXTENSION_GRIDS``
+(radius deviations to ±0.5, gaps -2.2 to 4.6 r̄) are served only while ``throats.SOLVER_VERSION``
 equals the version they were built with; how to rebuild them: ``docs/cache-table.md``.  Accuracy and speed: ``python -m cache.bench``.  ``cache`` never
 imports ``network`` (data flows network → cache through arrays and CSV files) and never
 meshes or solves itself: it calls ``throats``.
@@ -45,7 +45,7 @@ from ._kernel import point_kernel
 from ._interp import CALIBRATED_SAFETY, ERROR_SAFETY, GRIDS, GridSpec, GridTable, grid_coordinates
 from ._lookup import (POLICIES, SOURCES, Lookup, default_db_path, export_grid, load_grid_table,
                       lookup_qstar, read_grid_file, shipped_grid_path)
-from ._orbits import EXTENSION_GRID
+from ._orbits import EXTENSION_GRIDS
 from ._signature import QUANTUM, shape_keys, signature
 from ._store import CacheFileError, ThroatStore, open_store
 
@@ -54,4 +54,4 @@ __all__ = ["signature", "shape_keys", "QUANTUM", "lookup_qstar", "Lookup", "POLI
            "ThroatStore", "CacheFileError", "GridSpec", "GridTable", "GRIDS",
            "grid_coordinates", "load_grid_table", "export_grid", "shipped_grid_path",
            "dask_executor", "DaskConnectError", "CALIBRATED_SAFETY", "ERROR_SAFETY",
-           "point_kernel", "read_grid_file", "EXTENSION_GRID"]
+           "point_kernel", "read_grid_file", "EXTENSION_GRIDS"]

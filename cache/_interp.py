@@ -150,15 +150,15 @@ def _arange(lo, hi, step):
     return [round(lo + k * step, 10) for k in range(n + 1)]
 
 
-#: named grids for ``python -m cache.precompute --grid NAME``; 'g2' is the coarse sub-grid
-#: of 'g1' (every other node), so building g1 after g2 reuses all of g2's solves.
+#: grids for ``python -m cache.precompute --grid NAME``; g2 is g1's coarse sub-grid (built first)
 GRIDS = {
     "tiny": GridSpec("tiny", [-0.05, 0.0, 0.1, 0.3, 0.6], 0.15, 3),    # tests and smoke runs
     # gaps -0.2 .. 2.2 step 0.2 (g2) / 0.1 (g1), radius deviations +-0.25 step 0.25 / 0.125
     "g2": GridSpec("g2", _arange(-0.2, 2.2, 0.2), 0.25, 3),
     "g1": GridSpec("g1", _arange(-0.2, 2.2, 0.1), 0.125, 5),
-    # g1 extended to radius deviations +-0.375 and gaps to 4.6 (clumps; docs/cache-table.md)
+    # beyond g1 for clumps (docs/cache-table.md): radius deviations +-0.375 and gaps to 4.6 (x1),
     "x1": GridSpec("x1", _arange(-0.2, 2.2, 0.1) + [2.4, 2.6, 2.8, 3, 3.4, 3.8, 4.2, 4.6], 0.125, 7),
+    "d1": GridSpec("d1", _arange(-2.2, 2.2, 0.2), 0.125, 9),    # deep overlaps, deviations 0.5
 }
 
 

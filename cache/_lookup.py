@@ -38,7 +38,7 @@ from . import _build
 from ._build import precompute_throats, resolve_solver
 from ._derived import derived_path, load_derived, save_derived
 from ._interp import GridSpec, GridTable
-from ._orbits import EXTENSION_GRID, compact, expand, toward_extension
+from ._orbits import EXTENSION_GRIDS, compact, expand, toward_extension
 from ._signature import as_throats, match_keys, shape_keys, signature
 from ._store import open_store
 
@@ -132,9 +132,8 @@ def grid_from_store(store, name, solver_version):
 
 
 def export_grid(store, name, path, *, solver_version, orbits=False):
-    """Write grid ``name`` of ``store`` as a compressed ``.npz`` (spec, node Q*, node FE errors);
-    ``orbits``: one value per vertex-permutation orbit (``orbit_qstar``, ``orbit_fe_error``,
-    :mod:`cache._orbits`), about a sixth of the nodes."""
+    """Write grid ``name`` of ``store`` as ``.npz`` (spec, node Q*, node FE errors); ``orbits``:
+    one value per vertex-permutation orbit (``orbit_*``, :mod:`cache._orbits`), a sixth as many."""
     table = grid_from_store(store, name, solver_version)
     if table is None:
         raise ValueError(f"{store.path} holds no grid named {name!r} (grids: {store.grid_names()})")
@@ -221,7 +220,7 @@ def _shipped_table(name, solver_version):
             else:
                 table = GridTable(spec, rows["qstar"], rows["fe_error"], derived=rows)
             table.n_missing = 0
-            table.single = name != EXTENSION_GRID      # served to few rows: no float32 pass
+            table.single = name not in EXTENSION_GRIDS  # served to few rows: no float32 pass
             _TABLES[key] = table
     return _TABLES[key]
 
@@ -355,19 +354,22 @@ def lookup_qstar(radii, sides, *, db=None, policy="table+fe", rtol=1e-3, workers
 
 
 def _extension_rows(r, s, rows, q, err, src, stats, *, policy, rtol, errors, version):
-    """Interpolate ``rows`` the grid table does not serve in the shipped extension grid, each
+    """Interpolate ``rows`` the grid table does not serve in the extension grids in turn, each
     reordered to put its vertex of largest radius deviation third (in place); the rest back."""
-    ext = _shipped_table(EXTENSION_GRID, version)
     todo = rows[np.isinf(err[rows])]       # table+fe: rows the grid serves too roughly go to FE
-    if ext is None or not len(todo):
-        return rows
-    rp, sp = toward_extension(r[todo], s[todo])
-    qe, ee = ext.at_throats(rp, sp, errors=errors)
-    good = (ee <= rtol) if policy == "table+fe" else ~np.isinf(ee)
-    done = todo[good]
-    q[done], err[done], src[done] = qe[good], ee[good], INTERP
-    stats["n_interp_extension"] = int(done.size)
-    return np.setdiff1d(rows, done, assume_unique=True)
+    done = []
+    for name in EXTENSION_GRIDS:
+        ext = _shipped_table(name, version)
+        if ext is None or not len(todo):
+            continue
+        qe, ee = ext.at_throats(*toward_extension(r[todo], s[todo]), errors=errors)
+        good = (ee <= rtol) if policy == "table+fe" else ~np.isinf(ee)
+        q[todo[good]], err[todo[good]], src[todo[good]] = qe[good], ee[good], INTERP
+        stats[f"n_interp_{name}"] = int(good.sum())
+        done.append(todo[good])
+        todo = todo[~good]
+    stats["n_interp_extension"] = int(sum(d.size for d in done))
+    return np.setdiff1d(rows, np.concatenate([rows[:0], *done]), assume_unique=True)
 
 
 def _stored_first(r, s, rows, q, err, src, msg, *, db, rtol, solver_version):

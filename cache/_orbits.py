@@ -8,19 +8,21 @@ lattice, which lies in the grid box when its two first deviations do (:math:`\rh
 over each orbit: :func:`compact` keeps the value of each orbit's first node in C order (about a
 sixth of the nodes), :func:`expand` rebuilds the whole grid from them, bit for bit.
 
-The extension grid (``x1``: g1's nodes, radius deviations to ±0.375, gaps to 4.6) serves rows the
-shipped g1 does not: :func:`toward_extension` reorders each throat so that its vertex of largest
-|ρ| comes third, where the box reaches ±0.75 (``docs/cache-table.md``).
+The extension grids serve, in turn, rows the shipped g1 does not: ``x1`` (g1's nodes, radius
+deviations to ±0.375, gaps to 4.6), then ``d1`` (gaps from -2.2, the deep overlaps of two
+spheres of one grain, deviations to ±0.5, step 0.2); :func:`toward_extension` reorders each
+throat so that its vertex of largest |ρ| comes third, where a box reaches twice as far
+(``docs/cache-table.md``).
 """
 
 from __future__ import annotations
 
 import numpy as np
 
-__all__ = ["EXTENSION_GRID", "compact", "expand", "orbit_representatives", "toward_extension"]
+__all__ = ["EXTENSION_GRIDS", "compact", "expand", "orbit_representatives", "toward_extension"]
 
-#: grid shipped to serve the rows the default grid cannot (``cache/data/grid_x1.npz``)
-EXTENSION_GRID = "x1"
+#: grids shipped to serve, in this order, the rows the default grid cannot (``cache/data``)
+EXTENSION_GRIDS = ("x1", "d1")
 
 _PERMS = ((0, 1, 2), (0, 2, 1), (1, 0, 2), (1, 2, 0), (2, 0, 1), (2, 1, 0))
 

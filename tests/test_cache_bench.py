@@ -31,10 +31,12 @@ def test_bench_small_run_writes_json_and_table(tmp_path, capsys):
     assert methods["fe-only (FE rtol=1e-3)"]["error"]["max"] < 1e-3   # FE 1e-3 vs FE 1e-4
     for key in ("throughput_table_only", "throughput_interp_kernel", "throughput_shape_factor"):
         assert data[key]["n"] == 2000 and data[key]["rows_per_s_cpu_best"] > 0
-    # the extension grid on shapes g1 cannot serve: it serves them, the estimate is far off
-    ext = data["extension"]
-    assert ext["n"] == ext["served"] == 8 and ext["x1"]["max"] < 1e-2
-    assert ext["shape_factor"]["median"] > 0.1 and "extension grid x1" in text
+    # the extension grids on shapes the tables before them cannot serve: they serve them, the
+    # estimate is far off
+    for name in ("x1", "d1"):
+        ext = data["extension"][name]
+        assert ext["n"] >= 6 and ext["served"] >= 3 and ext["table"]["median"] < 2e-2
+        assert ext["shape_factor"]["median"] > 0.1 and f"extension grid {name}" in text
     # every row of the JSON is in the printed tables
     for name in list(data["tables"]) + list(methods):
         assert name in text

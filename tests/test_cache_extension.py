@@ -12,7 +12,7 @@ import pytest
 
 import cache
 import throats
-from cache import (EXTENSION_GRID, GRIDS, export_grid, lookup_qstar, open_store, precompute_grid,
+from cache import (EXTENSION_GRIDS, GRIDS, export_grid, lookup_qstar, open_store, precompute_grid,
                    read_grid_file, shipped_grid_path)
 from cache._orbits import compact, expand, orbit_representatives, toward_extension
 from test_cache_fakes import fake_solve
@@ -66,6 +66,8 @@ def test_reordering_keeps_the_shape_and_puts_the_odd_radius_third():
 # units of r̄: radius deviations to -0.373 (a half-size end sphere) and gaps to 3.2 r̄
 #: x1 against FE (rtol 1e-4) on these: within 0.07 % (the estimate: +29 %, +191 %, +130 %)
 TOL_X1 = 0.01
+#: d1 (gap step 0.2 r̄) against FE (rtol 1e-4) on the deep windows below: within TOL_D1
+TOL_D1 = 0.03
 
 CORN_WINDOWS = {
     "radii beyond g1": ([0.627139, 1.112045, 1.260816], [2.460587, 1.89567, 2.948195]),
@@ -100,4 +102,33 @@ def test_rows_g1_serves_keep_their_bits(tmp_path):
     inside = np.asarray(alone.source) == "interp"
     assert inside.mean() > 0.9 and both.stats.get("n_interp_extension", 0) <= (~inside).sum()
     np.testing.assert_array_equal(both.qstar[inside], alone.qstar[inside])
-    assert EXTENSION_GRID == "x1" and shipped_grid_path(EXTENSION_GRID).exists()
+    assert EXTENSION_GRIDS == ("x1", "d1")
+    assert all(shipped_grid_path(name).exists() for name in EXTENSION_GRIDS)
+
+
+# deep overlaps of corn (two spheres of one grain, gap below -0.2 r̄): 0.24 and 0.82 r̄, where
+# the estimate's deep class is 18 % and 20 % low
+DEEP_WINDOWS = {
+    "shallow": ([0.659862, 1.170069, 1.170069], [1.588953, 2.933039, 2.828358]),
+    "middle": ([0.95731, 0.95731, 1.08538], [3.033753, 1.226258, 2.595152]),
+}
+
+
+@pytest.mark.parametrize("name", DEEP_WINDOWS)
+def test_deep_grid_serves_deep_overlaps_against_fe(name, tmp_path):
+    r, s = (np.array([v]) for v in DEEP_WINDOWS[name])
+    assert throats.deep_overlap(r, s)[0]
+    res = lookup_qstar(r[:, [2, 0, 1]], s[:, [1, 2, 0]], policy="table-only",
+                       db=tmp_path / "t.sqlite")
+    assert list(res.source) == ["interp"] and res.stats["n_interp_d1"] == 1
+    fe = throats.solve_fem(r, s, rtol=1e-4).qstar[0]
+    assert res.qstar[0] == pytest.approx(fe, rel=TOL_D1)
+    assert throats.shape_factor_qstar(r, s)[0] < 0.85 * fe       # what the estimate gave
+
+
+def test_the_deepest_overlaps_stay_with_the_estimate(tmp_path):
+    # a wheat window overlapping by 1.59 r̄: d1's cell there has corners of three collinear
+    # centres (no triangle), so it is not served and the estimate's deep class answers
+    r, s = np.array([[0.790151, 1.104925, 1.104925]]), np.array([[2.110816, 2.339809, 0.621037]])
+    res = lookup_qstar(r, s, policy="table-only", db=tmp_path / "t.sqlite")
+    assert list(res.source) == ["shape-factor"] and res.stats["n_shape_factor_deep"] == 1

@@ -161,11 +161,16 @@ def test_invalid_rows_fail_alone(heldout, tmp_path):
 
 
 def test_table_only_counts_the_estimates_deep_overlap_rows(tmp_path):
-    # outside the table's gap range (-0.2 r̄): a deep overlap of two spheres of one grain takes
-    # the estimate with its own constants and is counted apart; an in-range shape is served
-    r = np.ones((3, 3))
-    s = np.array([[1.5, 2.3, 2.3], [0.9, 2.3, 2.3], [2.1, 2.1, 2.1]])
+    # outside g1's gap range (-0.2 r̄): deep overlaps of two spheres of one grain, served by the
+    # extension grid d1 where its cell is whole; where not (a corner of three collinear
+    # centres, the last row: a wheat window overlapping by 1.59 r̄) the estimate answers with
+    # its own constants and the row is counted apart; an in-range shape is served by g1
+    r = np.ones((4, 3))
+    r[3] = [0.790151, 1.104925, 1.104925]
+    s = np.array([[1.5, 2.3, 2.3], [0.9, 2.3, 2.3], [2.1, 2.1, 2.1],
+                  [2.110816, 2.339809, 0.621037]])
     res = cache.lookup_qstar(r, s, policy="table-only", db=tmp_path / "t.sqlite")
-    assert list(res.source) == ["shape-factor", "shape-factor", "interp"]
-    assert res.stats["n_shape_factor"] == 2 and res.stats["n_shape_factor_deep"] == 2
-    assert throats.deep_overlap(r, s).tolist() == [True, True, False]
+    assert list(res.source) == ["interp", "interp", "interp", "shape-factor"]
+    assert res.stats["n_interp_d1"] == 2 and res.stats["n_interp_extension"] == 2
+    assert res.stats["n_shape_factor"] == 1 and res.stats["n_shape_factor_deep"] == 1
+    assert throats.deep_overlap(r, s).tolist() == [True, True, False, True]

@@ -133,10 +133,10 @@ def test_no_traceback_as_a_subprocess(tmp_path):
 
 
 def test_windows_outside_the_table_are_counted_and_named(tmp_path, capsys, caplog):
-    # spheres of 2-6 mm: windows with radius deviations beyond the Q* tables' +-0.375 take the
+    # spheres of 1-6 mm: windows with radius deviations beyond the Q* tables' take the
     # shape-factor estimate (2-4x too open there, docs/cache-table.md): the run says so; the
     # bundled scene (5.5-7.5 mm, all inside the tables) does not
-    pk = random_packing(400, diameter_range_m=(0.002, 0.006), solid_fraction=0.55, rng=2)
+    pk = random_packing(400, diameter_range_m=(0.001, 0.006), solid_fraction=0.55, rng=2)
     bed = tmp_path / "poly.csv"
     np.savetxt(bed, np.column_stack([pk.centers, pk.radii]), delimiter=",", header="x,y,z,r",
                comments="")
@@ -144,7 +144,7 @@ def test_windows_outside_the_table_are_counted_and_named(tmp_path, capsys, caplo
     assert solve_cli.main([str(bed), "-q", "--stokes", "--json", str(js)]) == 0
     st = json.loads(js.read_text())["qstar"]["qstar_stats"]
     loose = st["n_shape_factor"] - st["n_shape_factor_deep"]
-    assert st["n_shape_factor_deep"] == 0 and loose > 0.03 * st["n"]
+    assert st["n_shape_factor_deep"] == 0 and loose > 0.1 * st["n"]
     assert st["n_interp_extension"] > loose          # the extension grid serves most of them
     assert f"{loose} of {st['n']} windows lie outside the Q* tables" in caplog.text
     caplog.clear()

@@ -1,13 +1,13 @@
-r"""The extension grid x1 against FE on the windows of clump beds that the shipped g1 cannot serve.
+r"""The extension grids x1 and d1 against FE on the windows of clump beds that g1 cannot serve.
 
-Research script behind ``cache/data/grid_x1.npz`` (``docs/cache-table.md``, "The extension
-grid"). For each bed: the windows (pore-body faces, not inside a merged body) of its z sample
-that g1 does not serve and that are not deep overlaps (two spheres of one grain, left to the
-shape-factor estimate's own class), solved by FE (``cache.lookup_qstar``, policy 'fe-only',
-stored in ``--db``: a second run solves nothing); their Q* from x1 (table-only lookup) and
-from the shape-factor estimate against FE; and the bed's permeability (``network.solve
---stokes``, z) table-only with g1 alone (x1 switched off), with g1 and x1, and with those
-windows by FE (x1 serving the conduits' reduced sections in the last two).
+Research script behind ``cache/data/grid_x1.npz`` and ``grid_d1.npz`` (``docs/cache-table.md``,
+"The extension grids"). For each bed: the windows (pore-body faces, not inside a merged body) of its z sample
+that g1 does not serve, solved by FE (``cache.lookup_qstar``, policy 'fe-only', stored in
+``--db``: a second run solves nothing); their Q* from the extension grids (table-only lookup)
+and from the shape-factor estimate against FE, apart for the deep overlaps (two spheres of one
+grain, d1's) and the rest (x1's); and the bed's permeability (``network.solve --stokes``, z)
+table-only with g1 alone, g1 and x1, g1, x1 and d1, and the last with those windows by FE
+(``--db`` must hold FE rows of these windows only: the reduced sections come from the tables).
 
     python docs/scripts/check_extension.py --db /tmp/x1check.sqlite shelled_corn.csv barley.csv
 
@@ -34,7 +34,8 @@ DATA = Path(__file__).resolve().parents[2] / "network" / "data"
 
 
 def outside_g1(path):
-    """(radii, sides) of the z sample's windows of a bed that g1 does not serve, no deep overlap."""
+    """(radii, sides, deep overlap, sample windows) of the z sample's windows of a bed that g1
+    does not serve."""
     t = tessellate(read_packing(path))
     merge = merge_pores(t)
     idx = np.flatnonzero(~np.asarray(merge.internal_throat))
@@ -45,43 +46,47 @@ def outside_g1(path):
     spec, _, values = read_grid_file(shipped_grid_path("g1"))
     g1 = GridTable(spec, *values())
     out = np.asarray(lookup_qstar(r, s, policy="table-only", table=g1).source) == "shape-factor"
-    out &= ~deep_overlap(r, s)
-    return r[out], s[out], len(idx)
+    return r[out], s[out], deep_overlap(r[out], s[out]), len(idx)
 
 
 def errors(q, q_fe):
     ok = (q_fe > 0) & (q > 0) & np.isfinite(q)
+    if not ok.any():
+        return None
     e = q[ok] / q_fe[ok] - 1.0
     return {"n": int(ok.sum()), "median": float(np.median(e)), "p5": float(np.percentile(e, 5)),
             "p95": float(np.percentile(e, 95)), "mean_abs": float(np.mean(np.abs(e)))}
 
 
-def check_bed(path, db, workers):
-    r, s, n_windows = outside_g1(path)
-    out = {"bed": str(path), "sample_windows": n_windows, "outside_g1": int(len(r))}
-    if len(r):
-        q_fe = np.asarray(lookup_qstar(r, s, policy="fe-only", db=db, workers=workers).qstar)
-        x1 = lookup_qstar(r, s, policy="table-only", db=Path(db).with_suffix(".none"))
-        served = np.asarray(x1.source) == "interp"
-        out["served_by_x1"] = int(served.sum())
-        out["x1"] = errors(np.asarray(x1.qstar)[served], q_fe[served])
-        out["shape_factor_on_those"] = errors(shape_factor_qstar(r[served], s[served]),
-                                              q_fe[served])
-        out["left_to_shape_factor"] = errors(shape_factor_qstar(r[~served], s[~served]),
-                                             q_fe[~served]) if (~served).any() else None
-    pk = read_packing(path)
-    k = {}
-    grid = lookup_module.EXTENSION_GRID
+def permeability(pk, grids, db=None):
+    """k_zz of ``pk``, table-only, with the extension grids ``grids`` (and ``db``'s FE rows)."""
+    kept = lookup_module.EXTENSION_GRIDS
     try:
-        lookup_module.EXTENSION_GRID = "switched-off"        # no such file: g1 alone
-        k["g1_only"] = solve_network(pk, axis="z", policy="table-only").permeability_m2
+        lookup_module.EXTENSION_GRIDS = grids
+        return solve_network(pk, axis="z", policy="table-only", db=db).permeability_m2
     finally:
-        lookup_module.EXTENSION_GRID = grid
-    k["g1_x1"] = solve_network(pk, axis="z", policy="table-only").permeability_m2
-    k["fe_windows"] = solve_network(pk, axis="z", policy="table-only", db=db).permeability_m2
+        lookup_module.EXTENSION_GRIDS = kept
+
+
+def check_bed(path, db, workers):
+    r, s, deep, n_windows = outside_g1(path)
+    out = {"bed": str(path), "sample_windows": n_windows, "outside_g1": int(len(r)),
+           "deep": int(deep.sum())}
+    q_fe = np.asarray(lookup_qstar(r, s, policy="fe-only", db=db, workers=workers).qstar)
+    tab = lookup_qstar(r, s, policy="table-only", db=Path(db).with_suffix(".none"))
+    served = np.asarray(tab.source) == "interp"
+    q_tab, q_sf = np.asarray(tab.qstar), shape_factor_qstar(r, s)
+    for name, cls in (("not_deep", ~deep), ("deep", deep)):
+        out[name] = {"n": int(cls.sum()), "served_by_tables": int((cls & served).sum()),
+                     "tables": errors(q_tab[cls & served], q_fe[cls & served]),
+                     "shape_factor_on_those": errors(q_sf[cls & served], q_fe[cls & served]),
+                     "left_to_shape_factor": errors(q_sf[cls & ~served], q_fe[cls & ~served])}
+    pk = read_packing(path)
+    k = {"g1_only": permeability(pk, ()), "g1_x1": permeability(pk, ("x1",)),
+         "g1_x1_d1": permeability(pk, ("x1", "d1")),
+         "fe_windows": permeability(pk, ("x1", "d1"), db)}
     out["permeability_m2"] = k
-    out["error_g1_only"] = k["g1_only"] / k["fe_windows"] - 1.0
-    out["error_g1_x1"] = k["g1_x1"] / k["fe_windows"] - 1.0
+    out["errors"] = {key: k[key] / k["fe_windows"] - 1.0 for key in k if key != "fe_windows"}
     return out
 
 
