@@ -1,10 +1,10 @@
-"""Orbit-compact grids and the extension grid x1 that serves what the shipped g1 cannot.
+"""Orbit-compact grids and the extension grids x1 and d1 that serve what the shipped g1 cannot.
 
 A compact grid keeps one value per vertex-permutation orbit of its nodes and must give back
-every node bit for bit; its orbits are the grid's distinct shapes. The extension serves clump
-windows outside g1 (radius deviations beyond ±0.25 r̄, gaps beyond 2.2 r̄), where the
-shape-factor estimate is about 2x too open, within its accuracy against FE; rows g1 serves keep
-their bits.
+every node bit for bit; its orbits are the grid's distinct shapes. x1 serves clump windows
+outside g1 (radius deviations beyond ±0.25 r̄, gaps beyond 2.2 r̄), where the shape-factor
+estimate is about 2x too open, d1 the deep overlaps of two spheres of one grain, where its deep
+class is 10-20 % low, each against FE; rows g1 serves keep their bits.
 """
 
 import numpy as np
