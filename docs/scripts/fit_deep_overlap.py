@@ -30,7 +30,7 @@ from pathlib import Path
 
 import numpy as np
 
-from cache import lookup_qstar
+from cache import GridTable, lookup_qstar, read_grid_file, shipped_grid_path
 from network.flow import solve_network
 from network.packing import read_packing
 from network.pores import default_region, merge_pores, select_sample, tessellate
@@ -51,7 +51,10 @@ def fallback_windows(path, sample_only=False):
                           groups=np.asarray(merge.labels))
         idx = np.intersect1d(idx, s.throats)
     r, s = t.throat_radii[idx], t.throat_sides[idx]
-    out = np.asarray(lookup_qstar(r, s, policy="table-only").source) == "shape-factor"
+    # g1 alone, as when the constants were fitted (the extension grids x1 and d1 came later)
+    spec, _, values = read_grid_file(shipped_grid_path("g1"))
+    g1 = GridTable(spec, *values())
+    out = np.asarray(lookup_qstar(r, s, policy="table-only", table=g1).source) == "shape-factor"
     return r[out], s[out]
 
 
