@@ -245,9 +245,10 @@ def main(argv=None) -> int:
 def _extension(n, seed, g1, version):
     """Each extension grid and the shape-factor estimate against FE (rtol 1e-4) on ``n`` random
     shapes in the grid's box that g1 and the grids before it do not serve: radii r̄(1 + ρ) with
-    ρ1, ρ2 uniform over the grid's radius axis, gaps uniform over its gap axis."""
+    ρ1, ρ2 uniform over the grid's radius axis (all three > 0.2 r̄), gaps uniform over its gap
+    axis, vertices in a random order."""
     rng = np.random.default_rng(seed + 1)
-    before, out = [g1], {}
+    before, out, pair = [g1], {}, {(0, 1): 0, (0, 2): 1, (1, 2): 2}
     for name in EXTENSION_GRIDS:
         ext = load_grid_table(grid=name, solver_version=version)
         if ext is None or g1 is None:
@@ -260,14 +261,15 @@ def _extension(n, seed, g1, version):
             g = rng.uniform(g_lo, g_hi, (8 * n, 3))
             ss = np.column_stack([rr[:, 0] + rr[:, 1] + g[:, 0], rr[:, 0] + rr[:, 2] + g[:, 1],
                                   rr[:, 1] + rr[:, 2] + g[:, 2]])
+            p = rng.permutation(3)                 # any vertex order: the lookup reorders
+            cols = [pair[tuple(sorted((p[a], p[b])))] for a, b in ((0, 1), (0, 2), (1, 2))]
+            rr, ss = rr[:, p], ss[:, cols]
             ok = throats.validate_throats(rr, ss)[0] & (rr.min(axis=1) > 0.2)
-            for t in before:
-                ok &= np.isinf(t.at_throats(*toward_extension(rr, ss), errors=False)[1])
+            for t in before:                       # as the lookup asks them: g1 in given order
+                ok &= np.isinf(t.at_throats(*((rr, ss) if t is g1 else toward_extension(rr, ss)),
+                                            errors=False)[1])
             r, s = np.vstack([r, rr[ok]]), np.vstack([s, ss[ok]])
-        p = rng.permutation(3)                     # any vertex order: the lookup reorders
-        pair = {(0, 1): 0, (0, 2): 1, (1, 2): 2}
-        cols = [pair[tuple(sorted((p[a], p[b])))] for a, b in ((0, 1), (0, 2), (1, 2))]
-        r, s = r[:n][:, p], s[:n][:, cols]
+        r, s = r[:n], s[:n]
         ref = throats.solve_fem(r, s, rtol=1e-4).qstar
         q, e = ext.at_throats(*toward_extension(r, s), errors=False)
         good = np.isfinite(ref) & (ref > 0)
