@@ -24,29 +24,19 @@ from pathlib import Path
 import numpy as np
 
 import cache._lookup as lookup_module
-from cache import GridTable, lookup_qstar, read_grid_file, shipped_grid_path
+from cache import lookup_qstar
+from fit_deep_overlap import DATA, bed_windows, outside_g1     # beside this script
 from network.flow import solve_network
 from network.packing import read_packing
-from network.pores import default_region, merge_pores, select_sample, tessellate
 from throats import deep_overlap, shape_factor_qstar
 
-DATA = Path(__file__).resolve().parents[2] / "network" / "data"
 
-
-def outside_g1(path):
+def windows_beyond_g1(path):
     """(radii, sides, deep overlap, sample windows) of the z sample's windows of a bed that g1
     does not serve."""
-    t = tessellate(read_packing(path))
-    merge = merge_pores(t)
-    idx = np.flatnonzero(~np.asarray(merge.internal_throat))
-    smp = select_sample(t, default_region(t.packing, axis="z"), axis="z",
-                        groups=np.asarray(merge.labels))
-    idx = np.intersect1d(idx, smp.throats)
-    r, s = t.throat_radii[idx], t.throat_sides[idx]
-    spec, _, values = read_grid_file(shipped_grid_path("g1"))
-    g1 = GridTable(spec, *values())
-    out = np.asarray(lookup_qstar(r, s, policy="table-only", table=g1).source) == "shape-factor"
-    return r[out], s[out], deep_overlap(r[out], s[out]), len(idx)
+    r, s = bed_windows(path, sample_only=True)
+    out = outside_g1(r, s)
+    return r[out], s[out], deep_overlap(r[out], s[out]), len(r)
 
 
 def errors(q, q_fe):
@@ -69,9 +59,8 @@ def permeability(pk, grids, db=None):
 
 
 def check_bed(path, db, workers):
-    r, s, deep, n_windows = outside_g1(path)
-    out = {"bed": str(path), "sample_windows": n_windows, "outside_g1": int(len(r)),
-           "deep": int(deep.sum())}
+    r, s, deep, n_windows = windows_beyond_g1(path)
+    out = {"bed": str(path), "sample_windows": n_windows, "outside_g1": int(len(r))}
     q_fe = np.asarray(lookup_qstar(r, s, policy="fe-only", db=db, workers=workers).qstar)
     tab = lookup_qstar(r, s, policy="table-only", db=Path(db).with_suffix(".none"))
     served = np.asarray(tab.source) == "interp"

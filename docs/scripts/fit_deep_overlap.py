@@ -40,9 +40,9 @@ from throats._shape_factor import FIT
 DATA = Path(__file__).resolve().parents[2] / "network" / "data"
 
 
-def fallback_windows(path, sample_only=False):
-    """(radii, sides) of the throats of a bed that the shipped table does not serve (not
-    inside a merged pore body; ``sample_only``: the z sample's throats only)."""
+def bed_windows(path, sample_only=False):
+    """(radii, sides) of a bed's windows (throats not inside a merged pore body;
+    ``sample_only``: the z sample's only)."""
     t = tessellate(read_packing(path))
     merge = merge_pores(t)
     idx = np.flatnonzero(~np.asarray(merge.internal_throat))
@@ -50,11 +50,21 @@ def fallback_windows(path, sample_only=False):
         s = select_sample(t, default_region(t.packing, axis="z"), axis="z",
                           groups=np.asarray(merge.labels))
         idx = np.intersect1d(idx, s.throats)
-    r, s = t.throat_radii[idx], t.throat_sides[idx]
-    # g1 alone, as when the constants were fitted (the extension grids x1 and d1 came later)
+    return t.throat_radii[idx], t.throat_sides[idx]
+
+
+def outside_g1(r, s):
+    """Rows the shipped table g1 alone does not serve (table-only), as when the constants were
+    fitted (the extension grids x1 and d1 came later)."""
     spec, _, values = read_grid_file(shipped_grid_path("g1"))
     g1 = GridTable(spec, *values())
-    out = np.asarray(lookup_qstar(r, s, policy="table-only", table=g1).source) == "shape-factor"
+    return np.asarray(lookup_qstar(r, s, policy="table-only", table=g1).source) == "shape-factor"
+
+
+def fallback_windows(path, sample_only=False):
+    """(radii, sides) of the windows of a bed that g1 does not serve (:func:`bed_windows`)."""
+    r, s = bed_windows(path, sample_only)
+    out = outside_g1(r, s)
     return r[out], s[out]
 
 
