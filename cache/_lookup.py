@@ -153,7 +153,7 @@ def read_grid_file(path):
 
     def values():
         if "orbit_qstar" in z:
-            return expand(spec, z["orbit_qstar"]), expand(spec, z["orbit_fe_error"])
+            return tuple(expand(spec, z["orbit_qstar"], z["orbit_fe_error"]))
         return z["qstar"], z["fe_error"]
     return spec, str(z["solver_version"]), values
 
@@ -357,17 +357,17 @@ def _extension_rows(r, s, rows, q, err, src, stats, *, policy, rtol, errors, ver
     """Interpolate ``rows`` the grid table does not serve in the extension grids in turn, each
     reordered to put its vertex of largest radius deviation third (in place); the rest back."""
     todo = rows[np.isinf(err[rows])]       # table+fe: rows the grid serves too roughly go to FE
-    done = []
+    done, (rp, sp) = [], toward_extension(r[todo], s[todo])    # one order for every grid
     for name in EXTENSION_GRIDS:
         ext = _shipped_table(name, version)
         if ext is None or not len(todo):
             continue
-        qe, ee = ext.at_throats(*toward_extension(r[todo], s[todo]), errors=errors)
+        qe, ee = ext.at_throats(rp, sp, errors=errors)
         good = (ee <= rtol) if policy == "table+fe" else ~np.isinf(ee)
         q[todo[good]], err[todo[good]], src[todo[good]] = qe[good], ee[good], INTERP
         stats[f"n_interp_{name}"] = int(good.sum())
         done.append(todo[good])
-        todo = todo[~good]
+        todo, rp, sp = todo[~good], rp[~good], sp[~good]
     stats["n_interp_extension"] = int(sum(d.size for d in done))
     return np.setdiff1d(rows, np.concatenate([rows[:0], *done]), assume_unique=True)
 

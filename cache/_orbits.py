@@ -62,14 +62,19 @@ def compact(spec, *arrays):
     return out
 
 
-def expand(spec, values):
-    """The grid (``spec.shape``) from its orbit representatives' values (:func:`compact`)."""
+def expand(spec, *values):
+    """The grids (``spec.shape``), one per array of orbit representatives' values
+    (:func:`compact`), sharing one pass over the orbits."""
     rep = orbit_representatives(spec)
     own = rep == np.arange(rep.size)
-    values = np.asarray(values, dtype=float)
-    if values.shape != (int(own.sum()),):
-        raise ValueError(f"grid {spec.name!r} has {int(own.sum())} orbits, got {values.shape}")
-    return values[np.cumsum(own)[rep] - 1].reshape(spec.shape)
+    pick = np.cumsum(own)[rep] - 1
+    out = []
+    for v in values:
+        v = np.asarray(v, dtype=float)
+        if v.shape != (int(own.sum()),):
+            raise ValueError(f"grid {spec.name!r} has {int(own.sum())} orbits, got {v.shape}")
+        out.append(v[pick].reshape(spec.shape))
+    return out
 
 
 def toward_extension(radii, sides):

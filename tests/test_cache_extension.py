@@ -22,8 +22,9 @@ def test_orbits_give_back_every_node_bit_for_bit():
     spec, _, values = read_grid_file(shipped_grid_path("g2"))
     q, fe = values()
     cq, cfe = compact(spec, q, fe)
-    np.testing.assert_array_equal(expand(spec, cq), q)
-    np.testing.assert_array_equal(expand(spec, cfe), fe)
+    eq, efe = expand(spec, cq, cfe)
+    np.testing.assert_array_equal(eq, q)
+    np.testing.assert_array_equal(efe, fe)
     # the index arithmetic's orbits are the geometry's distinct shapes
     r, s = spec.node_shapes()
     valid, _ = throats.validate_throats(r, s)
@@ -79,8 +80,7 @@ CORN_WINDOWS = {
 @pytest.mark.parametrize("name", CORN_WINDOWS)
 def test_extension_serves_clump_windows_outside_g1_against_fe(name, tmp_path):
     r, s = (np.array([v]) for v in CORN_WINDOWS[name])
-    spec, _, values = read_grid_file(shipped_grid_path("g1"))
-    g1 = cache.GridTable(spec, *values())
+    g1 = cache.load_grid_table(tmp_path / "t.sqlite", grid="g1")     # g1 alone, injected
     alone = lookup_qstar(r, s, policy="table-only", table=g1, db=tmp_path / "t.sqlite")
     assert list(alone.source) == ["shape-factor"]
     res = lookup_qstar(r[:, ::-1], s[:, ::-1], policy="table-only", db=tmp_path / "t.sqlite")
@@ -95,8 +95,7 @@ def test_rows_g1_serves_keep_their_bits(tmp_path):
     r = rng.uniform(0.85, 1.15, (500, 3))
     s = np.column_stack([r[:, 0] + r[:, 1], r[:, 0] + r[:, 2], r[:, 1] + r[:, 2]])
     s += rng.uniform(-0.15, 2.1, (500, 3))
-    spec, _, values = read_grid_file(shipped_grid_path("g1"))
-    g1 = cache.GridTable(spec, *values())
+    g1 = cache.load_grid_table(tmp_path / "t.sqlite", grid="g1")     # g1 alone, injected
     both = lookup_qstar(r, s, policy="table-only", db=tmp_path / "t.sqlite")
     alone = lookup_qstar(r, s, policy="table-only", db=tmp_path / "t.sqlite", table=g1)
     inside = np.asarray(alone.source) == "interp"

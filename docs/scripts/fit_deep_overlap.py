@@ -30,7 +30,7 @@ from pathlib import Path
 
 import numpy as np
 
-from cache import GridTable, lookup_qstar, read_grid_file, shipped_grid_path
+from cache import load_grid_table, lookup_qstar
 from network.flow import solve_network
 from network.packing import read_packing
 from network.pores import default_region, merge_pores, select_sample, tessellate
@@ -56,8 +56,7 @@ def bed_windows(path, sample_only=False):
 def outside_g1(r, s):
     """Rows the shipped table g1 alone does not serve (table-only), as when the constants were
     fitted (the extension grids x1 and d1 came later)."""
-    spec, _, values = read_grid_file(shipped_grid_path("g1"))
-    g1 = GridTable(spec, *values())
+    g1 = load_grid_table(grid="g1")
     return np.asarray(lookup_qstar(r, s, policy="table-only", table=g1).source) == "shape-factor"
 
 
