@@ -43,7 +43,7 @@ import sys
 from pathlib import Path
 
 from .benchmarks import (REF_LATTICE_CASES, REF_RANDOM_POROSITIES, has_grid, inertial_lines,
-                         inertial_speed, inertial_validation, lattice_case, machine, per_packing,
+                         inertial_speed, inertial_validation, lattice_case, machine, per_packing, baseline_source,
                          policies, policy_lines, references, references_table, run_one, scaling,
                          scaling_exponent)
 from .conductance import MODELS, POLICIES
@@ -114,13 +114,23 @@ def main(argv=None) -> int:
     ap.add_argument("--yade", action="store_true",
                     help="with --per-packing: also time YADE's FlowEngine on the same packings "
                          "here (needs the yade program; docs/scripts/yade_flowengine.py)")
+    ap.add_argument("--baseline", metavar="DIR", default=None,
+                    help="with --per-packing: a source checkout of an earlier commit (e.g. `git "
+                         "worktree add /tmp/issue18 b8b05a2`, the code issue 18 timed) whose "
+                         "command runs right after each --stokes run of ours: the paired "
+                         "speed-up, on this host, beside the one the issue asks for")
     ap.add_argument("--one", default=None, help=argparse.SUPPRESS)
     ap.add_argument("--no-trace", action="store_true", help=argparse.SUPPRESS)
     args = ap.parse_args(argv)
     if args.inertial_workers is not None and args.inertial_workers < 1:
         ap.error(f"--inertial-workers must be >= 1, got {args.inertial_workers}")
-    if args.yade and not args.per_packing:
-        ap.error("--yade goes with --per-packing")
+    if (args.yade or args.baseline) and not args.per_packing:
+        ap.error("--yade and --baseline go with --per-packing")
+    if args.baseline:
+        try:
+            baseline_source(args.baseline)
+        except ValueError as exc:
+            ap.error(str(exc))
     if args.references_only and args.skip_references:
         ap.error("--references-only and --skip-references exclude each other")
     if args.ref_repeats < 1 or args.ref_spheres < 1:
@@ -167,7 +177,8 @@ def main(argv=None) -> int:
         print(f"per packing: python -m network.solve FILE, wall time ({args.repeats} runs "
               "after a warm-up):", flush=True)
         report["per_packing"] = per_packing(args.sizes, workdir, args.seed,
-                                            repeats=args.repeats, yade=args.yade)
+                                            repeats=args.repeats, yade=args.yade,
+                                            baseline=args.baseline)
         report["machine_end"] = machine()
         with open(args.json_out, "w") as f:
             json.dump(report, f, indent=2, default=str)

@@ -13,14 +13,14 @@ Method and measurement history: ``docs/network-bench.md``.
 
 from ._common import machine, qstar_sources
 from ._inertial import INERTIAL_REYNOLDS, inertial_lines, inertial_speed, inertial_validation
-from ._per_packing import per_packing, per_packing_line
+from ._per_packing import baseline_source, per_packing, per_packing_line
 from ._policies import policies, policy_lines
 from ._references import (FE_POLICIES, REF_LATTICE_CASES, REF_RANDOM_POROSITIES, lattice_case,
                           references, references_table)
 from ._scaling import DIRECT_MAX, packing_file, run_one, scaling, scaling_exponent
 from ._table import has_grid
 
-__all__ = ["DIRECT_MAX", "FE_POLICIES", "INERTIAL_REYNOLDS", "inertial_lines", "inertial_speed",
+__all__ = ["baseline_source", "DIRECT_MAX", "FE_POLICIES", "INERTIAL_REYNOLDS", "inertial_lines", "inertial_speed",
            "inertial_validation", "REF_LATTICE_CASES", "REF_RANDOM_POROSITIES", "has_grid",
            "lattice_case", "machine", "packing_file", "per_packing", "per_packing_line", "policies", "policy_lines", "qstar_sources",
            "references", "references_table", "run_one", "scaling", "scaling_exponent"]
