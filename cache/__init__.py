@@ -45,7 +45,7 @@ from ._kernel import point_kernel
 from ._interp import CALIBRATED_SAFETY, ERROR_SAFETY, GRIDS, GridSpec, GridTable, grid_coordinates
 from ._lookup import (POLICIES, SOURCES, Lookup, default_db_path, export_grid, load_grid_table,
                       lookup_qstar, read_grid_file, shipped_grid_path)
-from ._orbits import EXTENSION_GRIDS
+from ._orbits import EXTENSION_GRIDS, table_coverage
 from ._signature import QUANTUM, shape_keys, signature
 from ._store import CacheFileError, ThroatStore, open_store
 
@@ -54,4 +54,5 @@ __all__ = ["signature", "shape_keys", "QUANTUM", "lookup_qstar", "Lookup", "POLI
            "ThroatStore", "CacheFileError", "GridSpec", "GridTable", "GRIDS",
            "grid_coordinates", "load_grid_table", "export_grid", "shipped_grid_path",
            "dask_executor", "DaskConnectError", "CALIBRATED_SAFETY", "ERROR_SAFETY",
-           "point_kernel", "read_grid_file", "EXTENSION_GRIDS"]
+           "point_kernel", "read_grid_file", "EXTENSION_GRIDS",
+           "table_coverage"]

@@ -38,7 +38,7 @@ from . import _build
 from ._build import precompute_throats, resolve_solver
 from ._derived import derived_path, load_derived, save_derived
 from ._interp import GridSpec, GridTable
-from ._orbits import EXTENSION_GRIDS, compact, expand, toward_extension
+from ._orbits import DEFAULT_GRID, EXTENSION_GRIDS, compact, expand, toward_extension
 from ._signature import as_throats, match_keys, shape_keys, signature
 from ._store import open_store
 
@@ -81,10 +81,6 @@ def default_db_path():
     if env:
         return Path(env)
     return Path.home() / ".cache" / "grainflow" / "throats.sqlite"
-
-
-#: grid served when a table has none of its own (shipped in ``cache/data``)
-DEFAULT_GRID = "g1"
 
 
 def shipped_grid_path(name=DEFAULT_GRID):

@@ -19,10 +19,29 @@ from __future__ import annotations
 
 import numpy as np
 
-__all__ = ["EXTENSION_GRIDS", "compact", "expand", "orbit_representatives", "toward_extension"]
+from ._interp import GRIDS
+
+__all__ = ["DEFAULT_GRID", "EXTENSION_GRIDS", "compact", "expand", "orbit_representatives",
+           "table_coverage", "toward_extension"]
+
+#: grid served when a table has none of its own (shipped in ``cache/data``)
+DEFAULT_GRID = "g1"
 
 #: grids shipped to serve, in this order, the rows the default grid cannot (``cache/data``)
 EXTENSION_GRIDS = ("x1", "d1")
+
+
+def table_coverage() -> str:
+    """The shapes the shipped tables serve, in words: for :data:`DEFAULT_GRID`, then each of
+    :data:`EXTENSION_GRIDS` in the order the lookup asks them, its gap range and the largest
+    deviation of the two first radii, in mean radii r̄ (the third radius, the largest |ρ| for
+    the extension grids, reaches twice as far: :func:`toward_extension`)."""
+    parts = []
+    for name in (DEFAULT_GRID,) + EXTENSION_GRIDS:
+        g = GRIDS[name]
+        parts.append(f"{name}: gaps {g.gap_nodes[0]:g} to {g.gap_nodes[-1]:g}, radius "
+                     f"deviations to {g.rho_nodes[-1]:g}")
+    return "; ".join(parts) + " (mean radii)"
 
 _PERMS = ((0, 1, 2), (0, 2, 1), (1, 0, 2), (1, 2, 0), (2, 0, 1), (2, 1, 0))
 

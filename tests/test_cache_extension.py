@@ -52,6 +52,13 @@ def test_orbit_export_reads_back_as_the_full_export(tmp_path):
     assert np.load(small)["orbit_qstar"].size < 0.5 * np.load(full)["qstar"].size
 
 
+def test_coverage_names_each_shipped_grid_in_lookup_order():
+    # the warning for windows outside every table names these ranges (network's conduit model)
+    assert cache.table_coverage() == (
+        "g1: gaps -0.2 to 2.2, radius deviations to 0.25; x1: gaps -0.2 to 4.6, radius "
+        "deviations to 0.375; d1: gaps -2.2 to 2.2, radius deviations to 0.5 (mean radii)")
+
+
 def test_reordering_keeps_the_shape_and_puts_the_odd_radius_third():
     rng = np.random.default_rng(3)
     r = rng.uniform(0.5, 1.5, (2000, 3))

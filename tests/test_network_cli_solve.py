@@ -8,6 +8,7 @@ import sys
 import numpy as np
 import pytest
 
+import cache
 from network import random_packing, read_packing
 from network import solve as solve_cli
 from network.flow import read_vtu_arrays
@@ -147,6 +148,7 @@ def test_windows_outside_the_table_are_counted_and_named(tmp_path, capsys, caplo
     assert st["n_shape_factor_deep"] == 0 and loose > 0.1 * st["n"]
     assert st["n_interp_extension"] > loose          # the extension grid serves most of them
     assert f"{loose} of {st['n']} windows lie outside the Q* tables" in caplog.text
+    assert cache.table_coverage() in caplog.text       # the ranges, from the grids themselves
     caplog.clear()
     assert solve_cli.main(["-q", "--stokes"]) == 0
     assert "outside the Q* tables" not in caplog.text

@@ -30,7 +30,7 @@ from concurrent.futures import ThreadPoolExecutor
 
 import numpy as np
 
-import throats
+from cache import table_coverage
 
 from .._air import MU_AIR_PA_S, check_viscosity
 from .._json import jsonable
@@ -219,12 +219,10 @@ def conduit_conductance(tessellation, throats_idx=None, *, viscosity_pa_s: float
     loose = qstats.get("n_shape_factor", 0) - qstats.get("n_shape_factor_deep", 0)
     if policy == "table-only" and qstar_fn is None and loose > 1e-3 * qstats.get("n", 0):
         # outside both tables and no deep overlap: there the estimate is 2-4x too open
-        logger.warning("%d of %d windows lie outside the Q* tables (radius deviations beyond "
-                       "0.5, or 0.375 with a gap over 2.2, or gaps beyond 4.6 mean radii) and "
-                       "took the shape-factor estimate, "
-                       "2-4x too open there (an unsettled barley bed: 0.4 %% of its windows, k "
-                       "+2.9 %%); --policy table+fe solves them by FE (docs/cache-table.md)",
-                       loose, qstats["n"])
+        logger.warning("%d of %d windows lie outside the Q* tables (%s) and took the "
+                       "shape-factor estimate, 2-4x too open there (an unsettled barley bed: "
+                       "0.4 %% of its windows, k +2.9 %%); --policy table+fe solves them by FE "
+                       "(docs/cache-table.md)", loose, qstats["n"], table_coverage())
     return ConductanceResult(g, "conduit", qstar, stats, h_m=h, internal=internal)
 
 
