@@ -34,11 +34,16 @@ def test_settled_drop_carries_its_weight():
     # another CPU: numba compiles for the host, a last-bit difference in one step grows
     # through the 8000 steps of collisions to 10 % (seen on an AMD EPYC host). What holds on
     # any CPU is Newton's third law of the settled bed: with frictionless walls only the floor
-    # carries the weight, the lid nothing, opposite side walls push alike.
+    # carries the weight, the lid nothing, opposite side walls push alike. How long the bed
+    # takes to come to rest depends on the trajectory too (unbalanced-force ratio 4.3e-3 after
+    # 32 000 steps on an AVX-512 host, below 2e-3 there on others), so it steps until at rest.
     sim, _ = _dense_drop(threads=1)
-    for _ in range(24000):
-        force = sim.step()
-    assert sim.unbalanced_force_ratio(force) < 2e-3
+    for _ in range(30):                             # up to 120 000 more steps
+        for _ in range(4000):
+            force = sim.step()
+        if sim.unbalanced_force_ratio(force) < 2e-4:
+            break
+    assert sim.unbalanced_force_ratio(force) < 2e-4
     fn = sim._wall_fn * sim._wall_touch.view(bool)          # (walls, particles), N
     normals = np.array([w.normal for w in sim.walls], dtype=float)
     floor, lid = np.flatnonzero(normals[:, 2] > 0.5), np.flatnonzero(normals[:, 2] < -0.5)

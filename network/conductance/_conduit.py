@@ -67,7 +67,8 @@ def conduit_conductance(tessellation, throats_idx=None, *, viscosity_pa_s: float
     policy, rtol, db, workers, progress : keyword-only
         Q* policy and options, as ``network._conductance.throat_qstar``. 'table-only' with
         the grid alone (no stored FE rows) on :data:`KERNEL_MIN_THROATS` throats or more runs
-        the compiled loop of :mod:`._conduit_kernel` (the same bits, 2-2.5x faster).
+        the compiled loop of :mod:`._conduit_kernel` (2-2.5x faster; the same values to 1e-15,
+        bit for bit where NumPy's exp, log and arcsin are the C library's, not AVX-512's).
     sections : {'qstar', 'ratio'}, keyword-only
         'qstar' (default): the Q* policy answers every section (n_sections + 1 per throat);
         'ratio': the policy answers the window only, the profile comes from
