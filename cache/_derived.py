@@ -5,6 +5,9 @@ cells in whole-grid passes (0.1-0.2 s for g1 on this 2-core machine, the largest
 first lookup). Their result depends only on the table file and on the code that derives it
 (``_interp.py``, ``_cells.py``), so it is saved beside the user's Q* table under a name hashed
 from both and read back as a memory map (a few ms); a changed table or code gets a new name.
+The name holds the table file's path too (a clone's files have their own times), so each
+checkout has its copy; :data:`KEEP` copies per table, the most recently used, are kept (x1's
+are 121 MB each: without the bound every clone added 0.2 GB for good).
 """
 
 from __future__ import annotations
@@ -18,7 +21,10 @@ import numpy as np
 
 logger = logging.getLogger(__name__)
 
-__all__ = ["ROWS", "derived_path", "load_derived", "save_derived"]
+__all__ = ["KEEP", "ROWS", "derived_path", "load_derived", "save_derived"]
+
+#: derived copies kept per table name (several checkouts), the most recently used
+KEEP = 3
 
 #: rows of the saved arrays (one float64 .npy, memory-mapped)
 ROWS = ("values", "k0", "k1", "k2", "k3", "k4", "cell_ok", "qstar", "fe_error")
@@ -52,6 +58,10 @@ def load_derived(saved, shape):
         return None
     out = dict(zip(ROWS, np.asarray(a)))      # plain ndarray views: no memmap wrapping later
     out["cell_ok"] = out["cell_ok"] > 0.5
+    try:
+        os.utime(saved)                       # its time says when it was last used (KEEP)
+    except OSError:
+        pass
     return out
 
 
@@ -70,6 +80,22 @@ def save_derived(saved, arrays):
         for old in saved.parent.glob(saved.name.rsplit("-", 1)[0] + "-*.npy"):
             if old != saved:                 # an older copy for the same table file
                 old.unlink(missing_ok=True)
+        _keep_recent(saved)
     except OSError as exc:
         logger.info("derived arrays not saved to %s (%s)", saved, exc)
         tmp.unlink(missing_ok=True)
+
+
+def _keep_recent(saved):
+    """Delete the derived copies of ``saved``'s table name beyond the :data:`KEEP` most
+    recently used (other checkouts' copies; a process reading one keeps its open map)."""
+    stem = saved.name.split(".derived-", 1)[0]
+    copies = []
+    for f in saved.parent.glob(f"{stem}.derived-*.npy"):
+        try:
+            copies.append((f == saved, f.stat().st_mtime_ns, f))
+        except OSError:
+            continue
+    copies.sort(reverse=True)                # the new copy first, then by last use
+    for _, _, f in copies[KEEP:]:
+        f.unlink(missing_ok=True)

@@ -49,3 +49,30 @@ def test_broken_or_foreign_files_are_not_used(tmp_path):
     assert load_derived(junk, spec.shape) is None
     assert load_derived(tmp_path / "absent.npy", spec.shape) is None
     assert derived_path(tmp_path / "absent.npz", tmp_path) is None
+
+
+def test_copies_of_other_checkouts_are_bounded_by_last_use(tmp_path):
+    # each checkout's table file has its own derived copy; KEEP of them stay, the most
+    # recently used (a load marks its use), so clones do not fill the cache for good
+    import os
+
+    import cache._derived as derived
+
+    src = shipped_grid_path("g1").read_bytes()
+    arrays = {k: np.arange(4.0) for k in ROWS}
+    cache_dir = tmp_path / "cache"
+    paths = []
+    for k in range(derived.KEEP + 1):
+        table = tmp_path / f"checkout{k}" / "grid_g1.npz"
+        table.parent.mkdir()
+        table.write_bytes(src)
+        paths.append(derived_path(table, cache_dir))
+    assert len(set(paths)) == len(paths)
+    for k, p in enumerate(paths[:derived.KEEP]):
+        save_derived(p, arrays)
+        os.utime(p, ns=(10**18 + k * 10**9, 10**18 + k * 10**9))     # saved in that order
+    assert load_derived(paths[0], (4,)) is not None                     # the oldest used now
+    save_derived(paths[derived.KEEP], arrays)
+    left = {p.name for p in cache_dir.iterdir()}
+    assert left == {paths[0].name, paths[2].name, paths[derived.KEEP].name}
+    assert len(left) == derived.KEEP
