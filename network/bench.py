@@ -115,22 +115,17 @@ def main(argv=None) -> int:
                     help="with --per-packing: also time YADE's FlowEngine on the same packings "
                          "here (needs the yade program; docs/scripts/yade_flowengine.py)")
     ap.add_argument("--baseline", metavar="DIR", default=None,
-                    help="with --per-packing: a source checkout of an earlier commit (e.g. `git "
-                         "worktree add /tmp/issue18 b8b05a2`, the code issue 18 timed) whose "
-                         "command runs right after each --stokes run of ours: the paired "
-                         "speed-up, on this host, beside the one the issue asks for")
+                    help="with --per-packing: an earlier commit of this checkout (e.g. b8b05a2, "
+                         "the code issue 18 timed; extracted for the run) or a source checkout "
+                         "of one, whose command runs right after each --stokes run of ours: "
+                         "the paired speed-up, on this host, beside the one the issue asks for")
     ap.add_argument("--one", default=None, help=argparse.SUPPRESS)
     ap.add_argument("--no-trace", action="store_true", help=argparse.SUPPRESS)
     args = ap.parse_args(argv)
     if args.inertial_workers is not None and args.inertial_workers < 1:
         ap.error(f"--inertial-workers must be >= 1, got {args.inertial_workers}")
-    if (args.yade or args.baseline) and not args.per_packing:
-        ap.error("--yade and --baseline go with --per-packing")
-    if args.baseline:
-        try:
-            baseline_source(args.baseline)
-        except ValueError as exc:
-            ap.error(str(exc))
+    if (args.yade or args.baseline) and (not args.per_packing or args.inertial):
+        ap.error("--yade and --baseline go with --per-packing (and not --inertial)")
     if args.references_only and args.skip_references:
         ap.error("--references-only and --skip-references exclude each other")
     if args.ref_repeats < 1 or args.ref_spheres < 1:
@@ -147,6 +142,11 @@ def main(argv=None) -> int:
         args.repeats = 7 if args.per_packing else 2
     if args.repeats < 1:
         ap.error(f"--repeats must be >= 1, got {args.repeats}")
+    if args.baseline:
+        try:            # the last check: a commit is extracted here, removed by per_packing
+            args.baseline = baseline_source(args.baseline)
+        except ValueError as exc:
+            ap.error(str(exc))
 
     if args.one:  # child process of the scaling part
         row = run_one(Path(args.one), args.policy, args.db, args.repeats, trace=not args.no_trace,

@@ -143,6 +143,7 @@ def test_per_packing_baseline(run, tmp_path):
     counted ``--stokes`` run of ours, its packages imported from DIR; the row carries the paired
     speed-up baseline / ours and, at the sizes issue 18 timed, the speed-up the issue asks for
     (its 1.4 s / 0.8 s and 4.3 s / 2 s); a DIR that is not such a checkout is bad input."""
+    import subprocess
     from pathlib import Path
 
     import network
@@ -173,6 +174,23 @@ def test_per_packing_baseline(run, tmp_path):
         base["times_s"][0] / rows[0]["times_s"][0])
     assert base["speedup_asked"] is None and "met" not in base      # no issue figure for 300
     assert "speed-up" in _per_packing.per_packing_line(rows[0])
+    # a commit of this checkout: extracted for the run, its command from there, removed after
+    with pytest.raises(ValueError, match="neither a directory nor a commit"):
+        _per_packing.baseline_source("no-such-commit-0000")
+    head = subprocess.run(["git", "-C", str(repo), "rev-parse", "--short=7", "HEAD"],
+                          capture_output=True, text=True, check=False)
+    if head.returncode != 0:            # not a git checkout: a commit cannot be a baseline
+        with pytest.raises(ValueError, match="neither a directory nor a commit"):
+            _per_packing.baseline_source("HEAD")
+        return
+    work = tmp_path / "work"
+    work.mkdir()
+    src = _per_packing.baseline_source("HEAD", work)
+    assert src["commit"] == head.stdout.strip() and src["temporary"] is not None
+    assert Path(src["dir"]).parent == work and (Path(src["dir"]) / "network" / "solve.py").is_file()
+    rows = _per_packing.per_packing([SIZES[0]], tmp, 1, repeats=1, bundled=False, baseline=src)
+    assert rows[0]["baseline"]["commit"] == src["commit"] and rows[0]["baseline"]["times_s"][0] > 0
+    assert not any(work.iterdir())                                  # the extraction is gone
     for argv in (["--baseline", str(repo)], ["--per-packing", "--baseline", str(tmp_path)]):
         with pytest.raises(SystemExit) as e:
             bench.main(argv)

@@ -23,20 +23,24 @@ follow one of ours, as without ``--yade``; the run right after each YADE run is 
 A shared host's speed also moves between sessions (YADE's FlowEngine 0.59-1.06 s on the same
 input), so a wall-time target is judged best against the code the issue timed, on the same host:
 ``baseline=DIR`` (``network.bench --per-packing --baseline DIR``, DIR a source checkout of an
-earlier commit, e.g. ``git worktree add /tmp/issue18 b8b05a2``) runs DIR's own command, its
-packages imported from DIR, right after each counted ``--stokes`` run of ours; the row carries
+earlier commit, or that commit itself, extracted from this checkout's git: ``--baseline
+b8b05a2``) runs DIR's own command, its packages imported from DIR, right after each counted
+``--stokes`` run of ours; the row carries
 the paired speed-up baseline / ours beside the one the issue asks of its own figures
 (:data:`ISSUE_S` / :data:`TARGETS_S`: 1.75x at 5 000 spheres, 2.15x at 20 000).
 """
 
 from __future__ import annotations
 
+import io
 import os
 import re
 import shutil
 import statistics
 import subprocess
 import sys
+import tarfile
+import tempfile
 import time
 from pathlib import Path
 
@@ -96,27 +100,65 @@ def yade_summary(runs: list, ours: list) -> dict | None:
             "faster_than_flowengine_runs": sum(q < 1.0 for q in ratio)}
 
 
-def baseline_source(directory) -> dict:
-    """Where ``python -m network.solve`` run in ``directory`` (with it first on PYTHONPATH)
-    imports ``network`` from, and the checkout's commit: ``{"dir", "commit", "env"}``.
-    ValueError where ``directory`` is not a source checkout whose packages shadow this one."""
-    d = Path(directory).resolve()
-    if not (d / "network" / "solve.py").is_file():
-        raise ValueError(f"--baseline {directory}: no network/solve.py there (not a source "
-                         "checkout of grainflow)")
-    env = user_environment()
-    env.pop("PYTHONDONTWRITEBYTECODE", None)
-    env["PYTHONPATH"] = str(d) + (os.pathsep + env["PYTHONPATH"] if env.get("PYTHONPATH") else "")
-    out = subprocess.run([sys.executable, "-c", "import network; print(network.__file__)"],
-                         cwd=d, env=env, capture_output=True, text=True, check=False)
-    where = Path(out.stdout.strip()).resolve().parent.parent if out.returncode == 0 else None
-    if where != d:
-        raise ValueError(f"--baseline {directory}: its network package is not imported from "
-                         f"there ({out.stdout.strip() or out.stderr.strip()[-120:]})")
-    rev = subprocess.run(["git", "-C", str(d), "rev-parse", "--short", "HEAD"],
-                         capture_output=True, text=True, check=False)
-    return {"dir": str(d), "commit": rev.stdout.strip() if rev.returncode == 0 else None,
-            "env": env}
+#: the source checkout this package runs from (a ``--baseline`` revision is taken from its git)
+REPO = Path(__file__).resolve().parents[2]
+
+
+def baseline_revision(spec) -> str | None:
+    """The full commit of ``spec`` in this checkout's git where ``spec`` is not a directory
+    (None where it is one); ValueError where it is neither a directory nor a commit here."""
+    if Path(spec).is_dir():
+        return None
+    out = subprocess.run(["git", "-C", str(REPO), "rev-parse", "--verify", "--quiet",
+                          f"{spec}^{{commit}}"], capture_output=True, text=True, check=False)
+    if out.returncode != 0:
+        raise ValueError(f"--baseline {spec}: neither a directory nor a commit of the git "
+                         f"checkout {REPO}")
+    return out.stdout.strip()
+
+
+def baseline_source(spec, workdir=None) -> dict:
+    """The baseline's command environment: ``{"dir", "commit", "env", "temporary"}``. ``spec``
+    a source checkout (its packages first on PYTHONPATH) or a commit of this checkout's git,
+    extracted (``git archive``) into a new directory under ``workdir`` that the caller
+    removes (``temporary``). ValueError where ``network`` is not imported from there."""
+    rev = baseline_revision(spec)
+    temporary = None
+    if rev is not None:
+        temporary = Path(tempfile.mkdtemp(prefix=f"baseline-{rev[:7]}-", dir=workdir))
+        arc = subprocess.run(["git", "-C", str(REPO), "archive", "--format=tar", rev],
+                             capture_output=True, check=False)
+        if arc.returncode != 0:
+            shutil.rmtree(temporary, ignore_errors=True)
+            raise ValueError(f"--baseline {spec}: git archive failed: "
+                             f"{arc.stderr.decode(errors='replace').strip()[-120:]}")
+        with tarfile.open(fileobj=io.BytesIO(arc.stdout)) as tar:
+            tar.extractall(temporary, filter="data")
+    d = Path(temporary or spec).resolve()
+    try:
+        if not (d / "network" / "solve.py").is_file():
+            raise ValueError(f"--baseline {spec}: no network/solve.py there (not a source "
+                             "checkout of grainflow)")
+        env = user_environment()
+        env.pop("PYTHONDONTWRITEBYTECODE", None)
+        env["PYTHONPATH"] = str(d) + (os.pathsep + env["PYTHONPATH"]
+                                      if env.get("PYTHONPATH") else "")
+        out = subprocess.run([sys.executable, "-c", "import network; print(network.__file__)"],
+                             cwd=d, env=env, capture_output=True, text=True, check=False)
+        where = Path(out.stdout.strip()).resolve().parent.parent if out.returncode == 0 else None
+        if where != d:
+            raise ValueError(f"--baseline {spec}: its network package is not imported from "
+                             f"there ({out.stdout.strip() or out.stderr.strip()[-120:]})")
+    except ValueError:
+        if temporary is not None:
+            shutil.rmtree(temporary, ignore_errors=True)
+        raise
+    if rev is None:
+        head = subprocess.run(["git", "-C", str(d), "rev-parse", "HEAD"],
+                              capture_output=True, text=True, check=False)
+        rev = head.stdout.strip() if head.returncode == 0 else None
+    return {"dir": str(d), "commit": rev[:7] if rev else None, "env": env,
+            "temporary": temporary}
 
 
 def baseline_summary(source: dict, runs: list, ours: list, n) -> dict:
@@ -140,12 +182,23 @@ def per_packing(sizes, workdir: Path, seed: int, repeats: int = 7,
     with ``yade`` the ``--stokes`` rows of the bench packings carry the :func:`yade_summary`
     of YADE runs interleaved with ours: each run of ours that the row counts follows another
     of ours (as without YADE) and is followed by YADE's; that other run, the one right after
-    YADE's, is timed apart (``ours_after_yade_s``). With ``baseline`` (a directory, see
-    :func:`baseline_source`) those rows also carry the :func:`baseline_summary` of the
-    baseline's command run right after each counted run of ours (after one warm-up)."""
+    YADE's, is timed apart (``ours_after_yade_s``). With ``baseline`` (a directory or a commit,
+    or what :func:`baseline_source` made of one; a temporary extraction is removed at the end)
+    those rows also carry the :func:`baseline_summary` of the baseline's command run right
+    after each counted run of ours (after one warm-up)."""
     env = user_environment()            # as a user starts it: not this process's additions
     env.pop("PYTHONDONTWRITEBYTECODE", None)
-    source = None if baseline is None else baseline_source(baseline)
+    source = (baseline if isinstance(baseline, dict) or baseline is None
+              else baseline_source(baseline, workdir))
+    try:
+        return _per_packing_rows(sizes, workdir, seed, repeats, bundled, yade, source, env)
+    finally:
+        if source is not None and source["temporary"] is not None:
+            shutil.rmtree(source["temporary"], ignore_errors=True)
+
+
+def _per_packing_rows(sizes, workdir, seed, repeats, bundled, yade, source, env):
+    """:func:`per_packing`'s rows, the baseline (if any) prepared."""
     cases = [(n, packing_file(n, workdir, seed)) for n in sizes]
     if bundled:
         cases.append((None, default_packing_path()))
