@@ -10,10 +10,12 @@ disk cut by the region's cross-section (a rectangle: inclusion-exclusion of disk
 areas; a circle: the circle-circle lens), in :math:`z = z_c + r\sin\theta`, by Gauss-Legendre
 on the pieces between the kinks where a slice meets a face, edge or wall, each mapped so the
 :math:`(\theta-\theta_k)^{3/2}` kink is smooth (16 nodes: 5e-9 of a sphere's volume).
-Overlapping pairs (DEM packings) subtract their lens volume, counted when the lens centre lies
-in the region; triple overlaps are neglected. The returned error is the quadrature's (the
-difference to 12 nodes) plus the lens volume of lenses within a lens radius of the region's
-faces. ``method='monte-carlo'``: :math:`M` uniform points,
+Overlapping pairs (DEM packings) subtract their lens volume (a sphere inside another: its
+own), counted when the lens centre lies in the region; triple overlaps are not computed. The
+returned error is the quadrature's (the difference to 12 nodes), the lens volume of lenses
+within a lens radius of the region's faces, and, for every three spheres overlapping pairwise,
+the smallest of their lenses (a bound of the triple intersection, subtracted once too often:
+the porosity errs high). ``method='monte-carlo'``: :math:`M` uniform points,
 :math:`\hat\varepsilon = 1 - S/M`, :math:`\sigma = \sqrt{\hat\varepsilon(1-\hat\varepsilon)/M}`.
 On the bundled scene: exact 0.399039 (error bound 3e-7) in 0.03 s; Monte Carlo 0.3992 ± 0.0008
 in 0.3-1.4 s (400 000 points). Inscribed cylinders along z and x: 0.39975 and 0.39664, Monte
@@ -172,18 +174,47 @@ def _exact(packing, region, axis, tree):
         i, j, dv, dist = i[hit], j[hit], dv[hit], dist[hit]
         if i.size:
             ri, rj = r[i], r[j]
-            lens = (np.pi * (ri + rj - dist) ** 2 * (dist**2 + 2 * dist * rj - 3 * rj**2
-                    + 2 * dist * ri + 6 * ri * rj - 3 * ri**2) / (12 * dist))
-            a = (dist**2 + ri**2 - rj**2) / (2 * dist)         # radical plane from centre i
-            pc = c[i] + (a / dist)[:, None] * dv
+            # a sphere inside another (a grain's small sphere, a fine): the lens is all of it
+            nested = dist <= np.abs(ri - rj)
+            dd = np.where(nested, 1.0, dist)
+            lens = np.where(nested, 4.0 / 3.0 * np.pi * np.minimum(ri, rj) ** 3,
+                            np.pi * (ri + rj - dd) ** 2 * (dd**2 + 2 * dd * rj - 3 * rj**2
+                            + 2 * dd * ri + 6 * ri * rj - 3 * ri**2) / (12 * dd))
+            a = (dd**2 + ri**2 - rj**2) / (2 * dd)             # radical plane from centre i
+            pc = np.where(nested[:, None], np.where((ri <= rj)[:, None], c[i], c[j]),
+                          c[i] + (a / dd)[:, None] * dv)
             v -= np.sum(lens[region.contains(pc, axis)])
             # lenses near a face are split by it: their volume bounds that error
-            rl = np.sqrt(np.maximum(ri**2 - a**2, 0.0))
+            rl = np.where(nested, np.minimum(ri, rj), np.sqrt(np.maximum(ri**2 - a**2, 0.0)))
             near = region.contains(pc, axis) != region.contains(
                 np.clip(pc, lo + rl[:, None], hi - rl[:, None]), axis)
             err += float(np.sum(lens[near]))
+            keep = ~outside[i] & ~outside[j]
+            err += _triple_bound(i[keep], j[keep], lens[keep], r.size)
     total = region.cross_section(axis) * (hi[axis] - lo[axis])
     return 1.0 - v / total, err / total
+
+
+def _triple_bound(i, j, lens, n):
+    r"""Bound of the solid volume the pairwise lens correction subtracts once too often: every
+    triangle of the overlap graph (three spheres overlapping pairwise, none outside the region)
+    may have a triple intersection, inside each of its three lenses, so at most the smallest."""
+    if i.size < 3:
+        return 0.0
+    lo, hi = np.minimum(i, j), np.maximum(i, j)
+    order = np.lexsort((hi, lo))
+    lo, hi, lens = lo[order], hi[order], lens[order]
+    key = lo.astype(np.int64) * n + hi                        # sorted: edges by (lo, hi)
+    end = np.searchsorted(lo, lo, side="right")
+    later = end - np.arange(lo.size) - 1                      # edges after e at the same apex
+    e = np.repeat(np.arange(lo.size), later)                  # apex lo[e] = lo[f], hi[e] < hi[f]
+    if not e.size:
+        return 0.0
+    f = e + 1 + np.arange(e.size) - np.repeat(np.cumsum(later) - later, later)
+    third = hi[e].astype(np.int64) * n + hi[f]
+    pos = np.minimum(np.searchsorted(key, third), key.size - 1)
+    tri = key[pos] == third
+    return float(np.sum(np.minimum(np.minimum(lens[e], lens[f]), lens[pos])[tri]))
 
 
 def _monte_carlo(packing, region, axis, tree, n_points, rng):
