@@ -260,8 +260,10 @@ def solve_fixed_pressure(n_pores, throat_conns, g, inlet, outlet, *, p_in: float
     info : SolveInfo
     check : dict from :func:`verify_solution` (plus ``throat_flow``)
 
-    If the AMG solve misses the mass-balance check (extreme conductance contrast), CG is
-    restarted from its result with a 100 times tighter tolerance once; the outcome is logged.
+    If the AMG solve misses the mass-balance check (conductances over many decades: CG's
+    updated residual then drifts from the true one, and a tighter tolerance does not help),
+    the solution is refined on the true residual, :math:`x \\leftarrow x + A^{-1}(b - Ax)` with
+    the same hierarchy (correction to 1e-8), at most twice; the outcome is logged.
     """
     inlet = np.asarray(inlet, dtype=np.int64)
     outlet = np.asarray(outlet, dtype=np.int64)
@@ -277,14 +279,20 @@ def solve_fixed_pressure(n_pores, throat_conns, g, inlet, outlet, *, p_in: float
                              smoother=smoother)
     p[free] = x
     check = verify_solution(throat_conns, g, p, inlet, outlet, rtol=check_rtol)
-    if not check["ok"] and solver is None:
-        x, info2 = solve_pressure(A_ii, b_i, tol=tol * 1e-2, maxiter=maxiter * 2,
-                                  smoother=smoother)
+    for step in range(2 if solver is None and info.amg is not None else 0):
+        if check["ok"]:
+            break
+        # iterative refinement on the true residual (14 decades of conductance, 200 tiny
+        # spheres among 600: worst pore 1.5e-6 of the flow -> 4e-10 in one step)
+        d, info2 = info.amg.solve(b_i - A_ii @ x, tol=1e-8, maxiter=maxiter)
+        x = x + d
         p[free] = x
-        info = dataclasses.replace(info2, iterations=info.iterations + info2.iterations,
-                                   setup_s=info.setup_s + info2.setup_s,
-                                   solve_s=info.solve_s + info2.solve_s)
+        info = dataclasses.replace(info, iterations=info.iterations + info2.iterations,
+                                   solve_s=info.solve_s + info2.solve_s,
+                                   residual=float(np.linalg.norm(b_i - A_ii @ x)
+                                                  / max(np.linalg.norm(b_i), 1e-300)))
         check = verify_solution(throat_conns, g, p, inlet, outlet, rtol=check_rtol)
-        log.info("re-solved with tol %.0e: check ok = %s", tol * 1e-2, check["ok"])
+        log.info("refined on the true residual (step %d, %d CG iterations): check ok = %s",
+                 step + 1, info2.iterations, check["ok"])
     info.assemble_s = t_asm
     return p, info, check
