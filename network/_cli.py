@@ -90,11 +90,13 @@ def bad_input():
 @contextlib.contextmanager
 def computing():
     """ValueError/RuntimeError/ArithmeticError/OSError inside become exit 1 (the computation
-    or writing its output failed)."""
+    or writing its output failed); exit 2 for an error that marks itself ``bad_input`` (found
+    only by computing, e.g. a packing too small for its sample: ``EmptySampleError``)."""
     try:
         yield
     except (ValueError, RuntimeError, ArithmeticError, NotImplementedError, OSError) as exc:
-        raise CliError(_message(exc), EXIT_FAILED) from exc
+        code = EXIT_BAD_INPUT if getattr(exc, "bad_input", False) else EXIT_FAILED
+        raise CliError(_message(exc), code) from exc
 
 
 def warn(message: str) -> None:

@@ -152,3 +152,16 @@ def test_windows_outside_the_table_are_counted_and_named(tmp_path, capsys, caplo
     caplog.clear()
     assert solve_cli.main(["-q", "--stokes"]) == 0
     assert "outside the Q* tables" not in caplog.text
+
+
+def test_a_packing_too_small_for_its_sample_is_bad_input(tmp_path, capsys):
+    # ten spheres: the default sample holds no inlet or outlet pore, which only the computation
+    # finds; it is the input's fault (exit 2, one line), as a margin leaving no interior is
+    pk = random_packing(800, solid_fraction=0.58, rng=4)
+    bed = tmp_path / "ten.csv"
+    np.savetxt(bed, np.column_stack([pk.centers[:10], pk.radii[:10]]), delimiter=",",
+               header="x,y,z,r", comments="")
+    assert solve_cli.main([str(bed), "-q"]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert err[-1] == ("error: sample has 0 inlet and 0 outlet pores along axis z: region too "
+                       "thin or outside the packing")

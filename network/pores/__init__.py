@@ -12,7 +12,8 @@ from ._porosity import region_porosity
 from ._region import (AXES, MIN_INTERIOR_DIAMETERS, OUTSIDE_BED_DIAMETERS, Region, axis_index,
                       check_inside_bed, default_region, sample_region)
 from ._simplex import column_norm, cross_components
-from ._sample import SampleNetwork, body_centroids, prune_disconnected, select_sample
+from ._sample import (EmptySampleError, SampleNetwork, body_centroids, prune_disconnected,
+                      select_sample)
 from ._tessellation import QHULL_OPTIONS, Tessellation, tessellate, tie_groups
 from ._throat_sample import sample_throats
 
@@ -20,4 +21,4 @@ __all__ = ["AXES", "MIN_INTERIOR_DIAMETERS", "OUTSIDE_BED_DIAMETERS", "QHULL_OPT
            "PoreMerge", "Region", "SampleNetwork", "Tessellation", "axis_index", "body_centroids",
            "check_inside_bed", "circumspheres", "column_norm", "cross_components",
            "default_region", "merge_pores", "prune_disconnected", "region_porosity", "sample_region", "sample_throats",
-           "select_sample", "tessellate", "tie_groups"]
+           "select_sample", "tessellate", "tie_groups", "EmptySampleError"]

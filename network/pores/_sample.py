@@ -27,7 +27,15 @@ import scipy.sparse as sp
 from .._deferred import csgraph
 from ._region import OUTSIDE_BED_DIAMETERS, Region, axis_index
 
-__all__ = ["SampleNetwork", "body_centroids", "select_sample", "prune_disconnected"]
+__all__ = ["EmptySampleError", "SampleNetwork", "body_centroids", "select_sample",
+           "prune_disconnected"]
+
+
+class EmptySampleError(ValueError):
+    """The sample region holds no inlet or no outlet pore: the packing is too small for the
+    region (or the region lies outside it), an input fault (``bad_input``: exit 2 in a CLI)."""
+
+    bad_input = True
 
 log = logging.getLogger(__name__)
 
@@ -185,8 +193,8 @@ def select_sample(tessellation, region: Region, *, axis="z", groups=None) -> Sam
     if both.size:  # a pore touching both ends (sample one pore thick): keep it as inlet
         outlet = np.setdiff1d(outlet, both)
     if inlet.size == 0 or outlet.size == 0:
-        raise ValueError(f"sample has {inlet.size} inlet and {outlet.size} outlet pores along "
-                         f"axis {'xyz'[ax]}: region too thin or outside the packing")
+        raise EmptySampleError(f"sample has {inlet.size} inlet and {outlet.size} outlet pores "
+                               f"along axis {'xyz'[ax]}: region too thin or outside the packing")
     throats = np.flatnonzero(internal)
     conns = np.column_stack([a[throats], b[throats]])
     xyz = xyz_all[pores]
