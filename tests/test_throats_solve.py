@@ -194,6 +194,19 @@ def test_random_extreme_throats_all_solve():
     assert np.all(sol.error_estimate[valid] <= 1e-2)
 
 
+def test_fines_far_apart_mesh_at_their_own_size():
+    """Three equal spheres 170-230 r̄ apart (fines among kernels, a window of a fines bed): at
+    the r̄ element size the open triangle took 1e5-1e6 elements and the solve never ended; the
+    bulk size scales with the region (SIZE_REF). Q* against a mesh of 33 000 elements (bulk
+    size 8x finer, 3.600752e8, 2e-7 between the three meshes tried): within the tolerance."""
+    r = [[1.0, 1.0, 1.0]]
+    s = [[171.36836, 203.98792, 233.99307]]
+    res = solve_fem(r, s, rtol=1e-3)
+    assert res.status[0] == "ok" and res.n_elements[0] < 2000
+    assert res.qstar[0] == pytest.approx(3.600752e8, rel=1e-3)
+    assert res.error_estimate[0] <= 1e-3
+
+
 def test_folded_curved_element_is_detected():
     from throats._trimesh import TriMesh
     g = build_geometries([[1, 1, 1]], [[2.2, 2.2, 2.2]])[0]

@@ -235,10 +235,20 @@ def _fe_solve(trimesh: TriMesh, orders=(3, 4), *, use_skfem_basis=False):
     return q, area_h
 
 
-def _h_for_rtol(rtol):
-    """First mesh size and arc angle for a tolerance (calibrated in throats.bench)."""
+#: open-region size (sqrt of its area, units of r̄) up to which the bulk element size is the
+#: calibrated one: every shape of the shipped tables' boxes lies below it (x1's largest, gaps
+#: 4.6 r̄, about 4.2); larger regions scale the bulk size with their own size
+SIZE_REF = 5.0
+
+
+def _h_for_rtol(rtol, area=0.0):
+    """First mesh size and arc angle for a tolerance (calibrated in throats.bench). The bulk
+    size is in units of the region's own size beyond :data:`SIZE_REF`: h x sqrt(area)/SIZE_REF
+    (three fines 200 r̄ apart made 1e5-1e6 elements at the r̄ size and never finished; the
+    arcs keep their curvature sizing and the mesh grades from them)."""
     s = (rtol / 1e-3) ** 0.25
-    return float(np.clip(0.6 * s, 0.05, 1.0)), float(np.clip(0.5 * s, 0.08, 0.8))
+    grow = max(1.0, float(np.sqrt(max(area, 0.0))) / SIZE_REF)
+    return float(np.clip(0.6 * s, 0.05, 1.0)) * grow, float(np.clip(0.5 * s, 0.08, 0.8))
 
 
 def _solve_geometry(geom, rtol, *, max_refine=2, delta=DELTA_DEFAULT):
@@ -253,7 +263,7 @@ def _solve_geometry(geom, rtol, *, max_refine=2, delta=DELTA_DEFAULT):
     if not geom.loops or geom.area < delta**2:
         return 0.0, 0.0, 0, "closed", (f"open region narrower than the closing width "
                                        f"{delta:g} rbar everywhere: Q* taken as 0")
-    h, ca = _h_for_rtol(rtol)
+    h, ca = _h_for_rtol(rtol, geom.area)
     orders = (2, 3) if rtol >= 5e-3 else (3, 4)
     msg = ""
     for level in range(max_refine + 1):
