@@ -76,6 +76,11 @@ def test_a_sphere_inside_another_is_counted_once():
     eps, err = region_porosity(pk, Region([0, 0, 0], [10, 10, 10]), 2)
     assert (1 - eps) * 1000 == pytest.approx(V1, rel=1e-8)
     assert 0 <= err < 1e-9
+    # cut by a face (x = 5.5 through both): half the big sphere, its exact share, no bound
+    eps, err = region_porosity(pk, Region([0, 0, 0], [5.5, 10, 10]), 2)
+    cap = np.pi * 0.5**2 * (3 - 0.5) / 3                         # x > 5.5 of the unit sphere
+    assert (1 - eps) * 550 == pytest.approx(V1 - cap, rel=1e-8)
+    assert 0 <= err < 1e-9
 
 
 def test_triple_overlaps_are_bounded():

@@ -10,8 +10,8 @@ disk cut by the region's cross-section (a rectangle: inclusion-exclusion of disk
 areas; a circle: the circle-circle lens), in :math:`z = z_c + r\sin\theta`, by Gauss-Legendre
 on the pieces between the kinks where a slice meets a face, edge or wall, each mapped so the
 :math:`(\theta-\theta_k)^{3/2}` kink is smooth (16 nodes: 5e-9 of a sphere's volume).
-Overlapping pairs (DEM packings) subtract their lens volume (a sphere inside another: its
-own), counted when the lens centre lies in the region; triple overlaps are not computed. The
+Overlapping pairs (DEM packings) subtract their lens volume, counted when the lens centre lies
+in the region (a sphere inside another: its exact share of the region); triple overlaps are not computed. The
 returned error is the quadrature's (the difference to 12 nodes), the lens volume of lenses
 within a lens radius of the region's faces, and, for every three spheres overlapping pairwise,
 the smallest of their lenses (a bound of the triple intersection, subtracted once too often:
@@ -183,11 +183,14 @@ def _exact(packing, region, axis, tree):
             a = (dd**2 + ri**2 - rj**2) / (2 * dd)             # radical plane from centre i
             pc = np.where(nested[:, None], np.where((ri <= rj)[:, None], c[i], c[j]),
                           c[i] + (a / dd)[:, None] * dv)
-            v -= np.sum(lens[region.contains(pc, axis)])
+            # a nested sphere's share of the region is exact, as any sphere's
+            v -= np.sum(sphere_region_volume(pc[nested], np.minimum(ri, rj)[nested], region,
+                                             axis)) if nested.any() else 0.0
+            v -= np.sum(lens[~nested & region.contains(pc, axis)])
             # lenses near a face are split by it: their volume bounds that error
-            rl = np.where(nested, np.minimum(ri, rj), np.sqrt(np.maximum(ri**2 - a**2, 0.0)))
-            near = region.contains(pc, axis) != region.contains(
-                np.clip(pc, lo + rl[:, None], hi - rl[:, None]), axis)
+            rl = np.sqrt(np.maximum(ri**2 - a**2, 0.0))
+            near = ~nested & (region.contains(pc, axis) != region.contains(
+                np.clip(pc, lo + rl[:, None], hi - rl[:, None]), axis))
             err += float(np.sum(lens[near]))
             keep = ~outside[i] & ~outside[j]
             err += _triple_bound(i[keep], j[keep], lens[keep], r.size)
