@@ -10,13 +10,16 @@ from __future__ import annotations
 
 import math
 
-__all__ = ["MU_AIR_PA_S", "RHO_AIR_KG_M3", "check_viscosity", "check_density",
+__all__ = ["MU_AIR_PA_S", "P_ATM_PA", "RHO_AIR_KG_M3", "check_viscosity", "check_density",
            "check_positive"]
 
 #: Dynamic viscosity of air used by the thesis (Appendix G), Pa·s.
 MU_AIR_PA_S = 1.932e-5
 #: Density of air used by the thesis, kg/m³.
 RHO_AIR_KG_M3 = 1.20
+#: Standard atmospheric pressure, Pa: the flow is incompressible while the pressure drop is a
+#: small part of it (10 % of it changes the density by 10 %).
+P_ATM_PA = 101_325.0
 
 
 def check_positive(name: str, value) -> float:

@@ -25,7 +25,7 @@ import sys
 import warnings
 from pathlib import Path
 
-from ._air import MU_AIR_PA_S, RHO_AIR_KG_M3, check_positive
+from ._air import MU_AIR_PA_S, P_ATM_PA, RHO_AIR_KG_M3, check_positive
 from ._lean import keep_heap
 from .packing import UNITS, default_packing_path, read_container, read_packing, scale_warning
 from .flow import DEFAULT_INERTIAL_LAW, INERTIAL_LAWS
@@ -102,6 +102,25 @@ def computing():
 def warn(message: str) -> None:
     """One ``warning:`` line on stderr."""
     print(f"warning: {' '.join(str(message).split())}", file=sys.stderr)
+
+
+#: Largest particle Reynolds number the inertial law was checked at (issue 14: against the
+#: Beetstra law to 200, against the resolved flow to 93; docs/inertial-flow.md)
+RE_P_CHECKED = 200.0
+
+
+def warn_validity(reynolds_particle=None, pressure_drop_pa=None) -> None:
+    """``warning:`` lines for a result outside the model's range: Re_p above
+    :data:`RE_P_CHECKED` (the per-conduit law extrapolated, the flow likely unsteady), a pressure
+    drop above 10 % of :data:`~network._air.P_ATM_PA` (the air's density changes by as much;
+    the model takes it constant)."""
+    if reynolds_particle is not None and reynolds_particle > RE_P_CHECKED:
+        warn(f"Re_p {reynolds_particle:.3g} is beyond the {RE_P_CHECKED:g} the inertial law was "
+             "checked to: the result is an extrapolation (docs/inertial-flow.md)")
+    if pressure_drop_pa is not None and pressure_drop_pa > 0.1 * P_ATM_PA:
+        warn(f"a pressure drop of {pressure_drop_pa:.3g} Pa is {pressure_drop_pa / P_ATM_PA:.0%} "
+             "of the atmosphere's: the air is compressed by as much, which the model (constant "
+             "density) leaves out")
 
 
 def progress_log(args, fmt: str = "[%(relativeCreated)7.0f ms] %(message)s") -> None:

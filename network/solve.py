@@ -24,7 +24,7 @@ import numpy as np
 
 from ._cli import (CliError, CliParser, add_air, add_packing, add_sample, add_table,
                    available_cores, bad_input, check_common, check_outputs, computing,
-                   finish, load_packing, progress_log, run, sample_box_m)
+                   finish, load_packing, progress_log, run, sample_box_m, warn_validity)
 from .conductance import MODELS, POLICIES, throat_qstar
 from .flow import (DEFAULT_DEPTH_M, DEFAULT_VELOCITY_M_S, combined_summary, solve_axes,
                    write_network_vtu)
@@ -240,6 +240,9 @@ def _main(args) -> int:
           f"{args.conductance_model}, policy {args.policy}")
     for res in results:
         _print_result(res, sys.stdout)
+        s = res.summary()
+        warn_validity(s.get("reynolds_particle") if "pressure_drop_stokes_pa" in s else None,
+                      s["pressure_drop_pa"])
     out = combined_summary(results, seconds={"read": t_read, "wall": total}, packing=packing)
     out["packing"] = str(path)
     out["units"] = args.units

@@ -165,3 +165,14 @@ def test_a_packing_too_small_for_its_sample_is_bad_input(tmp_path, capsys):
     err = capsys.readouterr().err.strip().splitlines()
     assert err[-1] == ("error: sample has 0 inlet and 0 outlet pores along axis z: region too "
                        "thin or outside the packing")
+
+
+def test_results_outside_the_checked_range_are_warned(capsys):
+    # 50 m/s through the bundled scene: Re_p 2e4 and 1.9 MPa over 0.25 m, both beyond the
+    # model's range (inertial law checked to Re_p 200, air taken incompressible)
+    assert solve_cli.main(["-q", "--velocity", "50"]) == 0
+    err = capsys.readouterr().err
+    assert "warning: Re_p 2.05e+04 is beyond the 200 the inertial law was checked to" in err
+    assert "warning: a pressure drop of 1.91e+06 Pa is 1881% of the atmosphere's" in err
+    assert solve_cli.main(["-q"]) == 0                  # 0.013 m/s: Re_p 5.3, 1.6 Pa
+    assert "warning" not in capsys.readouterr().err
