@@ -76,7 +76,9 @@ def _clipped_fraction(t, lo, hi) -> np.ndarray:
             out[idx, np.minimum(emitted[idx], kmax - 1)] = a[idx] + w * (b[idx] - a[idx])
             emitted[idx] += 1
         poly, count = out, np.minimum(emitted, kmax)
-    x, y = poly[..., 0], poly[..., 1]
+    # the shoelace on coordinates relative to each polygon's first vertex: in bin coordinates
+    # (1e5 m) the raw products cancelled to 1e-6 of the areas (k 0.2 % off)
+    x, y = poly[..., 0] - poly[:, :1, 0], poly[..., 1] - poly[:, :1, 1]
     nxt = np.where(np.arange(kmax)[None, :] + 1 < count[:, None],
                    np.arange(kmax)[None, :] + 1, 0)
     valid = np.arange(kmax)[None, :] < count[:, None]
@@ -175,7 +177,7 @@ def core_permeability(sample, g, p, *, margin_m: float, viscosity_pa_s: float = 
     if np.unique(np.round(xa / (hi[ax] - lo[ax]), 9)).size < 2:
         raise ValueError("the core holds fewer than two distinct pore positions along the "
                          "axis: enlarge the sample or reduce margin_m")
-    grad = -np.polyfit(xa, p[core], 1)[0]
+    grad = -np.polyfit(xa - xa.mean(), p[core], 1)[0]        # centred: bin coordinates
     i, j = sample.conns[:, 0], sample.conns[:, 1]
     ai, aj = x[i, ax], x[j, ax]
     planes = np.linspace(lo[ax], hi[ax], int(n_planes) + 2)[1:-1]
