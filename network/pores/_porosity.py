@@ -11,11 +11,11 @@ areas; a circle: the circle-circle lens), in :math:`z = z_c + r\sin\theta`, by G
 on the pieces between the kinks where a slice meets a face, edge or wall, each mapped so the
 :math:`(\theta-\theta_k)^{3/2}` kink is smooth (16 nodes: 5e-9 of a sphere's volume).
 Overlapping pairs (DEM packings) subtract their lens volume, counted when the lens centre lies
-in the region (a sphere inside another: its exact share of the region); triple overlaps are not computed. The
-returned error is the quadrature's (the difference to 12 nodes), the lens volume of lenses
-within a lens radius of the region's faces, and, for every three spheres overlapping pairwise,
-the smallest of their lenses (a bound of the triple intersection, subtracted once too often:
-the porosity errs high). ``method='monte-carlo'``: :math:`M` uniform points,
+in the region (a sphere inside another: its exact share of the region); triple overlaps are not
+computed. The returned error is the quadrature's (the difference to 12 nodes), the lens volume
+of lenses within a lens radius of the region's faces, and, for every three spheres overlapping
+pairwise, the smallest of their lenses (a bound of the triple intersection, subtracted once too
+often: the porosity errs high). ``method='monte-carlo'``: :math:`M` uniform points,
 :math:`\hat\varepsilon = 1 - S/M`, :math:`\sigma = \sqrt{\hat\varepsilon(1-\hat\varepsilon)/M}`.
 On the bundled scene: exact 0.399039 (error bound 3e-7) in 0.03 s; Monte Carlo 0.3992 ± 0.0008
 in 0.3-1.4 s (400 000 points). Inscribed cylinders along z and x: 0.39975 and 0.39664, Monte
