@@ -328,3 +328,20 @@ def test_fines_spanning_fourteen_decades_are_refined_to_mass_balance(caplog):
     assert res.check["ok"] and res.check["max_pore_residual"] <= 1e-8
     direct = solve_network(fines, solver=spsolve)
     assert res.permeability_m2 == pytest.approx(direct.permeability_m2, rel=1e-8)
+
+
+def test_spheres_apart_from_the_bed_are_left_out_of_the_default_sample(caplog):
+    """Three escaped particles (2 m above the bed, 0.5 m and 1 m beside it), as a DEM run
+    leaves them: the default sample came out of the extent they stretch ('0 outlet pores',
+    exit 2); now they are named and left out, and k is the bed's own."""
+    pk = read_packing(default_packing_path())
+    far = [[0.01, 0.01, 2.0], [0.5, 0.5, 0.05], [-1.0, 0.02, 0.02]]
+    escaped = Packing(np.vstack([pk.centers, far]), np.append(pk.radii, [0.003] * 3))
+    with caplog.at_level("WARNING", logger="network.pores._region"):
+        res = solve_network(escaped, porosity_points=0)
+    assert "3 sphere(s) lie apart from the bed" in caplog.text
+    assert "#3001, #3002, #3003" in caplog.text
+    base = solve_network(pk, porosity_points=0)
+    assert res.permeability_m2 == pytest.approx(base.permeability_m2, rel=1e-3)
+    # the same box, up to the margin (1.5 mean diameters, the three among them: 8e-7 m)
+    assert default_region(escaped).lo == pytest.approx(default_region(pk).lo, abs=1e-6)

@@ -7,10 +7,12 @@ surfaces, where the packing is looser than the bulk (thesis 4.2.3, Appendix G).
 from __future__ import annotations
 
 import dataclasses
+import logging
 
 import numpy as np
 
 __all__ = ["AXES", "MIN_INTERIOR_DIAMETERS", "OUTSIDE_BED_DIAMETERS", "Region", "axis_index",
+           "bed_members",
            "check_inside_bed", "default_region", "sample_region"]
 
 AXES = {"x": 0, "y": 1, "z": 2}
@@ -77,6 +79,29 @@ OUTSIDE_BED_DIAMETERS = 2.0
 #: Thinnest interior (in mean diameters) that :func:`default_region` accepts on any axis.
 MIN_INTERIOR_DIAMETERS = 2.0
 
+log = logging.getLogger(__name__)
+
+
+def bed_members(packing) -> np.ndarray:
+    """Spheres of the bed (bool, (N,)): along every axis the sorted sphere surfaces of a packed
+    bed leave no empty band wider than :data:`OUTSIDE_BED_DIAMETERS` mean diameters; spheres
+    beyond such a band from the largest contiguous run (a DEM's escaped particles, a stray row)
+    are not. O(N log N), no neighbour search."""
+    c, r = packing.centers, packing.radii
+    gap = OUTSIDE_BED_DIAMETERS * packing.grain_diameter
+    keep = np.ones(c.shape[0], dtype=bool)
+    for k in range(3):
+        order = np.argsort(c[:, k], kind="stable")
+        top = np.maximum.accumulate(c[order, k] + r[order])     # highest surface so far
+        breaks = np.flatnonzero(c[order[1:], k] - r[order[1:]] - top[:-1] > gap) + 1
+        if breaks.size:
+            edges = np.concatenate([[0], breaks, [order.size]])
+            run = int(np.argmax(np.diff(edges)))
+            out = np.ones(order.size, dtype=bool)
+            out[edges[run]:edges[run + 1]] = False
+            keep[order[out]] = False
+    return keep
+
 
 def default_region(packing, *, margin: float | None = None, cylinder: bool = False,
                    container: dict | None = None, axis="z") -> Region:
@@ -103,6 +128,16 @@ def default_region(packing, *, margin: float | None = None, cylinder: bool = Fal
         Flow axis (matters for a cylindrical container only).
     """
     lo, hi = packing.extent()
+    bed = bed_members(packing)
+    if not bed.all():
+        apart = np.flatnonzero(~bed)
+        log.warning("%d sphere(s) lie apart from the bed, beyond an empty band of %g mean "
+                    "diameters (sphere %s): the default sample leaves them out", apart.size,
+                    OUTSIDE_BED_DIAMETERS, ", ".join(f"#{i + 1}" for i in apart[:5])
+                    + (", ..." if apart.size > 5 else ""))
+        sub = packing.centers[bed], packing.radii[bed]
+        lo = (sub[0] - sub[1][:, None]).min(axis=0)
+        hi = (sub[0] + sub[1][:, None]).max(axis=0)
     m = 1.5 * packing.grain_diameter if margin is None else float(margin)
     if m < 0:
         raise ValueError(f"margin must be >= 0, got {m}")
