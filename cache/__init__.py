@@ -46,6 +46,7 @@ from ._interp import CALIBRATED_SAFETY, ERROR_SAFETY, GRIDS, GridSpec, GridTable
 from ._lookup import (POLICIES, SOURCES, Lookup, default_db_path, export_grid, load_grid_table,
                       lookup_qstar, read_grid_file, shipped_grid_path)
 from ._orbits import EXTENSION_GRIDS, table_coverage
+from ._routes import table_routes
 from ._signature import QUANTUM, shape_keys, signature
 from ._store import CacheFileError, ThroatStore, open_store
 
@@ -55,4 +56,4 @@ __all__ = ["signature", "shape_keys", "QUANTUM", "lookup_qstar", "Lookup", "POLI
            "grid_coordinates", "load_grid_table", "export_grid", "shipped_grid_path",
            "dask_executor", "DaskConnectError", "CALIBRATED_SAFETY", "ERROR_SAFETY",
            "point_kernel", "read_grid_file", "EXTENSION_GRIDS",
-           "table_coverage"]
+           "table_coverage", "table_routes"]

@@ -42,7 +42,8 @@ import throats
 from ._interp import GridTable, grid_coordinates
 from ._lookup import (default_db_path, grid_from_store, load_grid_table, lookup_qstar,
                       read_grid_file, shipped_grid_path)
-from ._orbits import EXTENSION_GRIDS, toward_extension
+from ._orbits import EXTENSION_GRIDS
+from ._routes import table_routes
 from ._store import open_store
 
 
@@ -201,8 +202,7 @@ def main(argv=None) -> int:
         res["throughput_shape_factor"] = {"n": args.n_batch, "wall_s": walls, "cpu_s": cpus,
                                           "rows_per_s_cpu_best": args.n_batch / min(cpus)}
     if args.n_extension > 0:
-        res["extension"] = _extension(args.n_extension, args.seed, tables.get("g1 (shipped)"),
-                                      version)
+        res["extension"] = _extension(args.n_extension, args.seed, version)
     res["loadavg_end"] = os.getloadavg()
 
     # report ---------------------------------------------------------------------------------
@@ -242,19 +242,19 @@ def main(argv=None) -> int:
     return 0
 
 
-def _extension(n, seed, g1, version):
+def _extension(n, seed, version):
     """Each extension grid and the shape-factor estimate against FE (rtol 1e-4) on ``n`` random
-    shapes in the grid's box that g1 and the grids before it do not serve: radii r̄(1 + ρ) with
-    ρ1, ρ2 uniform over the grid's radius axis (all three > 0.2 r̄), gaps uniform over its gap
-    axis, vertices in a random order."""
+    shapes in the grid's box that g1 and the grids before it do not serve (:func:`table_routes`):
+    radii r̄(1 + ρ) with ρ1, ρ2 uniform over the grid's radius axis (all three > 0.2 r̄), gaps
+    uniform over its gap axis, vertices in a random order."""
     rng = np.random.default_rng(seed + 1)
-    before, out, pair = [g1], {}, {(0, 1): 0, (0, 2): 1, (1, 2): 2}
+    out, pair = {}, {(0, 1): 0, (0, 2): 1, (1, 2): 2}
     for name in EXTENSION_GRIDS:
         ext = load_grid_table(grid=name, solver_version=version)
-        if ext is None or g1 is None:
+        if ext is None:
             continue
         rho_max, (g_lo, g_hi) = ext.spec.rho_nodes[-1], ext.spec.gap_nodes[[0, -1]]
-        r, s = np.empty((0, 3)), np.empty((0, 3))
+        r, s, sv = np.empty((0, 3)), np.empty((0, 3)), np.empty(0, dtype=bool)
         while len(r) < n:
             rho = rng.uniform(-rho_max, rho_max, (8 * n, 2))
             rr = np.column_stack([1 + rho, 1 - rho.sum(axis=1)])
@@ -265,21 +265,19 @@ def _extension(n, seed, g1, version):
             cols = [pair[tuple(sorted((p[a], p[b])))] for a, b in ((0, 1), (0, 2), (1, 2))]
             rr, ss = rr[:, p], ss[:, cols]
             ok = throats.validate_throats(rr, ss)[0] & (rr.min(axis=1) > 0.2)
-            for t in before:                       # as the lookup asks them: g1 in given order
-                ok &= np.isinf(t.at_throats(*((rr, ss) if t is g1 else toward_extension(rr, ss)),
-                                            errors=False)[1])
-            r, s = np.vstack([r, rr[ok]]), np.vstack([s, ss[ok]])
-        r, s = r[:n], s[:n]
+            for route, _, rn, sn, served in table_routes(rr[ok], ss[ok], solver_version=version):
+                if route == name:                  # the rows that reach it, as it is asked
+                    r, s, sv = np.vstack([r, rn]), np.vstack([s, sn]), np.append(sv, served)
+        r, s, sv = r[:n], s[:n], sv[:n]
         ref = throats.solve_fem(r, s, rtol=1e-4).qstar
-        q, e = ext.at_throats(*toward_extension(r, s), errors=False)
+        q = ext.at_throats(r, s, errors=False)[0]
         good = np.isfinite(ref) & (ref > 0)
-        served = good & ~np.isinf(e)
+        served = good & sv
         out[name] = {"n": int(good.sum()), "served": int(served.sum()),
                      "table": _pct(np.abs(q[served] / ref[served] - 1)),
                      "shape_factor": _pct(np.abs(throats.shape_factor_qstar(r[served], s[served])
                                                  / ref[served] - 1)),
                      "bytes": shipped_grid_path(name).stat().st_size}
-        before.append(ext)
     return out
 
 

@@ -140,6 +140,25 @@ def test_the_deepest_overlaps_stay_with_the_estimate(tmp_path):
     assert list(res.source) == ["shape-factor"] and res.stats["n_shape_factor_deep"] == 1
 
 
+def test_table_routes_follow_the_lookup():
+    # the rows each shipped table serves, as cache.table_routes tells them, are the lookup's
+    # 'interp' rows (g1's, then the extension grids' counts), the rest its estimate
+    import network
+
+    t = network.tessellate(network.random_packing(300, diameter_range_m=(0.001, 0.006),
+                                                  solid_fraction=0.55, rng=5))
+    r, s = t.throat_radii, t.throat_sides
+    routes = cache.table_routes(r, s)
+    assert [e[0] for e in routes] == ["g1", *EXTENSION_GRIDS]
+    res = lookup_qstar(r, s, policy="table-only")
+    src = np.asarray(res.source)
+    for name, rows, _, _, served in routes:
+        assert res.stats.get(f"n_interp_{name}", int(served.sum())) == int(served.sum())
+    assert np.array_equal(np.sort(routes[-1][1][~routes[-1][4]]),
+                          np.flatnonzero(src != "interp"))
+    assert routes[1][1].size == routes[0][1].size - int(routes[0][4].sum())
+
+
 def test_x1_error_estimate_covers_held_out_windows():
     # x1's safety factor (cache.CALIBRATED_SAFETY, docs/scripts/calibrate_extension.py) was
     # measured on clump beds and 1-6 mm sphere packings of seeds 2 and 3: on seed 4's windows
@@ -149,9 +168,8 @@ def test_x1_error_estimate_covers_held_out_windows():
 
     t = network.tessellate(network.random_packing(400, diameter_range_m=(0.001, 0.006),
                                                   solid_fraction=0.55, rng=4))
-    r, s = t.throat_radii, t.throat_sides
-    outside = np.isinf(cache.load_grid_table(grid="g1").at_throats(r, s, errors=False)[1])
-    rp, sp = toward_extension(r[outside], s[outside])
+    routes = {e[0]: e for e in cache.table_routes(t.throat_radii, t.throat_sides)}
+    _, _, rp, sp, _ = routes["x1"]              # beyond g1, reordered as the lookup asks x1
     x1 = cache.load_grid_table(grid="x1")
     assert x1.safety == cache.CALIBRATED_SAFETY["x1"] < cache.ERROR_SAFETY
     q, est = x1.at_throats(rp, sp, errors=True)

@@ -11,7 +11,7 @@ size where the sub-grid cannot judge). A grid without a measured :math:`c_s` tak
 1. **calibration** on two populations of windows beyond g1: the two bundled clump beds
    (``network/data/soybean_grains.csv``, ``wheat_grains.csv``: every window not inside a
    merged pore body) and a random packing of 400 spheres of 1-6 mm (seed 2). Each window g1
-   does not serve goes, reordered as the lookup does (:func:`cache._orbits.toward_extension`),
+   does not serve goes, reordered as the lookup does (:func:`cache.table_routes`),
    to x1, and what x1 does not serve to d1 (at most ``--max-rows`` per set and grid, a random
    subset); each is solved by FE at rtol 1e-4 and its table error is
    :math:`t = |\ln Q^*_{table} - \ln Q^*_{FE}|`. :math:`c_s` is the smallest factor whose
@@ -38,9 +38,8 @@ import numpy as np
 
 import network
 import throats
-from cache import (ERROR_SAFETY, EXTENSION_GRIDS, GridTable, load_grid_table, read_grid_file,
-                   shipped_grid_path)
-from cache._orbits import toward_extension
+from cache import (ERROR_SAFETY, EXTENSION_GRIDS, GridTable, read_grid_file, shipped_grid_path,
+                   table_routes)
 from fit_deep_overlap import DATA, bed_windows
 
 COVER = 0.95          # share of the errors the estimate must cover (as for g1)
@@ -48,17 +47,10 @@ RTOL = 1e-3           # the policy's default tolerance, for the FE share
 
 
 def served_rows(r, s):
-    """Per extension grid, (radii, sides) of the windows the lookup sends it: outside g1, in
-    the reordered vertex order, not served by the grids before it."""
-    g1 = load_grid_table(grid="g1")
-    out = np.isinf(g1.at_throats(r, s, errors=False)[1])
-    rp, sp = toward_extension(r[out], s[out])
-    rows = {}
-    for name in EXTENSION_GRIDS:
-        ok = ~np.isinf(load_grid_table(grid=name).at_throats(rp, sp, errors=False)[1])
-        rows[name] = (rp[ok], sp[ok])
-        rp, sp = rp[~ok], sp[~ok]
-    return rows
+    """Per extension grid, (radii, sides) of the windows it serves, as the lookup asks it
+    (:func:`cache.table_routes`)."""
+    return {name: (rr[served], ss[served])
+            for name, _, rr, ss, served in table_routes(r, s) if name in EXTENSION_GRIDS}
 
 
 def estimate_parts(name, r, s):
