@@ -111,6 +111,8 @@ def _print_result(res, out):
               f"k = {s['permeability_core_m2']:.4e} m² "
               f"({s['permeability_core_m2'] / s['permeability_m2']:.3f} of the whole sample)",
               file=out)
+    warn_validity(s["reynolds_particle"] if "pressure_drop_stokes_pa" in s else None,
+                  s["pressure_drop_pa"])
     print(f"  at v = {s['velocity_m_s']:g} m/s: gradient {s['pressure_gradient_pa_per_m']:.4g} "
           f"Pa/m, drop over {s['depth_m']:g} m = {s['pressure_drop_pa']:.4g} Pa", file=out)
     if "pressure_drop_stokes_pa" in s:
@@ -240,9 +242,6 @@ def _main(args) -> int:
           f"{args.conductance_model}, policy {args.policy}")
     for res in results:
         _print_result(res, sys.stdout)
-        s = res.summary()
-        warn_validity(s.get("reynolds_particle") if "pressure_drop_stokes_pa" in s else None,
-                      s["pressure_drop_pa"])
     out = combined_summary(results, seconds={"read": t_read, "wall": total}, packing=packing)
     out["packing"] = str(path)
     out["units"] = args.units
