@@ -42,10 +42,10 @@ import json
 import sys
 from pathlib import Path
 
-from .benchmarks import (REF_LATTICE_CASES, REF_RANDOM_POROSITIES, has_grid, inertial_lines,
-                         inertial_speed, inertial_validation, lattice_case, machine, per_packing, baseline_source,
-                         policies, policy_lines, references, references_table, run_one, scaling,
-                         scaling_exponent)
+from .benchmarks import (REF_LATTICE_CASES, REF_RANDOM_POROSITIES, baseline_source, has_grid,
+                         inertial_lines, inertial_speed, inertial_validation, lattice_case,
+                         machine, per_packing, policies, policy_lines, references,
+                         references_table, run_one, scaling, scaling_exponent)
 from .conductance import MODELS, POLICIES
 
 

@@ -86,10 +86,12 @@ class Packing:
         """(2, 3) array: lowest and highest centre coordinate along x, y, z (m)."""
         return np.stack([self.centers.min(axis=0), self.centers.max(axis=0)])
 
-    def extent(self) -> np.ndarray:
-        """(2, 3) array: the bed's bounding box, lowest and highest sphere surface (m)."""
-        return np.stack([(self.centers - self.radii[:, None]).min(axis=0),
-                         (self.centers + self.radii[:, None]).max(axis=0)])
+    def extent(self, members=None) -> np.ndarray:
+        """(2, 3) array: the bed's bounding box, lowest and highest sphere surface (m); of the
+        spheres ``members`` (a bool mask or indices) only, when given."""
+        c, r = ((self.centers, self.radii) if members is None
+                else (self.centers[members], self.radii[members]))
+        return np.stack([(c - r[:, None]).min(axis=0), (c + r[:, None]).max(axis=0)])
 
     @functools.cached_property
     def grain_diameters(self) -> np.ndarray:

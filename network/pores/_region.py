@@ -127,17 +127,14 @@ def default_region(packing, *, margin: float | None = None, cylinder: bool = Fal
     axis : {'x', 'y', 'z'}
         Flow axis (matters for a cylindrical container only).
     """
-    lo, hi = packing.extent()
     bed = bed_members(packing)
+    lo, hi = packing.extent(None if bed.all() else bed)
     if not bed.all():
         apart = np.flatnonzero(~bed)
         log.warning("%d sphere(s) lie apart from the bed, beyond an empty band of %g mean "
                     "diameters (sphere %s): the default sample leaves them out", apart.size,
                     OUTSIDE_BED_DIAMETERS, ", ".join(f"#{i + 1}" for i in apart[:5])
                     + (", ..." if apart.size > 5 else ""))
-        sub = packing.centers[bed], packing.radii[bed]
-        lo = (sub[0] - sub[1][:, None]).min(axis=0)
-        hi = (sub[0] + sub[1][:, None]).max(axis=0)
     m = 1.5 * packing.grain_diameter if margin is None else float(margin)
     if m < 0:
         raise ValueError(f"margin must be >= 0, got {m}")
