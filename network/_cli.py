@@ -123,6 +123,15 @@ def warn_validity(reynolds_particle=None, pressure_drop_pa=None) -> None:
              "density) leaves out")
 
 
+def warn_curve(points, depth_m: float, key: str = "pressure_gradient_pa_per_m") -> None:
+    """:func:`warn_validity` for the converged points of a curve: the largest Re_p, and the
+    largest drop over ``depth_m`` (Pa) = gradient ``key`` (Pa/m) x depth."""
+    ok = [p for p in points if p["converged"]]
+    if ok:
+        warn_validity(max(p["reynolds_particle"] for p in ok),
+                      max(p[key] for p in ok) * depth_m)
+
+
 def progress_log(args, fmt: str = "[%(relativeCreated)7.0f ms] %(message)s") -> None:
     """Stage progress on stderr (INFO log lines) unless ``--quiet``."""
     if not getattr(args, "quiet", False):

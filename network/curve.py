@@ -25,7 +25,7 @@ from ._air import check_positive
 from ._cli import (CliError, CliParser, add_air, add_packing, add_sample, add_table,
                    available_cores, bad_input, check_common, check_outputs, check_plot, computing,
                    finish, load_packing, progress_log, run, sample_box_m,
-                   warn_validity)
+                   warn_curve)
 from .conductance import POLICIES
 from ._grains import GRAIN_ALIASES, d272_constants
 from .flow import (DEFAULT_DEPTH_M, GRAINS, asabe_d272_gradient, ergun_gradient,
@@ -202,9 +202,7 @@ def _main(args) -> int:
               f"{p['newton_iterations']:6d} {p['cg_iterations']:5d}  {p['converged']}")
     for k, v in fits.items():
         print(f"  {k} = {v:.5g}" if isinstance(v, float) else f"  {k} = {v}")
-    if ok:
-        warn_validity(max(p["reynolds_particle"] for p in ok),
-                      max(p["pressure_gradient_pa_per_m"] for p in ok) * args.depth)
+    warn_curve(pts, args.depth)
     total = time.perf_counter() - t0
     print(f"total {total:.2f} s")
     out = {"packing": str(path), "units": args.units, "n_spheres": packing.n, "axis": args.axis,

@@ -21,7 +21,6 @@ Exit 0 done, 1 a solve failed, 2 bad input: one ``error:`` line (docs/cli.md, do
 from __future__ import annotations
 
 import json
-import sys
 import time
 from pathlib import Path
 
@@ -29,11 +28,10 @@ import numpy as np
 
 from ._cli import (CliError, CliParser, add_air, add_sample, available_cores, bad_input,
                    check_common, check_outputs, check_plot, computing, load_packing,
-                   finish, progress_log, run, sample_box_m)
+                   finish, progress_log, run, sample_box_m, warn_curve)
 from ._grains import BED, D272, GRAIN_ALIASES, grains_with_d272
 from ._report_bed import add_bed_options, bed_json, plan_bed, prepare_bed
-from ._report_band import (BAND_OFFSETS, band_gradients, measured_band, pack_band,
-                           slope_at)
+from ._report_band import BAND_OFFSETS, band_gradients, measured_band, pack_band, slope_at
 from ._report_porosity import (bundled_grains, bundled_packing, check_reachable, packing_meta,
                                reachable_range, requested_porosity, shift_factor)
 from ._report_html import write_figures, write_html
@@ -426,6 +424,8 @@ def _main(args) -> int:
     with computing():
         rep = build_report(args, opts, path, packing)
     print_report(rep)
+    warn_curve(rep["points"], args.depth, "pressure_gradient_pa_per_m" if args.axis == "z"
+               else "pressure_gradient_horizontal_pa_per_m")
     with computing():
         if args.json_out:
             with open(args.json_out, "w") as f:

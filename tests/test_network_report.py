@@ -248,3 +248,21 @@ def test_measured_band_is_the_fit_of_the_grain_beds():
         assert b["slope_stderrs"][j] == pytest.approx(np.sqrt(cov[0, 0]), rel=1e-6)
     assert [round(x, 2) for x in b["slopes"]] == [-10.63, -10.12, -8.64]     # session 18 beds
     assert measured_band("soybean") is None and len(data["beds"]) == 8
+
+
+def test_results_outside_the_checked_range_are_warned(tmp_path, capsys, monkeypatch):
+    # 3 m/s through 40 m of soybeans: Re_p 1.2e3 and 8.3e5 Pa, beyond the inertial law's
+    # checked Re_p 200 and the constant-density air; the warnings name the system curve's drop
+    monkeypatch.chdir(tmp_path)
+    out = tmp_path / "r.json"
+    assert main(["--grain", "soybean", "--velocities", "0.01,3", "--depth", "40", "--no-band",
+                 "--no-figures", "--json", str(out), "-q"]) == 0
+    err = capsys.readouterr().err
+    r = json.loads(out.read_text())
+    re_max = max(p["reynolds_particle"] for p in r["points"])
+    drop = max(s["static_pressure_pa"] for s in r["system_curve"])
+    assert f"warning: Re_p {re_max:.3g} is beyond the 200" in err and re_max > 1000
+    assert f"warning: a pressure drop of {drop:.3g} Pa is" in err and drop > 1e5
+    assert main(["--grain", "soybean", "--velocities", "0.01,0.1", "--depth", "3", "--no-band",
+                 "--no-figures", "-q"]) == 0
+    assert "warning" not in capsys.readouterr().err
