@@ -18,10 +18,12 @@ from __future__ import annotations
 import argparse
 import atexit
 import contextlib
+import json
 import logging
 import os
 import re
 import sys
+import tempfile
 import warnings
 from pathlib import Path
 
@@ -256,32 +258,69 @@ def add_air(ap, *, density: bool = True) -> None:
 
 
 # ------------------------------------------------------------------ checks
-def check_outputs(**paths) -> None:
+def check_outputs(*, inputs=(), **paths) -> None:
     """ValueError unless every given output path (``option=path``; None skipped) can be
-    written: its folder exists and is writable, and it is not a folder itself."""
-    for option, p in paths.items():
+    written: its folder exists and takes a new file (tried: a temporary file made and removed,
+    which ``os.access`` cannot tell for root or a read-only mount), it is not a folder, and no
+    two outputs, nor an output and one of ``inputs`` (``(what, path)`` pairs, e.g.
+    :func:`packing_inputs`), name the same file."""
+    check_output_list([("--" + k.replace("_", "-"), p) for k, p in paths.items()], inputs)
+
+
+def check_output_list(pairs, inputs=()) -> None:
+    """:func:`check_outputs` for ``(option, path)`` pairs (an option may come more than once)."""
+    seen = {Path(p).resolve(): what for what, p in inputs if p is not None}
+    for opt, p in pairs:
         if p is None:
             continue
-        opt = "--" + option.replace("_", "-")
         path = Path(p)
         folder = path.parent if str(path.parent) else Path(".")
         if path.is_dir():
             raise ValueError(f"{opt} {p}: is a folder, give a file name")
         if not folder.is_dir():
             raise ValueError(f"{opt} {p}: folder {folder} does not exist")
-        if not os.access(folder, os.W_OK | os.X_OK):
-            raise ValueError(f"{opt} {p}: folder {folder} is not writable")
+        key = path.resolve()
+        if key in seen:
+            raise ValueError(f"{opt} {p}: the same file as {seen[key]}; give another name")
+        seen[key] = f"{opt} {p}"
+        try:
+            tempfile.TemporaryFile(dir=folder, prefix=".grainflow-").close()
+        except OSError as exc:
+            raise ValueError(f"{opt} {p}: folder {folder} is not writable "
+                             f"({exc.strerror or exc})") from None
         if path.exists() and not os.access(path, os.W_OK):
             raise ValueError(f"{opt} {p}: file exists and is not writable")
 
 
-def check_plot(option: str = "--plot") -> None:
-    """ValueError naming the extra to install when matplotlib is missing."""
+def packing_inputs(args) -> list:
+    """``(what, path)`` of the files a network command reads: the packing file (``args.packing``)
+    and its companion JSON when that holds the DEM's container (:func:`read_container`)."""
+    if not args.packing:
+        return []
+    path = Path(args.packing)
+    out = [("the packing file", path)]
+    try:
+        if "container" in json.loads(path.with_suffix(".json").read_text()):
+            out.append(("the packing's companion JSON (its container)", path.with_suffix(".json")))
+    except (OSError, ValueError, TypeError):
+        pass
+    return out
+
+
+def check_plot(option: str = "--plot", path=None) -> None:
+    """ValueError naming the extra to install when matplotlib is missing, or naming the
+    formats matplotlib writes when ``path``'s suffix is not one of them (no suffix: PNG)."""
     try:
         import matplotlib  # noqa: F401 - optional dependency
+        from matplotlib.backend_bases import FigureCanvasBase
     except ImportError as exc:
         raise ValueError(f"{option} needs matplotlib, which is not installed: "
                          "pip install '.[plot]' (or pip install matplotlib)") from exc
+    fmt = Path(path).suffix.lower().lstrip(".") if path else ""
+    known = FigureCanvasBase.get_supported_filetypes()
+    if fmt and fmt not in known:
+        raise ValueError(f"{option} {path}: matplotlib cannot write .{fmt}; use one of "
+                         + ", ".join(f".{k}" for k in sorted(known)))
 
 
 def available_cores() -> int:

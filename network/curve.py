@@ -24,7 +24,7 @@ import numpy as np
 from ._air import check_positive
 from ._cli import (CliError, CliParser, add_air, add_packing, add_sample, add_table,
                    available_cores, bad_input, check_common, check_outputs, check_plot, computing,
-                   finish, load_packing, progress_log, run, sample_box_m,
+                   finish, load_packing, packing_inputs, progress_log, run, sample_box_m,
                    warn_curve)
 from .conductance import POLICIES
 from ._grains import GRAIN_ALIASES, d272_constants
@@ -137,9 +137,10 @@ def plot_curve(path, points, *, grain, porosity, diameter_m, viscosity_pa_s, den
 def _check_options(args) -> list[float]:
     check_common(args)
     d272_constants(args.grain)          # an unknown or unsourced grain: ValueError naming them
-    check_outputs(json=args.json_out, csv=args.csv_out, plot=args.plot)
+    check_outputs(json=args.json_out, csv=args.csv_out, plot=args.plot,
+                  inputs=packing_inputs(args))
     if args.plot:
-        check_plot()
+        check_plot(path=args.plot)
     return parse_velocities(args.velocities)
 
 

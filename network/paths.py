@@ -32,13 +32,12 @@ import dataclasses
 import json
 import os
 import platform
-import sys
 import time
 
 import numpy as np
 
 from ._cli import (CliParser, add_air, add_packing, bad_input, check_outputs,
-                   check_plot, computing, finish, load_packing, run)
+                   check_plot, computing, finish, load_packing, packing_inputs, run)
 from ._air import check_positive
 from .airpaths import (bed_depth, branched_table, face_graph, plot_paths, pore_pressure_array,
                        pressure_along_path, random_entry_points, trace_paths)
@@ -160,9 +159,9 @@ def _check_options(args) -> None:
         raise ValueError(f"--velocity must be > 0 m/s, got {args.velocity}")
     check_positive("--depth", args.depth)
     check_positive("--viscosity", args.viscosity)
-    check_outputs(json=args.json, plot=args.plot)
+    check_outputs(json=args.json, plot=args.plot, inputs=packing_inputs(args))
     if args.plot:
-        check_plot()
+        check_plot(path=args.plot)
 
 
 def _read(args):

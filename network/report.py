@@ -27,8 +27,8 @@ from pathlib import Path
 import numpy as np
 
 from ._cli import (CliError, CliParser, add_air, add_sample, available_cores, bad_input,
-                   check_common, check_outputs, check_plot, computing, load_packing,
-                   finish, progress_log, run, sample_box_m, warn_curve)
+                   check_common, check_outputs, check_plot, computing, finish, load_packing,
+                   packing_inputs, progress_log, run, sample_box_m, warn_curve)
 from ._grains import BED, D272, GRAIN_ALIASES, grains_with_d272
 from ._report_bed import add_bed_options, bed_json, plan_bed, prepare_bed
 from ._report_band import BAND_OFFSETS, band_gradients, measured_band, pack_band, slope_at
@@ -171,7 +171,7 @@ def _check(args) -> dict:
         if args.diameter is None and args.floor_area is None:
             raise ValueError("--fan needs the bin: --diameter (round) or --floor-area")
         fan = read_fan(args.fan)
-    check_outputs(json=args.json_out, html=args.html)
+    check_outputs(json=args.json_out, html=args.html, inputs=packing_inputs(args))
     if args.plot_dir is not None and not Path(args.plot_dir).is_dir():
         raise ValueError(f"--plot-dir {args.plot_dir}: not an existing folder")
     if args.html or args.plot_dir:

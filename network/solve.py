@@ -23,8 +23,9 @@ from pathlib import Path
 import numpy as np
 
 from ._cli import (CliError, CliParser, add_air, add_packing, add_sample, add_table,
-                   available_cores, bad_input, check_common, check_outputs, computing,
-                   finish, load_packing, progress_log, run, sample_box_m, warn_validity)
+                   available_cores, bad_input, check_common, check_output_list, computing,
+                   finish, load_packing, packing_inputs, progress_log, run, sample_box_m,
+                   warn_validity)
 from .conductance import MODELS, POLICIES, throat_qstar
 from .flow import (DEFAULT_DEPTH_M, DEFAULT_VELOCITY_M_S, combined_summary, solve_axes,
                    write_network_vtu)
@@ -142,14 +143,15 @@ def _check_inputs(args, axes) -> None:
         raise ValueError(f"--vtk {args.vtk}: the writer makes VTK XML (.vtu, read by ParaView "
                          f"and meshio), not legacy VTK; name the file "
                          f"{Path(args.vtk).with_suffix('.vtu')}")
-    multi = len(axes) > 1
+    multi, pairs = len(axes) > 1, [("--json", args.json_out)]
     for ax in axes:
         vtu = args.vtk and _per_axis(args.vtk, ax, multi, ".vtu")
-        check_outputs(json=args.json_out, vtk=vtu,
-                      vtk_spheres=vtu and vtu.with_name(f"{vtu.stem}_spheres.vtu"),
-                      pores_csv=args.pores_csv and _per_axis(args.pores_csv, ax, multi, ".csv"),
-                      throats_csv=args.throats_csv
-                      and _per_axis(args.throats_csv, ax, multi, ".csv"))
+        pairs += [("--vtk", vtu),
+                  ("--vtk (spheres)", vtu and vtu.with_name(f"{vtu.stem}_spheres.vtu")),
+                  ("--pores-csv", args.pores_csv and _per_axis(args.pores_csv, ax, multi, ".csv")),
+                  ("--throats-csv",
+                   args.throats_csv and _per_axis(args.throats_csv, ax, multi, ".csv"))]
+    check_output_list(pairs, packing_inputs(args))
 
 
 def _pore_volume(res, tess):

@@ -27,7 +27,8 @@ import time
 import numpy as np
 
 from ._cli import (CliParser, add_packing, add_sample, bad_input, check_common, check_outputs,
-                   computing, load_packing, progress_log, run, sample_box_m)
+                   computing, load_packing, packing_inputs, progress_log, run,
+                   sample_box_m)
 from .packing import read_container
 from .pores import sample_region, select_sample, tessellate, tie_groups
 
@@ -63,7 +64,7 @@ def _main(args) -> int:
     t0 = time.perf_counter()
     with bad_input():
         check_common(args)
-        check_outputs(out=args.out)
+        check_outputs(out=args.out, inputs=packing_inputs(args))
         path, packing = load_packing(args)
         box, margin = sample_box_m(args)
         region = None if args.everything else sample_region(

@@ -92,6 +92,39 @@ def test_unwritable_folder_is_refused(tmp_path):
     finally:
         ro.chmod(0o700)
     _cli.check_outputs(json=tmp_path / "o.json", plot=None)      # fine
+    if os.path.isdir("/proc"):          # os.access says yes to root there; the probe file fails
+        with pytest.raises(ValueError, match="--json /proc/o.json: folder /proc is not writable"):
+            _cli.check_outputs(json="/proc/o.json")
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["ro"]   # the probe leaves nothing
+
+
+def test_outputs_may_not_overwrite_the_inputs_or_each_other(tmp_path, capsys, monkeypatch):
+    monkeypatch.chdir(tmp_path)
+    bed = tmp_path / "bed.csv"
+    bed.write_bytes(default_packing_path().read_bytes())
+    companion = '{"container": {"kind": "box", "size_m": [1, 1]}}'
+    (tmp_path / "bed.json").write_text(companion)
+    cases = [
+        (solve, ["--json", "bed.csv"], "--json bed.csv: the same file as the packing file"),
+        (solve, ["--json", "bed.json"], "--json bed.json: the same file as the packing's "
+                                        "companion JSON (its container)"),
+        (solve, ["--pores-csv", "p.csv", "--throats-csv", "./p.csv"],
+         "--throats-csv p.csv: the same file as --pores-csv p.csv"),
+        (solve, ["--axis", "all", "--pores-csv", "p.csv", "--json", "p_x.csv"],
+         "--pores-csv p_x.csv: the same file as --json p_x.csv"),
+        (curve, ["--csv", "c.csv", "--json", "c.csv"], "--csv c.csv: the same file as --json"),
+        (curve, ["--json", "c.json", "--plot", "c.txt"], "--plot c.txt: matplotlib cannot "
+                                                        "write .txt; use one of"),
+        (throats, ["--out", "bed.csv"], "--out bed.csv: the same file as the packing file"),
+        (paths, ["--json", "j.json", "--plot", "j.json"], "--plot j.json: the same file as"),
+    ]
+    for mod, argv, words in cases:
+        assert mod.main(["bed.csv"] + argv) == 2, argv
+        out, err = capsys.readouterr()
+        assert out == "" and err.count("\n") == 1 and words in err, (argv, err)
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["bed.csv", "bed.json"]
+    assert bed.read_bytes() == default_packing_path().read_bytes()
+    assert (tmp_path / "bed.json").read_text() == companion
 
 
 @pytest.mark.parametrize("argv, words", [
