@@ -1,7 +1,8 @@
 r"""One point of :class:`cache.GridTable`'s interpolation as a numba function, for compiled callers.
 
 :func:`interp_point` evaluates :math:`\ln Q^*` at one throat exactly as
-``GridTable.at_throats(..., errors=False)`` does for a chunk of throats (same coordinates,
+``GridTable.at_throats(..., errors=False)`` does for a chunk of throats (the same lookup order,
+:mod:`cache._order`, and coordinates,
 same cell, the 32 corners blended in float32 in the same order, the same curvature
 terms): the values agree bit for bit (``tests/test_cache_kernel.py``). A compiled loop
 (the network's conduit sections, :mod:`network.conductance._conduit_kernel`) calls it per
@@ -32,7 +33,8 @@ def point_kernel():
 
                 inline = numba.njit(inline="always", error_model="numpy")
                 g = globals()
-                for name in ("_gap_cell", "_rho_cell", "_lerp", "_square", "_cube"):
+                for name in ("_lookup_order", "_side", "_gap_cell", "_rho_cell", "_lerp",
+                             "_square", "_cube"):
                     g[name] = inline(g[name])
                 _COMPILED.append(numba.njit(cache=True, nogil=True,
                                             error_model="numpy")(interp_point))
@@ -49,6 +51,7 @@ def interp_point(r0, r1, r2, s0, s1, s2, gap, rho_lo, rho_hi, rho_inv, n_rho, st
     outside the box or in a cell the table does not serve. Arguments:
     :meth:`GridTable.kernel_arrays`.
     """
+    r0, r1, r2, s0, s1, s2 = _lookup_order(r0, r1, r2, s0, s1, s2)
     inv = 1.0 / ((r0 + r1 + r2) * (1.0 / 3.0))
     i0, t0, o0 = _gap_cell((s0 - r0 - r1) * inv, gap, snap)
     i1, t1, o1 = _gap_cell((s1 - r0 - r2) * inv, gap, snap)
@@ -71,6 +74,30 @@ def interp_point(r0, r1, r2, s0, s1, s2, gap, rho_lo, rho_hi, rho_inv, n_rho, st
     v -= np.float64(t3 * (one - t3) * kk[3])
     v -= np.float64(t4 * (one - t4) * kk[4])
     return v, kk[5] > 0 and not outside
+
+
+def _lookup_order(r0, r1, r2, s0, s1, s2):
+    """One throat in :func:`cache._order.lookup_order`'s order: a stable sort of the vertices
+    by (radius, opposite side), then the vertex of largest |rho| third."""
+    a, b, c = 0, 1, 2
+    r = (r0, r1, r2)
+    opp = (s2, s1, s0)
+    if r[b] < r[a] or (r[b] == r[a] and opp[b] < opp[a]):
+        a, b = b, a
+    if r[c] < r[b] or (r[c] == r[b] and opp[c] < opp[b]):
+        b, c = c, b
+        if r[b] < r[a] or (r[b] == r[a] and opp[b] < opp[a]):
+            a, b = b, a
+    if 2.0 * r[b] > r[a] + r[c]:
+        a, b, c = b, c, a
+    return (r[a], r[b], r[c], _side(a, b, s0, s1, s2), _side(a, c, s0, s1, s2),
+            _side(b, c, s0, s1, s2))
+
+
+def _side(i, j, s0, s1, s2):
+    """l_ij of vertices i != j (0-based) from ``[l12, l13, l23]``."""
+    k = i + j                 # 1: pair (0, 1), 2: (0, 2), 3: (1, 2)
+    return s0 if k == 1 else (s1 if k == 2 else s2)
 
 
 def _gap_cell(x, gap, snap):

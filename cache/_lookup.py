@@ -38,7 +38,7 @@ from . import _build
 from ._build import precompute_throats, resolve_solver
 from ._derived import derived_path, load_derived, save_derived
 from ._interp import GridSpec, GridTable
-from ._orbits import DEFAULT_GRID, EXTENSION_GRIDS, compact, expand, toward_extension
+from ._orbits import DEFAULT_GRID, EXTENSION_GRIDS, compact, expand
 from ._signature import as_throats, match_keys, shape_keys, signature
 from ._store import open_store
 
@@ -350,10 +350,10 @@ def lookup_qstar(radii, sides, *, db=None, policy="table+fe", rtol=1e-3, workers
 
 
 def _extension_rows(r, s, rows, q, err, src, stats, *, policy, rtol, errors, version):
-    """Interpolate ``rows`` the grid table does not serve in the extension grids in turn, each
-    reordered to put its vertex of largest radius deviation third (in place); the rest back."""
+    """Interpolate ``rows`` the grid table does not serve in the extension grids in turn (in
+    place); the rest back."""
     todo = rows[np.isinf(err[rows])]       # table+fe: rows the grid serves too roughly go to FE
-    done, (rp, sp) = [], toward_extension(r[todo], s[todo])    # one order for every grid
+    done, rp, sp = [], r[todo], s[todo]
     for name in EXTENSION_GRIDS:
         ext = _shipped_table(name, version)
         if ext is None or not len(todo):

@@ -10,9 +10,8 @@ sixth of the nodes), :func:`expand` rebuilds the whole grid from them, bit for b
 
 The extension grids serve, in turn, rows the shipped g1 does not: ``x1`` (g1's nodes, radius
 deviations to ±0.375, gaps to 4.6), then ``d1`` (gaps from -2.2, the deep overlaps of two
-spheres of one grain, deviations to ±0.5, step 0.2); :func:`toward_extension` reorders each
-throat so that its vertex of largest |ρ| comes third, where a box reaches twice as far
-(``docs/cache-table.md``).
+spheres of one grain, deviations to ±0.5, step 0.2); every grid reads a throat with its vertex of
+largest |ρ| third, where a box reaches twice as far (:mod:`cache._order`, ``docs/cache-table.md``).
 """
 
 from __future__ import annotations
@@ -22,7 +21,7 @@ import numpy as np
 from ._interp import GRIDS
 
 __all__ = ["DEFAULT_GRID", "EXTENSION_GRIDS", "compact", "expand", "orbit_representatives",
-           "table_coverage", "toward_extension"]
+           "table_coverage"]
 
 #: grid served when a table has none of its own (shipped in ``cache/data``)
 DEFAULT_GRID = "g1"
@@ -35,7 +34,7 @@ def table_coverage() -> str:
     """The shapes the shipped tables serve, in words: for :data:`DEFAULT_GRID`, then each of
     :data:`EXTENSION_GRIDS` in the order the lookup asks them, its gap range and the largest
     deviation of the two first radii, in mean radii r̄ (the third radius, the largest |ρ| for
-    the extension grids, reaches twice as far: :func:`toward_extension`)."""
+    lookup order, reaches twice as far: :mod:`cache._order`)."""
     parts = []
     for name in (DEFAULT_GRID,) + EXTENSION_GRIDS:
         g = GRIDS[name]
@@ -94,18 +93,3 @@ def expand(spec, *values):
             raise ValueError(f"grid {spec.name!r} has {int(own.sum())} orbits, got {v.shape}")
         out.append(v[pick].reshape(spec.shape))
     return out
-
-
-def toward_extension(radii, sides):
-    """Throats (N, 3) reordered so that the vertex with the largest |r_i - r̄| is the third:
-    radii ``[r1, r2, r3]`` and sides ``[l12, l13, l23]`` of the same shape (N, 3)."""
-    r = np.asarray(radii, dtype=float)
-    s = np.asarray(sides, dtype=float)
-    dev = np.abs(r - r.mean(axis=1, keepdims=True))
-    m = np.argmax(dev, axis=1)
-    # vertex 1 to the end: order (2, 3, 1), sides (l23, l12, l13); vertex 2: order (1, 3, 2),
-    # sides (l13, l12, l23); vertex 3 stays
-    r_order = np.array([[1, 2, 0], [0, 2, 1], [0, 1, 2]])[m]
-    s_order = np.array([[2, 0, 1], [1, 0, 2], [0, 1, 2]])[m]
-    rows = np.arange(len(r))[:, None]
-    return r[rows, r_order], s[rows, s_order]

@@ -94,3 +94,16 @@ def test_threshold_and_stored_rows(tess, tmp_path, monkeypatch):
     monkeypatch.setattr(conduit, "KERNEL_MIN_THROATS", 0)
     res = conduit_conductance(tess, policy="table-only", db=stored)
     assert res.stats["qstar_stats"].get("backend") != "conduit kernel"
+
+
+def test_compiled_cache_follows_the_table_kernel_source():
+    # numba caches conduit_rows by its own file's time stamp: the digest of the file whose
+    # functions it inlines lives in that file, so editing one without the other fails here
+    import hashlib
+    from pathlib import Path
+
+    import cache
+    from network.conductance import _conduit_kernel
+
+    src = (Path(cache.__file__).parent / "_kernel.py").read_bytes()
+    assert hashlib.sha256(src).hexdigest()[:16] == _conduit_kernel.INTERP_SOURCE_SHA256
