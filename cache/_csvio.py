@@ -16,7 +16,8 @@ def read_throat_csv(path, parse_errors=None):
     """Read a throat CSV: ``(header list, rows list of lists, radii (N,3), sides (N,3))``.
 
     Cells that do not parse as numbers become NaN (the row is then reported as invalid); with
-    a dict ``parse_errors``, row index -> "cannot parse l12='abc'" is filled in.
+    a dict ``parse_errors``, row index -> "cannot parse l12='abc'" (or, for a row too short to
+    hold a shape column, "the row has 5 of 6 values") is filled in.
     """
     with open(path, newline="") as fh:
         reader = csv.reader(fh)
@@ -36,8 +37,9 @@ def read_throat_csv(path, parse_errors=None):
                 vals[i, j] = float(row[c])
             except (ValueError, IndexError):
                 if parse_errors is not None and i not in parse_errors:
-                    cell = row[c] if c < len(row) else ""
-                    parse_errors[i] = f"cannot parse {SHAPE_COLUMNS[j]}={cell!r}"
+                    parse_errors[i] = (f"cannot parse {SHAPE_COLUMNS[j]}={row[c]!r}"
+                                       if c < len(row) else
+                                       f"the row has {len(row)} of {len(header)} values")
     return header, rows, vals[:, :3], vals[:, 3:]
 
 

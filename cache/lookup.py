@@ -14,7 +14,7 @@ of ``python -m throats.solve --csv``, with the same meanings) and ``source, mess
 * ``source``: exact (stored FE value), interp (grid table), fe, shape-factor, closed, failed.
 
 Default policy ``table+fe``; ``table-only`` and ``table+fe`` use values already stored in
-``--db`` before interpolating.  Invalid rows are reported on stderr as ``FILE row N: ...``
+``--db`` before interpolating.  Invalid rows are reported on stderr as ``error: FILE row N: ...``
 (header = row 1, as a spreadsheet counts) and written with empty values.  Exit status: 0 every
 row answered, 1 some row not (or Ctrl-C: no output written), 2 bad options or files (one
 ``error:`` line, checked before anything is computed or written).
@@ -43,7 +43,8 @@ def build_parser():
     p.add_argument("--db", default=None, metavar="DB.sqlite",
                    help="throat table, SQLite: stored values are used first, FE results are "
                         "stored in it (default: cache.default_db_path(), $GRAINFLOW_CACHE_DB or "
-                        "~/.cache/grainflow/throats.sqlite)")
+                        "~/.cache/grainflow/throats.sqlite); a file given here is created if "
+                        "missing, its folder must exist")
     p.add_argument("--csv", required=True, metavar="IN.csv",
                    help="input, columns r1,r2,r3,l12,l13,l23 in any one length unit (other "
                         "columns are copied; required)")
@@ -88,8 +89,8 @@ def _main(argv):
         if args.workers < 1:
             raise ValueError(f"--workers must be >= 1, got {args.workers}")
         check_output(args.out)
-        if args.db is not None and os.path.isdir(args.db):
-            raise ValueError(f"--db {args.db} is a folder, not a file")
+        if args.db is not None and not os.path.isfile(args.db):
+            check_output(args.db, "--db")      # to be created: its folder must exist, writable
         header, rows, radii, sides = read_throat_csv(args.csv, errors)
         res = lookup_qstar(radii, sides, db=args.db, policy=args.policy, rtol=args.rtol,
                            workers=args.workers, progress=not args.quiet, grid=args.grid)
@@ -104,7 +105,7 @@ def _main(argv):
         area[ok] = throats.open_area(radii[ok], sides[ok])        # input units squared
         ctype[ok] = throats.contact_type(radii[ok], sides[ok])
     for line in row_problems(args.csv, ok, res.message, errors):
-        print(line, file=sys.stderr)
+        print(f"error: {line}", file=sys.stderr)
     write_csv(args.out, header, rows, {"qstar": res.qstar, "open_area": area,
                                       "contact_type": ctype, "error_estimate": res.error_estimate,
                                       "source": res.source, "message": res.message})

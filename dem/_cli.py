@@ -10,15 +10,19 @@ of failures to exit codes, the project's convention: 2 for bad input (``ValueErr
 
 from __future__ import annotations
 
+import math
+import os
 import sys
+import tempfile
 import time
+from pathlib import Path
 
 from ._container import SCENES, Container
 from ._integrate import DemInstabilityError
 from ._perf import tune_malloc
 
 __all__ = ["EXIT_BAD_INPUT", "EXIT_FAILED", "EXIT_UNSTABLE", "run_main", "progress_printer",
-           "resolve_container"]
+           "resolve_container", "check_output", "check_seed"]
 
 EXIT_BAD_INPUT = 2
 #: A computation that failed: unstable, not converged, interrupted (the same code as network's).
@@ -77,9 +81,41 @@ def resolve_container(scene, *, size_m=None, height_m=None, summary=None):
     if scene in ("box", "cylinder"):
         if size_m is None or height_m is None:
             raise ValueError(f"--scene {scene} needs --size and --height")
+        for opt, vals in (("--size", list(size_m)), ("--height", [height_m])):
+            if not all(math.isfinite(v) and v > 0 for v in vals):
+                raise ValueError(f"{opt} {' '.join(f'{v:g}' for v in vals)}: lengths must be "
+                                 "finite and > 0 (m)")
         return Container(scene, tuple(size_m), height_m)
     if scene is not None:
         raise ValueError(f"unknown scene {scene!r}; choose from {sorted(SCENES)} or 'box'/'cylinder'")
     if summary and "container" in summary:
         return Container.from_dict(summary["container"])
     raise ValueError("no container: give --scene or keep the packing's JSON summary beside it")
+
+
+def check_output(path, option="--out") -> None:
+    """ValueError naming ``option`` when the file ``path`` cannot be written: it is a folder,
+    an existing file not writable, or its folder (the nearest existing one: missing folders
+    are created when written) takes no new file, probed by making and removing a temporary
+    file there (``os.access`` says yes to root, even on ``/proc``)."""
+    path = Path(path)
+    if path.is_dir():
+        raise ValueError(f"{option} {path}: is a folder, give a file name")
+    folder = path.parent
+    while not folder.is_dir():
+        if folder.exists() or folder == folder.parent:
+            raise ValueError(f"{option} {path}: {folder} is not a folder")
+        folder = folder.parent
+    try:
+        tempfile.TemporaryFile(dir=folder, prefix=".grainflow-").close()
+    except OSError as exc:
+        raise ValueError(f"{option} {path}: folder {folder} is not writable "
+                         f"({exc.strerror or exc})") from None
+    if path.exists() and not os.access(path, os.W_OK):
+        raise ValueError(f"{option} {path}: file exists and is not writable")
+
+
+def check_seed(seed, option="--seed") -> None:
+    """ValueError naming ``option`` unless ``seed`` is a non-negative integer (numpy's rule)."""
+    if seed is not None and seed < 0:
+        raise ValueError(f"{option} must be a non-negative integer, got {seed}")

@@ -35,7 +35,7 @@ import numpy as np
 from scipy.spatial import cKDTree
 from scipy.stats import qmc
 
-from ._fill import generate_spheres
+from ._fill import check_sphere_count, generate_spheres
 from ._io import summary_path
 from ._material import SOYBEAN
 from ._rigid import random_quaternions
@@ -46,6 +46,11 @@ __all__ = ["pack_grains", "pack_grains_to_porosity", "procedure_lever", "write_g
 
 #: deposition friction searched by :func:`pack_grains_to_porosity`: frictionless (densest) to 1.0
 DEPOSITION_FRICTION_RANGE = (0.0, 1.0)
+
+#: porosities the grain count N = (1-φ)V/V_g of a porosity search is taken from: a target
+#: outside is counted at the nearest end (0.2 overfills the bin: the closed-box end blows up;
+#: 0.9 leaves a bed too thin for network's region), its reachable range measured and refused
+COUNT_POROSITY_RANGE = (0.35, 0.5)
 
 #: grain sizes: the coefficient of variation is below this; normal deviates cut at SIZE_CUT sigma
 SIZE_CV_MAX = 0.3
@@ -121,6 +126,7 @@ def pack_grains(container, template, *, material=SOYBEAN, porosity=0.408, n_grai
     n = int((1 - porosity) * container.volume_m3 / v_mean) if n_grains is None else int(n_grains)
     if n < 1:
         raise ValueError(f"no grain of {v_mean:.3g} m^3 fits the container")
+    check_sphere_count(n * template.n, f"spheres ({n:,} grains of {template.n})")
     lid = container.fill_height_m * (1 + lid_headroom)
     gen_box = replace(container, fill_height_m=lid)
     f_max = 1 + SIZE_CUT * size_cv
@@ -203,9 +209,11 @@ def pack_grains_to_porosity(container, template, *, porosity, porosity_tol=0.005
     ``porosity_tol`` of ``porosity``, reached by the packing procedure's lever λ (:func:`procedure_lever`).
 
     The two ends λ = -1 and +1 are packed first (same seed, same grain count
-    :math:`N = \lfloor(1-φ)V/V_g\rfloor` from the requested φ): they bound the porosities this
-    procedure reaches. A request more than ``porosity_tol`` outside them is a ValueError naming the
-    reachable range. Inside, regula falsi on φ(λ) (monotone up to the packing noise) packs until
+    :math:`N = \lfloor(1-φ)V/V_g\rfloor` from the requested φ, clipped to
+    :data:`COUNT_POROSITY_RANGE`): they bound the porosities this procedure reaches. A request
+    more than ``porosity_tol`` outside them is a ValueError naming the reachable range (also
+    when an end leaves network's region empty: a bed too thin). Inside, regula falsi on φ(λ)
+    (monotone up to the packing noise) packs until
     a bed lands within ``porosity_tol`` or ``max_packings`` beds are spent (then RuntimeError with the
     closest). ``on_packing(dict)`` is called after each packing with its λ, headroom, friction,
     porosity and wall time. ``workers=2`` packs the two ends in two processes (the same beds:
@@ -221,11 +229,12 @@ def pack_grains_to_porosity(container, template, *, porosity, porosity_tol=0.005
     if int(max_packings) < 2:
         raise ValueError(f"the search packs its two ends at least: max packings >= 2, got {max_packings!r}")
     tried, best = [], None
+    count_phi = float(np.clip(porosity, *COUNT_POROSITY_RANGE))   # sets N only
 
     def pack(lam, out=None):
         head, mu = procedure_lever(lam)
         if out is None:
-            out = pack_grains(container, template, porosity=porosity, deposition_friction=mu,
+            out = pack_grains(container, template, porosity=count_phi, deposition_friction=mu,
                               lid_headroom=head, **kwargs)
         e = out[4]["porosity_network_region"]
         tried.append({"lever": float(lam), "lid_headroom": head, "deposition_friction": mu,
@@ -239,12 +248,17 @@ def pack_grains_to_porosity(container, template, *, porosity, porosity_tol=0.005
     if workers > 1:
         with ProcessPoolExecutor(2) as ex:
             kw = {**kwargs, "progress": None}
-            jobs = [ex.submit(pack_grains, container, template, porosity=porosity,
+            jobs = [ex.submit(pack_grains, container, template, porosity=count_phi,
                               deposition_friction=procedure_lever(lam)[1],
                               lid_headroom=procedure_lever(lam)[0], **kw) for lam in (-1.0, 1.0)]
             (lo, e_lo), (hi, e_hi) = pack(-1.0, jobs[0].result()), pack(1.0, jobs[1].result())
     else:
         (lo, e_lo), (hi, e_hi) = pack(-1.0), pack(1.0)
+    if not (np.isfinite(e_lo) and np.isfinite(e_hi)):
+        raise ValueError(f"network's sample region (1.5 grain diameters inside the bed on every "
+                         f"side) is empty in the {template.name} beds this container holds "
+                         f"(porosity {e_lo:.4f} at lever -1, {e_hi:.4f} at +1): give a larger "
+                         "container or more grains")
     reach = (min(e_lo, e_hi), max(e_lo, e_hi))
     if not (reach[0] - tol <= porosity <= reach[1] + tol):
         raise ValueError(f"porosity {porosity:g} is outside what this procedure reaches for "
@@ -293,16 +307,21 @@ def write_grain_packing(path, centers, radii, grain_id, grains, summary=None):
     path.parent.mkdir(parents=True, exist_ok=True)
     tmp = path.with_name(path.name + ".tmp")
     data = np.column_stack([centers, radii, grain_id])
-    np.savetxt(tmp, data, delimiter=",", header="x,y,z,r,grain_id", comments="",
-               fmt=["%.9e"] * 4 + ["%d"])
-    os.replace(tmp, path)
     gp = grains_path(path)
+    gtmp = gp.with_name(gp.name + ".tmp")
     rows = ["id,x,y,z,qw,qx,qy,qz,template,volume_m3"]
     for k, (c, q, v, t) in enumerate(zip(grains["centers"], grains["quaternions"], grains["volume_m3"],
                                          grains["template"])):
         rows.append(",".join([str(k)] + [f"{a:.9e}" for a in (*c, *q)] + [t, f"{v:.9e}"]))
-    gp.with_name(gp.name + ".tmp").write_text("\n".join(rows) + "\n")
-    os.replace(gp.with_name(gp.name + ".tmp"), gp)
+    try:                                   # renamed when whole; no .tmp left on a failure
+        np.savetxt(tmp, data, delimiter=",", header="x,y,z,r,grain_id", comments="",
+                   fmt=["%.9e"] * 4 + ["%d"])
+        os.replace(tmp, path)
+        gtmp.write_text("\n".join(rows) + "\n")
+        os.replace(gtmp, gp)
+    finally:
+        tmp.unlink(missing_ok=True)
+        gtmp.unlink(missing_ok=True)
     if summary is not None:
         jp = summary_path(path)
         jp.write_text(json.dumps(summary, indent=1, default=lambda o: o.item() if hasattr(o, "item") else str(o)))

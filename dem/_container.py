@@ -47,8 +47,10 @@ class Container:
         need = 2 if self.kind == "box" else 1
         if len(self.size_m) != need:
             raise ValueError(f"{self.kind} needs {need} size value(s), got {self.size_m}")
-        if not all(s > 0 for s in self.size_m) or not self.fill_height_m > 0:
-            raise ValueError(f"container dimensions must be positive, got {self.size_m}, {self.fill_height_m}")
+        dims = (*self.size_m, self.fill_height_m)
+        if not all(np.isfinite(d) and d > 0 for d in dims):
+            raise ValueError(f"container dimensions must be finite and positive, got "
+                             f"{tuple(float(d) for d in self.size_m)}, {float(self.fill_height_m)}")
 
     @property
     def area_m2(self):

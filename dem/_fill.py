@@ -2,6 +2,7 @@ r"""Filling a container: the thesis's sphere count and random sequential additio
 
 * :func:`thesis_particle_count`: N from the target porosity (thesis Eq. 3.10).
 * :func:`check_fill`: refuses porosities no sphere packing reaches and bins smaller than a grain.
+* :func:`check_sphere_count`: refuses a bed of more than :data:`MAX_SPHERES` spheres.
 * :func:`generate_spheres`: N non-overlapping spheres at random (PFC3D ``generate``).
 """
 
@@ -12,10 +13,26 @@ from scipy.spatial import cKDTree
 
 from ._material import SOYBEAN
 
-__all__ = ["KEPLER_POROSITY", "thesis_particle_count", "check_fill", "generate_spheres"]
+__all__ = ["KEPLER_POROSITY", "MAX_SPHERES", "thesis_particle_count", "check_fill",
+           "check_sphere_count", "generate_spheres"]
 
 #: Densest packing of equal spheres (Kepler), porosity 1 − π/√18.
 KEPLER_POROSITY = 1.0 - np.pi / np.sqrt(18.0)
+
+
+#: Most spheres in one bed: the thesis's cyl-bin holds 18 188; a million spheres already need
+#: ~10^11 particle-steps to settle (hours to days at the ~10^7 particle-steps/s of one core) and
+#: GBs of neighbour lists, and a request far beyond (a 1 m bin: 4 million; 100 m: 8e12, 60 TiB
+#: for its radii alone) only fails late.
+MAX_SPHERES = 1_000_000
+
+
+def check_sphere_count(n, what="spheres"):
+    """ValueError when a bed of ``n`` spheres exceeds :data:`MAX_SPHERES` (the message names
+    both and what they count)."""
+    if n > MAX_SPHERES:
+        raise ValueError(f"the container needs {n:,} {what}, more than the limit of "
+                         f"{MAX_SPHERES:,} spheres per bed: make it smaller")
 
 
 def thesis_particle_count(container, porosity, material=SOYBEAN):

@@ -22,7 +22,7 @@ def write_packing(path, centers, radii, summary=None):
     """Write ``x,y,z,r`` rows (m, 9 significant digits) and, if given, the JSON summary.
 
     Files are written to a temporary name first and renamed, so a crash never leaves a
-    half-written packing.
+    half-written packing; the temporary file is removed when writing or renaming fails.
     """
     centers = np.asarray(centers, dtype=float)
     radii = np.asarray(radii, dtype=float)
@@ -33,8 +33,12 @@ def write_packing(path, centers, radii, summary=None):
     path = Path(path)
     path.parent.mkdir(parents=True, exist_ok=True)
     tmp = path.with_name(path.name + ".tmp")
-    np.savetxt(tmp, np.column_stack([centers, radii]), delimiter=",", header="x,y,z,r", comments="", fmt="%.9e")
-    os.replace(tmp, path)
+    try:
+        np.savetxt(tmp, np.column_stack([centers, radii]), delimiter=",", header="x,y,z,r",
+                   comments="", fmt="%.9e")
+        os.replace(tmp, path)
+    finally:                                   # a failed write leaves no .tmp behind
+        tmp.unlink(missing_ok=True)
     if summary is not None:
         write_summary(path, summary)
 
@@ -43,8 +47,11 @@ def write_summary(csv_path, summary):
     """Write (replace) the JSON summary beside a packing CSV, atomically."""
     jp = summary_path(csv_path)
     tmpj = jp.with_name(jp.name + ".tmp")
-    tmpj.write_text(json.dumps(summary, indent=1, default=_json_default))
-    os.replace(tmpj, jp)
+    try:
+        tmpj.write_text(json.dumps(summary, indent=1, default=_json_default))
+        os.replace(tmpj, jp)
+    finally:
+        tmpj.unlink(missing_ok=True)
 
 
 #: Header names of the radius column (``diameter`` names are halved), as network's reader.
@@ -173,7 +180,8 @@ def _validate(path, centers, radii, grain, rows):
                          f"{centers[i].tolist() + [float(radii[i])]}")
     bad = np.flatnonzero(radii <= 0)
     if bad.size:
-        raise ValueError(f"{path}: row {rows[bad[0]]}: radius must be > 0, got {radii[bad[0]]!r}")
+        raise ValueError(f"{path}: row {rows[bad[0]]}: radius must be > 0, "
+                         f"got {float(radii[bad[0]])}")
     order = np.lexsort(centers.T[::-1])
     dup = np.flatnonzero(np.all(centers[order][1:] == centers[order][:-1], axis=1))
     if dup.size:

@@ -26,7 +26,7 @@ from dataclasses import dataclass, field, replace
 import numpy as np
 
 from ._container import Container, make_simulation
-from ._fill import check_fill, generate_spheres, thesis_particle_count
+from ._fill import check_fill, check_sphere_count, generate_spheres, thesis_particle_count
 from ._material import SOYBEAN
 from ._measure import sphere_volume
 from ._summary import interior_porosity, overlap_fractions, summarize
@@ -119,6 +119,7 @@ def pack_bed(container, *, material=SOYBEAN, porosity=0.408, n_particles=None, r
     n = thesis_particle_count(container, porosity, material) if n_particles is None else int(n_particles)
     if n < 1:
         raise ValueError(f"no sphere fits: n_particles = {n}")
+    check_sphere_count(n, "spheres (thesis Eq. 3.10)" if n_particles is None else "spheres")
     if procedure not in PROCEDURES:
         raise ValueError(f"procedure must be one of {PROCEDURES}, got {procedure!r}")
     if procedure == "sediment" and not (lid_headroom > 0 and sediment_steps >= 0 and tap_duration_s >= 0

@@ -23,10 +23,12 @@ from __future__ import annotations
 import argparse
 import sys
 from dataclasses import replace
+from pathlib import Path
 
 import numpy as np
 
-from ._cli import EXIT_FAILED, progress_printer, resolve_container, run_main
+from ._cli import (EXIT_FAILED, check_output, check_seed, progress_printer, resolve_container,
+                   run_main)
 from ._container import SCENE_DEFAULTS, SCENES, default_measure_spheres
 from ._material import Material
 from ._io import summary_path, write_packing
@@ -243,9 +245,23 @@ def _procedure_options(args):
     return opts
 
 
+def _check_outputs(args):
+    """ValueError naming --out when the packing, its JSON summary or (--grain) its grain table
+    cannot be written, before any work."""
+    check_output(args.out)
+    files = [summary_path(args.out)] + ([grains_path(args.out)] if args.grain is not None else [])
+    for f in files:
+        if f.resolve() == Path(args.out).resolve():
+            raise ValueError(f"--out {args.out}: the packing would overwrite its own {f.name}; "
+                             "give a .csv name")
+        check_output(f, f"--out {args.out}: companion")
+
+
 def _pack(args) -> int:
+    check_seed(args.seed)
     if args.max_steps is not None and args.max_steps < 1:
         raise ValueError(f"--max-steps must be >= 1, got {args.max_steps}")
+    _check_outputs(args)
     if args.grain is not None:
         return _pack_grains(args)
     material = _material(args)

@@ -22,7 +22,7 @@ from pathlib import Path
 
 import numpy as np
 
-from ._cli import progress_printer, resolve_container, run_main
+from ._cli import check_seed, progress_printer, resolve_container, run_main
 from ._container import SCENES
 from ._integrate import DemInstabilityError
 from ._material import Material
@@ -95,6 +95,7 @@ def _amplitudes(args):
 
 
 def _vibrate(args) -> int:
+    check_seed(args.seed)
     amps = _amplitudes(args)
     if args.study:
         if args.packing:

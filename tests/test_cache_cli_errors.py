@@ -92,7 +92,7 @@ def test_lookup_bad_rows_spreadsheet_numbers_exit_1(files, monkeypatch, capsys):
     rc = lookup_cli.main(["--csv", "flat.csv", "--out", "o.csv", "--policy", "shape-factor",
                           "--quiet", "--db", "t.sqlite"])
     err = capsys.readouterr().err
-    assert rc == 1 and err.startswith("flat.csv row 4: sides [1.0, 2.0, 3.0]")
+    assert rc == 1 and err.startswith("error: flat.csv row 4: sides [1.0, 2.0, 3.0]")
     rows = list(csv.DictReader(open(files / "o.csv")))
     assert [r["source"] for r in rows] == ["shape-factor", "shape-factor", "failed"]
 

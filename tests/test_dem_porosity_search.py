@@ -119,3 +119,45 @@ def test_search_passes_over_a_bed_not_at_equilibrium(monkeypatch):
     out = pack_grains_to_porosity(box, sphere_template(0.001), porosity=0.401, porosity_tol=0.002)
     assert len(calls) == 4 and out[4]["stages"]["settle"]["converged"]
     assert abs(out[4]["porosity_network_region"] - 0.401) <= 0.002
+
+
+@pytest.mark.parametrize("target, count_phi", [(0.2, 0.35), (0.9, 0.5), (0.42, 0.42)])
+def test_far_targets_count_grains_within_range_and_name_reach(monkeypatch, target, count_phi):
+    """A target far outside what grains reach no longer sets the grain count: 0.2 overfilled the
+    bin (N = 0.8 V/V_g: the closed-box end blew up, exit 1 after 46 s) and 0.9 left a bed too thin
+    for network's region (reachable range 'nan-nan'). N comes from the target clipped to
+    COUNT_POROSITY_RANGE; the ends are packed and the reachable range named (ValueError: exit 2).
+    On a real soybean bed (0.08 x 0.08 x 0.05 m box) 0.2 now ends in 42 s with 0.3211-0.4000."""
+    seen = []
+    law = _fake(lambda lam: 0.40 + 0.01 * lam, [])
+
+    def pack(container, template, *, porosity, **kw):
+        seen.append(porosity)
+        return law(container, template, porosity=porosity, **kw)
+    monkeypatch.setattr(cp, "pack_grains", pack)
+    assert cp.COUNT_POROSITY_RANGE == (0.35, 0.5)
+    box = Container("box", (0.01, 0.01), 0.01)
+    with pytest.raises(ValueError, match=r"outside what this procedure reaches .*0\.3900-0\.4100"):
+        pack_grains_to_porosity(box, sphere_template(0.001), porosity=target)
+    assert seen == [count_phi, count_phi]
+
+
+def test_an_empty_network_region_is_named_not_nan(monkeypatch):
+    monkeypatch.setattr(cp, "pack_grains", _fake(lambda lam: float("nan"), []))
+    box = Container("box", (0.01, 0.01), 0.01)
+    with pytest.raises(ValueError, match=r"network's sample region .* is empty .*porosity nan "
+                                         r"at lever -1, nan at \+1\): give a larger container"):
+        pack_grains_to_porosity(box, sphere_template(0.001), porosity=0.9)
+
+
+def test_pack_cli_unreachable_porosity_exits_2(tmp_path, monkeypatch, capsys):
+    """dem.pack --grain --porosity 0.2: exit 2 with the reachable range, nothing written."""
+    monkeypatch.setattr(cp, "pack_grains", _fake(lambda lam: 0.32 + 0.04 * (lam + 1), []))
+    from dem.pack import main
+    out = tmp_path / "g.csv"
+    assert main(["--scene", "box", "--size", "0.08", "0.08", "--height", "0.05", "--grain",
+                 "soybean", "--porosity", "0.2", "--out", str(out), "--quiet"]) == 2
+    err = [ln for ln in capsys.readouterr().err.splitlines() if not ln.startswith("[search]")]
+    assert len(err) == 1 and err[0].startswith("error: porosity 0.2 is outside"), err
+    assert "0.3200-0.4000" in err[0]
+    assert not list(tmp_path.iterdir())

@@ -105,3 +105,15 @@ def test_validate_throats_flags_bad_rows_with_messages():
 def test_bad_shapes_raise():
     with pytest.raises(ValueError, match=r"shape \(N, 3\)"):
         open_area([[1, 1]], [[2, 2]])
+
+
+@pytest.mark.parametrize("scale", [1e-300, 1e-100, 1.0, 1e80, 1e200, 1e300])
+def test_triangle_test_is_scale_free(scale):
+    """The triangle test divides by the longest side: at 1e80 and up the squared sides
+    overflowed (warning, 'do not form a triangle'), at 1e-100 and down they underflowed."""
+    r = scale * np.array([[1.0, 1, 1], [1, 1, 1], [1, 1, 1]])
+    s = scale * np.array([[2.2, 2.2, 2.2], [1, 1, 3], [1, 2, 3]])
+    with np.errstate(all="raise"):
+        ok, msg = validate_throats(r, s)
+    assert ok.tolist() == [True, False, False]
+    assert msg[0] == "" and "do not form a triangle" in msg[1] and "do not form" in msg[2]

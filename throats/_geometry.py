@@ -241,11 +241,16 @@ def check_rows(r, s, *, deep_overlap):
     flag(cols(r, lambda c: c <= 0), lambda k: f"radius <= 0 in radii {r[k].tolist()}")
     flag(cols(s, lambda c: c <= 0), lambda k: f"side length <= 0 in sides {s[k].tolist()}")
     with np.errstate(invalid="ignore"):
-        # the sorted sides by a sorting network (the same values as np.sort(s, axis=1))
-        lo1, hi1 = np.minimum(s[:, 0], s[:, 1]), np.maximum(s[:, 0], s[:, 1])
-        x = np.maximum(lo1, s[:, 2])
-        lo, mid, hi = np.minimum(lo1, s[:, 2]), np.minimum(hi1, x), np.maximum(hi1, x)
-        area = triangle_area(np.where(np.isfinite(s), s, 1.0))
+        # scaled by a power of two (exact: every comparison as in the given unit) so that the
+        # longest side lies in [0.5, 1): no square or sum overflows or underflows, whatever
+        # the (finite, positive) length unit; then the sorted sides by a sorting network (the
+        # same values as np.sort(s, axis=1))
+        top = np.max(np.where(np.isfinite(s) & (s > 0), s, 0.0), axis=1)
+        q = np.ldexp(s, -np.frexp(np.where(top > 0, top, 1.0))[1][:, None])
+        lo1, hi1 = np.minimum(q[:, 0], q[:, 1]), np.maximum(q[:, 0], q[:, 1])
+        x = np.maximum(lo1, q[:, 2])
+        lo, mid, hi = np.minimum(lo1, q[:, 2]), np.minimum(hi1, x), np.maximum(hi1, x)
+        area = triangle_area(np.where(np.isfinite(q), q, 1.0))
         bad_tri = (hi >= lo + mid) | (area <= 1e-9 * hi ** 2)
     flag(bad_tri, lambda k: f"sides {s[k].tolist()} do not form a triangle "
                             "(triangle inequality violated or collinear vertices)")

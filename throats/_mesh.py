@@ -36,7 +36,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ._boundary import region_boundary
-from ._geometry import PAIR_COL, PAIRS, triangle_vertices
+from ._geometry import PAIRS, triangle_vertices
 
 __all__ = ["DELTA_DEFAULT", "FLUID", "NOSLIP", "SYMMETRY", "ThroatGeometry", "build_geometries",
            "disk_geometry", "polygon_geometry"]

@@ -18,7 +18,7 @@ message`` added (the columns of ``python -m cache.lookup``, with the same meanin
 
 Default method ``fem``.  Every triangle of disks gets an answer (``status`` 'ok' or 'closed',
 Q* possibly 0).  A bad row (unparsable, NaN, non-positive radius, impossible or collinear
-triangle) is reported on stderr as ``FILE row N: ...`` with N counted as a spreadsheet does
+triangle) is reported on stderr as ``error: FILE row N: ...`` with N counted as a spreadsheet does
 (header = row 1); the other rows are still written.  Exit status: 0 when every row has an
 answer, 1 when some row is invalid or failed (or Ctrl-C), 2 for bad options or files (one
 ``error:`` line, checked before anything is computed or written).
@@ -31,12 +31,13 @@ import csv
 import json
 import os
 import sys
+import tempfile
 import time
 
 import numpy as np
 
 from ._area import open_area
-from ._geometry import contact_type, validate_throats
+from ._geometry import contact_type, mean_radius, validate_throats
 from ._shape_factor import FIT, shape_factor_qstar
 from ._solve import solve_fem
 
@@ -55,12 +56,21 @@ class OneLineParser(argparse.ArgumentParser):
 
 
 def check_output(path, option="--out"):
-    """ValueError naming ``option`` if ``path`` cannot be written (folder missing, a folder)."""
+    """ValueError naming ``option`` if ``path`` cannot be written: a folder, a missing folder,
+    a folder where no file can be made (probed by creating and removing a temporary file there,
+    since ``os.access`` says yes to root even on ``/proc``), an existing file not writable."""
     folder = os.path.dirname(os.path.abspath(path))
     if os.path.isdir(path):
         raise ValueError(f"{option} {path} is a folder, not a file")
     if not os.path.isdir(folder):
         raise ValueError(f"{option} {path}: folder {folder} does not exist")
+    try:
+        tempfile.TemporaryFile(dir=folder, prefix=".grainflow-").close()
+    except OSError as exc:
+        raise ValueError(f"{option} {path}: folder {folder} is not writable "
+                         f"({exc.strerror or exc})") from None
+    if os.path.exists(path) and not os.access(path, os.W_OK):
+        raise ValueError(f"{option} {path}: file exists and is not writable")
 
 
 def _parser():
@@ -94,25 +104,36 @@ def _parser():
 
 
 def _compute(radii, sides, method, rtol, workers, progress):
-    """Per-row results as a dict of (N,) arrays (open_area in input units²)."""
+    """Per-row results as a dict of (N,) arrays (open_area in input units²).
+
+    Valid rows are solved in units of their mean radius r̄ (Q* is scale-free) and the open
+    area scaled back by r̄², so any finite positive length unit gives the same Q*; an area
+    beyond the float range (unit ~1e155 and up) is written empty.
+    """
     t0 = time.perf_counter()
+    ok, msg = validate_throats(radii, sides)
+    rbar = np.ones(radii.shape[0])
+    rbar[ok] = mean_radius(radii[ok])
+    r_star, s_star = radii / rbar[:, None], sides / rbar[:, None]
     if method == "fem":
-        sol = solve_fem(radii, sides, rtol=rtol, workers=workers, progress=progress)
-        rbar = radii.mean(axis=1)
-        return dict(qstar=sol.qstar, open_area=sol.open_area * rbar**2,
+        sol = solve_fem(r_star, s_star, rtol=rtol, workers=workers, progress=progress)
+        with np.errstate(over="ignore", under="ignore", invalid="ignore"):
+            area = sol.open_area * rbar**2
+        return dict(qstar=sol.qstar, open_area=area,
                     contact_type=sol.contact_type, error_estimate=sol.error_estimate,
                     seconds=sol.seconds, status=sol.status, message=sol.message)
-    ok, msg = validate_throats(radii, sides)
     q = np.full(radii.shape[0], np.nan)
-    area = np.full(radii.shape[0], np.nan)
+    area_star = np.full(radii.shape[0], np.nan)
     ctype = np.full(radii.shape[0], "", dtype=object)
     if ok.any():
-        q[ok] = shape_factor_qstar(radii[ok], sides[ok])
-        area[ok] = open_area(radii[ok], sides[ok])
-        ctype[ok] = contact_type(radii[ok], sides[ok])
+        q[ok] = shape_factor_qstar(r_star[ok], s_star[ok])
+        area_star[ok] = open_area(r_star[ok], s_star[ok])
+        ctype[ok] = contact_type(r_star[ok], s_star[ok])
+    with np.errstate(over="ignore", under="ignore", invalid="ignore"):
+        area = area_star * rbar**2
     # no per-throat estimate exists: report the fit's 95th-percentile error
     est = np.where(ok, FIT["p95_rel_error"], np.nan)
-    status = np.where(ok, np.where(area > 0, "ok", "closed"), "invalid")
+    status = np.where(ok, np.where(area_star > 0, "ok", "closed"), "invalid")
     secs = np.full(radii.shape[0], (time.perf_counter() - t0) / max(radii.shape[0], 1))
     return dict(qstar=q, open_area=area, contact_type=ctype.astype(str), error_estimate=est,
                 seconds=secs, status=status, message=msg.astype(str))
@@ -135,6 +156,9 @@ def _read_csv(path):
                 vals[k, c] = float(row[name])
             except (TypeError, ValueError):
                 parse_err[k] = f"cannot parse {name}={row[name]!r}"
+        if any(row[f] is None for f in fields):         # DictReader's filler of a short row
+            given = sum(row[f] is not None for f in fields)
+            parse_err[k] = f"the row has {given} of {len(fields)} values"
     return rows, fields, vals, parse_err
 
 
@@ -157,6 +181,10 @@ def _main(argv):
     if args.radii is not None:
         if args.sides is None:
             parser.error("--radii needs --sides L12 L13 L23")
+        ok, why = validate_throats([args.radii], [args.sides])
+        if not ok[0]:           # bad options, not a bad CSV row: exit 2 before any work
+            parser.error(f"--radii {' '.join(f'{v:g}' for v in args.radii)} --sides "
+                         f"{' '.join(f'{v:g}' for v in args.sides)}: {why[0]}")
         res = _compute(np.array([args.radii]), np.array([args.sides]), args.method,
                        args.rtol, 1, False)
         out = {k: (v[0].item() if hasattr(v[0], "item") else v[0]) for k, v in res.items()}
@@ -187,7 +215,7 @@ def _main(argv):
     for k in range(len(rows)):
         if res["status"][k] in ("invalid", "failed"):
             bad += 1
-            print(f"{args.csv} row {k + 2}: {res['status'][k]}: {res['message'][k]}",
+            print(f"error: {args.csv} row {k + 2}: {res['status'][k]}: {res['message'][k]}",
                   file=sys.stderr)   # header = row 1, as in a spreadsheet
     extra = ["qstar", "open_area", "contact_type", "error_estimate", "status", "message"]
     with open(f"{args.out}.part", "w", newline="") as fh:   # renamed once complete
