@@ -29,7 +29,8 @@ from pathlib import Path
 
 from ._air import MU_AIR_PA_S, P_ATM_PA, RHO_AIR_KG_M3, check_positive
 from ._lean import keep_heap
-from .packing import UNITS, default_packing_path, read_container, read_packing, scale_warning
+from .packing import (UNITS, check_three_dimensional, default_packing_path, read_container,
+                      read_packing, scale_warning)
 from .flow import DEFAULT_INERTIAL_LAW, INERTIAL_LAWS
 
 __all__ = ["EXIT_OK", "EXIT_FAILED", "EXIT_BAD_INPUT", "CliError", "CliParser", "bad_input",
@@ -37,6 +38,11 @@ __all__ = ["EXIT_OK", "EXIT_FAILED", "EXIT_BAD_INPUT", "CliError", "CliParser", 
            "check_plot", "load_packing", "sample_box_m", "warn"]
 
 EXIT_OK, EXIT_FAILED, EXIT_BAD_INPUT = 0, 1, 2
+#: Smallest ``--viscosity`` taken, Pa s: about a hundredth of hydrogen's (8.8e-6 Pa s at 20 °C),
+#: the least viscous gas. Far below it the viscous term is lost beside the inertial one in the
+#: Newton solve (Re_p 1e16 at 1e-20 Pa s: a gradient 8 times low, exit 0; at 1e-30 no
+#: convergence after two minutes).
+MIN_VISCOSITY_PA_S = 1e-7
 #: a number, negative ones and exponents included: argparse's own pattern misses ``-1.8e-5``
 _NUMBER = re.compile(r"^-(\d+\.?\d*|\.\d+)([eE][-+]?\d+)?$|^-(inf|infinity|nan)$", re.I)
 
@@ -134,10 +140,42 @@ def warn_curve(points, depth_m: float, key: str = "pressure_gradient_pa_per_m") 
                       max(p[key] for p in ok) * depth_m)
 
 
+class _WarningLines(logging.Handler):
+    """Log records of level WARNING and above as one ``warning:`` line each, a message
+    repeated within the run (once per axis, a file read twice) printed once."""
+
+    def __init__(self):
+        super().__init__(logging.WARNING)
+        self.seen: set[str] = set()
+
+    def emit(self, record):
+        text = " ".join(record.getMessage().split())
+        if text not in self.seen:
+            self.seen.add(text)
+            warn(text)
+
+
+def _below_warning(record) -> bool:
+    return record.levelno < logging.WARNING
+
+
+#: handlers :func:`run` installed on the root logger, removed when the command ends
+_INSTALLED: list = []
+
+
 def progress_log(args, fmt: str = "[%(relativeCreated)7.0f ms] %(message)s") -> None:
-    """Stage progress on stderr (INFO log lines) unless ``--quiet``."""
-    if not getattr(args, "quiet", False):
-        logging.basicConfig(level=logging.INFO, format=fmt, stream=sys.stderr)
+    """Stage progress on stderr (INFO log lines) unless ``--quiet`` or logging is configured
+    already (a test's or an embedding program's handlers); warnings go to :func:`run`'s
+    ``warning:`` lines, not here."""
+    root = logging.getLogger()
+    if getattr(args, "quiet", False) or any(h not in _INSTALLED for h in root.handlers):
+        return
+    handler = logging.StreamHandler(sys.stderr)
+    handler.setFormatter(logging.Formatter(fmt))
+    handler.addFilter(_below_warning)
+    root.addHandler(handler)
+    _INSTALLED.append(handler)
+    root.setLevel(min(root.level or logging.WARNING, logging.INFO))
 
 
 def run(body, parser: argparse.ArgumentParser, argv=None) -> int:
@@ -145,9 +183,24 @@ def run(body, parser: argparse.ArgumentParser, argv=None) -> int:
     code; a :class:`CliError` (or any other exception: exit 1) becomes one ``error:`` line.
 
     Captured warnings do not reach the terminal; when there were any, one line says how many
-    and quotes the first (the checks of the result decide whether it is good).
+    and quotes the first (the checks of the result decide whether it is good). The library's
+    logged warnings (``logging``) become ``warning:`` lines, each distinct one once.
     """
     debug = os.environ.get("GRAINFLOW_DEBUG")
+    root = logging.getLogger()
+    level, mark = root.level, len(_INSTALLED)      # a run inside a run keeps the outer's
+    lines = _WarningLines()
+    root.addHandler(lines)
+    _INSTALLED.append(lines)
+    try:
+        return _run(body, parser, argv, debug)
+    finally:
+        while len(_INSTALLED) > mark:
+            root.removeHandler(_INSTALLED.pop())
+        root.setLevel(level)
+
+
+def _run(body, parser, argv, debug) -> int:
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always")
         try:
@@ -242,7 +295,8 @@ def add_table(ap) -> None:
 def add_air(ap, *, density: bool = True) -> None:
     """``--viscosity`` (and ``--density``), SI."""
     ap.add_argument("--viscosity", type=float, default=MU_AIR_PA_S,
-                    help="dynamic viscosity of the air, Pa s, > 0 (thesis air)")
+                    help=f"dynamic viscosity of the air, Pa s, > 0 (at least "
+                         f"{MIN_VISCOSITY_PA_S:g}; thesis air)")
     if density:
         ap.add_argument("--density", type=float, default=RHO_AIR_KG_M3,
                         help="air density for the inertial losses, kg/m^3, > 0")
@@ -333,10 +387,15 @@ def available_cores() -> int:
 
 
 def check_common(args) -> None:
-    """The numeric options every command may have, checked once (ValueError names them)."""
+    """The numeric options every command may have, checked once (ValueError names them);
+    ``--viscosity`` also at least :data:`MIN_VISCOSITY_PA_S`."""
     for name in ("viscosity", "density", "velocity", "depth", "rtol"):
         if getattr(args, name, None) is not None and not isinstance(getattr(args, name), list):
             check_positive(f"--{name}", getattr(args, name))
+    if getattr(args, "viscosity", None) is not None and args.viscosity < MIN_VISCOSITY_PA_S:
+        raise ValueError(f"--viscosity {args.viscosity:g} Pa s is below {MIN_VISCOSITY_PA_S:g} "
+                         "Pa s, about a hundredth of the least viscous gas's (hydrogen, "
+                         "8.8e-6 Pa s at 20 C): give the fluid's dynamic viscosity in Pa s")
     if getattr(args, "margin", None) is not None and not args.margin >= 0:
         raise ValueError(f"--margin must be >= 0 (packing units), got {args.margin!r}")
     for name in ("workers", "threads"):
@@ -350,6 +409,7 @@ def load_packing(args):
     unknown kind or malformed is refused here, before any work (:func:`read_container`)."""
     path = Path(args.packing) if args.packing else default_packing_path()
     packing = read_packing(path, units=args.units)
+    check_three_dimensional(packing.centers, str(path))
     read_container(path)
     keep_heap(packing.n)
     msg = scale_warning(packing)

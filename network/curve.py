@@ -24,7 +24,7 @@ import numpy as np
 from ._air import check_positive
 from ._cli import (CliError, CliParser, add_air, add_packing, add_sample, add_table,
                    available_cores, bad_input, check_common, check_outputs, check_plot, computing,
-                   finish, load_packing, packing_inputs, progress_log, run, sample_box_m,
+                   finish, load_packing, packing_inputs, progress_log, run, sample_box_m, warn,
                    warn_curve)
 from .conductance import POLICIES
 from ._grains import GRAIN_ALIASES, d272_constants
@@ -37,6 +37,9 @@ from .pores import sample_region
 DEFAULT_VELOCITIES = "0.005:0.3:12"
 #: Thesis section 4.2.3: measured drops over 0.25 m of soybeans, (m/s, Pa/m).
 THESIS_POINTS = [(0.013, 2.44 / 0.25), (0.027, 6.80 / 0.25)]
+#: Fewest distinct velocities the fits take (:func:`network.flow.fit_curve`: each fit has two
+#: constants; with fewer every fit is None).
+MIN_FIT_VELOCITIES = 2
 KEYS = ["velocity_m_s", "reynolds_particle", "pressure_gradient_pa_per_m",
         "apparent_permeability_m2", "converged"]
 
@@ -141,7 +144,16 @@ def _check_options(args) -> list[float]:
                   inputs=packing_inputs(args))
     if args.plot:
         check_plot(path=args.plot)
-    return parse_velocities(args.velocities)
+    us = parse_velocities(args.velocities)
+    _warn_fits(len(set(us)), f"--velocities {args.velocities} gives")
+    return us
+
+
+def _warn_fits(n_distinct: int, what: str) -> None:
+    """A ``warning:`` line when ``n_distinct`` velocities are too few for the fits."""
+    if n_distinct < MIN_FIT_VELOCITIES:
+        warn(f"the fits (Darcy-Forchheimer, D272, Ergun) need at least {MIN_FIT_VELOCITIES} "
+             f"distinct velocities; {what} {n_distinct}: they are reported as None")
 
 
 def _write_outputs(args, out, pts, ok, res) -> None:
@@ -191,6 +203,8 @@ def _main(args) -> int:
                for p in res.curve_points()]
         ok = [p for p in pts if p["converged"]]
         fits = res.curve_fits()
+    if len(set(us)) >= MIN_FIT_VELOCITIES:
+        _warn_fits(len({p["velocity_m_s"] for p in ok}), "the converged points have")
     print(f"packing {path} ({packing.n} spheres), axis {args.axis}: k (Stokes) = "
           f"{res.permeability_m2:.4e} m2, porosity {res.porosity:.4f}, d32 "
           f"{res.sauter_diameter_m:.4g} m")

@@ -36,15 +36,15 @@ import time
 
 import numpy as np
 
-from ._cli import (CliParser, add_air, add_packing, bad_input, check_outputs,
+from ._cli import (CliParser, add_air, add_packing, bad_input, check_common, check_outputs,
                    check_plot, computing, finish, load_packing, packing_inputs, run)
-from ._air import check_positive
 from .airpaths import (bed_depth, branched_table, face_graph, plot_paths, pore_pressure_array,
                        pressure_along_path, random_entry_points, trace_paths)
 from .conductance import POLICIES
 from .flow import DEFAULT_DEPTH_M, asabe_d272_gradient, ergun_gradient, solve_network
 from .packing import UNITS, Packing, random_packing
-from .pores import Region, axis_index, default_region, region_porosity, tessellate, tie_groups
+from .pores import (NoInteriorError, Region, axis_index, default_region, region_porosity,
+                    tessellate, tie_groups)
 
 _ALL = ("widest", "narrowest", "maximin", "shortest")
 #: Thesis values (Tables 4.1-4.5) printed beside ours (pressures: over 0.25 m of soybeans).
@@ -114,9 +114,10 @@ def _parser():
                    help="draw the paths (needs matplotlib: pip install '.[plot]'; default: "
                         "not drawn)")
     p.add_argument("--standin", nargs=3, type=float, metavar=("LX", "LY", "LZ"),
-                   help="instead of PACKING, a geometric stand-in packing in this box (m): "
-                        "diameters 5.5-7.5 mm, porosity 0.408, by network.packing.random_packing "
-                        "(--seed)")
+                   help=f"instead of PACKING, a geometric stand-in packing in this box (m, "
+                        f"sides >= {STANDIN_MIN_SIDE_M:g}, at most {STANDIN_MAX_SPHERES} "
+                        "spheres): diameters 5.5-7.5 mm, porosity 0.408, by "
+                        "network.packing.random_packing (--seed)")
     return p
 
 
@@ -124,6 +125,11 @@ def _parser():
 #: porosity.
 STANDIN_DIAMETERS_M = (5.5e-3, 7.5e-3)
 STANDIN_POROSITY = 0.408
+#: Most spheres a stand-in may have (about a 0.29 m cube; the thesis's bin holds 18 000).
+STANDIN_MAX_SPHERES = 100_000
+#: Shortest stand-in side, m: 6 mean diameters, the default sample's 1.5-diameter margins on
+#: both sides and its 2-diameter interior (``network.pores.default_region``) with room to spare.
+STANDIN_MIN_SIDE_M = 0.04
 
 
 def standin_packing(box_m, *, rng=None):
@@ -134,15 +140,28 @@ def standin_packing(box_m, *, rng=None):
     box's aspect ratio; its box has the volume of the drawn spheres at that porosity, so it
     differs from ``box_m`` by the sampling error of the mean sphere volume.
     """
+    n = standin_size(box_m)
+    pk = random_packing(n, diameter_range_m=STANDIN_DIAMETERS_M,
+                        solid_fraction=1.0 - STANDIN_POROSITY,
+                        aspect=np.asarray(box_m, dtype=float), rng=rng)
+    return np.asarray(pk.centers), np.asarray(pk.radii)
+
+
+def standin_size(box_m) -> int:
+    """Spheres of the stand-in in the box ``box_m`` (3,) m; ValueError naming ``--standin``
+    and the box when a side is not > 0 or the count is over :data:`STANDIN_MAX_SPHERES`."""
     box = np.asarray(box_m, dtype=float)
-    if box.shape != (3,) or not np.all(box > 0):
+    if box.shape != (3,) or not np.all(np.isfinite(box) & (box > 0)):
         raise ValueError(f"--standin needs three box sides > 0 (m), got {box_m}")
     d0, d1 = STANDIN_DIAMETERS_M
     mean_vol = np.pi / 6.0 * (d1**4 - d0**4) / (4.0 * (d1 - d0))  # E[pi d^3 / 6], d uniform
-    n = int(round((1.0 - STANDIN_POROSITY) * box.prod() / mean_vol))
-    pk = random_packing(n, diameter_range_m=STANDIN_DIAMETERS_M,
-                        solid_fraction=1.0 - STANDIN_POROSITY, aspect=box, rng=rng)
-    return np.asarray(pk.centers), np.asarray(pk.radii)
+    n = (1.0 - STANDIN_POROSITY) * float(box.prod()) / mean_vol
+    if n > STANDIN_MAX_SPHERES:
+        side = (STANDIN_MAX_SPHERES * mean_vol / (1.0 - STANDIN_POROSITY)) ** (1 / 3)
+        raise ValueError(f"--standin {' '.join(f'{v:g}' for v in box)}: the box holds about "
+                         f"{n:.3g} spheres, more than the {STANDIN_MAX_SPHERES} a stand-in may "
+                         f"have (a cube of {side:.2g} m); give a smaller box")
+    return int(round(n))
 
 
 def main(argv=None) -> int:
@@ -157,8 +176,15 @@ def _check_options(args) -> None:
                          f"{args.entries}")
     if any(not u > 0 for u in args.velocity):
         raise ValueError(f"--velocity must be > 0 m/s, got {args.velocity}")
-    check_positive("--depth", args.depth)
-    check_positive("--viscosity", args.viscosity)
+    if args.seed < 0:
+        raise ValueError(f"--seed must be an integer >= 0, got {args.seed}")
+    if args.standin:
+        standin_size(args.standin)
+        if min(args.standin) < STANDIN_MIN_SIDE_M:
+            raise ValueError(f"--standin {' '.join(f'{v:g}' for v in args.standin)}: every side "
+                             f"must be >= {STANDIN_MIN_SIDE_M:g} m (6 mean diameters: the "
+                             "interior sample keeps 1.5 from each face)")
+    check_common(args)
     check_outputs(json=args.json, plot=args.plot, inputs=packing_inputs(args))
     if args.plot:
         check_plot(path=args.plot)
@@ -220,6 +246,7 @@ def _main(args) -> int:
         x, r, source = _read(args)
         t_read = time.perf_counter() - t0
         xy = _entries(args, x, r)
+        region = None if args.no_branched else _interior(args, x, r, source)
         kinds = _ALL if args.kind == "all" else (args.kind,)
         need_graph = any(k in ("maximin", "shortest") for k in kinds) or args.method == "delaunay"
         graph = tess = None
@@ -272,7 +299,7 @@ def _main(args) -> int:
     branched, table45 = [], {}
     if not args.no_branched:
         with computing():
-            branched, table45 = _branched(args, x, r, paths, dup)
+            branched, table45 = _branched(args, x, r, paths, dup, region)
 
     along = []
     if args.pressure:
@@ -308,7 +335,17 @@ def _thesis_point(args, u: str) -> bool:
     return np.isclose(args.depth, THESIS_DEPTH_M) and u in THESIS["measured_pa"]
 
 
-def _branched(args, x, r, paths, dup):
+def _interior(args, x, r, source):
+    """The default interior sample, whose porosity enters Ergun (:func:`_table_4_5`), found
+    before any work; ValueError when the bed has none."""
+    try:
+        return default_region(Packing(x, r), axis=args.axis)
+    except NoInteriorError as exc:
+        raise ValueError(f"{source}: {exc.reason}; network.paths needs an interior sample for "
+                         "the Ergun porosity of its Table 4.5 (--no-branched skips it)") from exc
+
+
+def _branched(args, x, r, paths, dup, region):
     """The branched model on every distinct ok widest/narrowest path: Table 4.4 (Pa along the
     path) and the Table 4.5 layout (Pa over --depth)."""
     t2 = time.perf_counter()
@@ -331,7 +368,7 @@ def _branched(args, x, r, paths, dup):
             print(f"{b['kind']:10s} {w:8s} "
                   + " ".join(f"{b[w]['MFx3'][u]:12.3g}" for u in us) + " "
                   + " ".join(f"{b[w]['MFx2'][u]:12.3g}" for u in us))
-    table45 = _table_4_5(args, x, r, branched)
+    table45 = _table_4_5(args, x, r, branched, region)
     for u in us:
         along = np.mean([b["average"]["MFx3"][u] for b in branched])
         print(f"mean MFx3 average-width at {u} m/s: {along:.3g} Pa along the paths, "
@@ -344,7 +381,7 @@ def _branched(args, x, r, paths, dup):
     return branched, table45
 
 
-def _table_4_5(args, x, r, branched):
+def _table_4_5(args, x, r, branched, region):
     """Pressure drops over --depth (Pa): measured (thesis, only at its 0.25 m), branched model
     (ours, mean of the MFx3 average-width paths, each drop / its L0 x depth), ASABE D272 and
     Ergun (thesis 4.2.2) with the porosity and Sauter diameter that ``network.solve`` uses: the
@@ -352,7 +389,7 @@ def _table_4_5(args, x, r, branched):
     so both commands print one Ergun value for one bed."""
     depth, velocities = args.depth, args.velocity
     pk = Packing(x, r)
-    porosity, _ = region_porosity(pk, default_region(pk, axis=args.axis), axis_index(args.axis))
+    porosity, _ = region_porosity(pk, region, axis_index(args.axis))
     us = [f"{u:g}" for u in velocities]
     out = {}
     if any(_thesis_point(args, u) for u in us):

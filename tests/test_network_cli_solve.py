@@ -34,7 +34,11 @@ def _k(argv, tmp_path, capsys):
     js = tmp_path / "o.json"
     rc = solve_cli.main(argv + ["-q", "--stokes", "--policy", "shape-factor", "--json", str(js)])
     cap = capsys.readouterr()
-    return rc, (json.loads(js.read_text()) if rc == 0 else None), cap.err
+    # this small bed's sample is too narrow for the boundary-free estimate: that warning
+    # line is the same in every run here and left out
+    err = "".join(ln for ln in cap.err.splitlines(keepends=True)
+                  if "grain diameters wide" not in ln)
+    return rc, (json.loads(js.read_text()) if rc == 0 else None), err
 
 
 def test_units_mm_gives_the_metre_answer_and_a_warning_otherwise(beds, tmp_path, capsys):

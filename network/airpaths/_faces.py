@@ -223,6 +223,13 @@ def random_entry_points(centers, radii, n, *, axis="z", rng=None, margin_m=None)
     return rng.uniform(lo + m, hi - m, size=(int(n), 2))
 
 
+class NoPathError(ValueError):
+    """No enterable tetrahedron near the floor connects to the top: the packing has no path
+    along the axis, an input fault (``bad_input``: exit 2 in a CLI)."""
+
+    bad_input = True
+
+
 def entry_faces(graph, entry_xy, *, axis="z", min_quality=MIN_QUALITY):
     """Start tetrahedron and face of a path on the tessellation for each entry point.
 
@@ -252,8 +259,12 @@ def entry_faces(graph, entry_xy, *, axis="z", min_quality=MIN_QUALITY):
     through = np.intersect1d(comp[low], comp[high])
     cand = np.flatnonzero(low & np.isin(comp, through))
     if cand.size == 0:
-        raise ValueError("no enterable tetrahedron near the floor opens onto the top "
-                         "(min_quality too high?)")
+        raise NoPathError(
+            f"no air path through the bed along {'xyz'[ax]}: no enterable tetrahedron within "
+            f"{END_BAND_DIAMETERS:g} mean diameters of the floor opens onto the top through "
+            f"open faces ({graph.n_pores} tetrahedra: a bed too small or too loose for a path?"
+            + ("" if min_quality == MIN_QUALITY else f"; min_quality {min_quality:g} too high?")
+            + ")")
     plane = plane_axes(ax)
     cc = graph.points[graph.pore_vertices[cand]].mean(axis=1)
     lo = graph.points[:, ax].min()

@@ -8,13 +8,15 @@ the regular arrays whose exact permeability is known.
 from ._generate import SOYBEAN_DEFAULT, periodic_copies, random_packing, soybean_default_scene
 from ._io import (FORMATS, UNITS, default_packing_path, read_container, read_packing,
                   write_packing_csv)
-from ._packing import (MIN_SPHERES, PLAUSIBLE_DIAMETER_M, Packing, check_grains, grain_volumes,
-                       scale_warning, validate_spheres)
+from ._packing import (MIN_SPHERES, PLAUSIBLE_DIAMETER_M, DegeneratePackingError, Packing,
+                       check_grains, check_three_dimensional, grain_volumes, scale_warning,
+                       validate_spheres)
 from ._lattices import (LATTICES, SPHERES_PER_CELL, TOUCHING_FRACTION, lattice_basis,
                         lattice_packing, lattice_radius)
 
 __all__ = ["FORMATS", "LATTICES", "MIN_SPHERES", "PLAUSIBLE_DIAMETER_M", "SOYBEAN_DEFAULT",
-           "SPHERES_PER_CELL", "TOUCHING_FRACTION", "UNITS", "Packing", "check_grains", "grain_volumes",
+           "SPHERES_PER_CELL", "TOUCHING_FRACTION", "UNITS", "DegeneratePackingError", "Packing",
+           "check_grains", "check_three_dimensional", "grain_volumes",
            "default_packing_path", "lattice_basis", "lattice_packing", "lattice_radius",
            "periodic_copies", "random_packing", "read_container", "read_packing",
            "scale_warning", "soybean_default_scene", "validate_spheres", "write_packing_csv"]

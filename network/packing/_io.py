@@ -64,7 +64,7 @@ def _read_csv(path: Path) -> Packing:
     """Delimited text: comma, semicolon, or spaces/tabs (YADE's ``export.text``: ``#`` comment
     lines, then ``x y z r`` rows); an optional header names x, y, z and r/radius/diameter."""
     src = str(path)
-    text = path.read_text(errors="replace").splitlines()
+    text = path.read_text(encoding="utf-8-sig", errors="replace").splitlines()  # BOM: Excel
     # the first line that is neither blank nor a comment: the header or the first row
     first = next((i for i, ln in enumerate(text)
                   if (t := ln.strip()) and not t.startswith("#")), None)
@@ -154,7 +154,7 @@ def _read_npz(path: Path) -> Packing:
 def _read_dump(path: Path) -> Packing:
     """LAMMPS/LIGGGHTS ``dump custom`` text; the last snapshot in the file is read."""
     src = str(path)
-    text = path.read_text().splitlines()
+    text = path.read_text(encoding="utf-8-sig").splitlines()
     starts = [i for i, ln in enumerate(text) if ln.startswith("ITEM: ATOMS")]
     if not starts:
         raise ValueError(f"{src}: no 'ITEM: ATOMS' line: not a LAMMPS/LIGGGHTS dump custom file")
@@ -221,7 +221,7 @@ def read_packing(path: str | os.PathLike, *, units: str = "m") -> Packing:
     Raises
     ------
     FileNotFoundError
-        The file does not exist.
+        The file does not exist (``IsADirectoryError``: it is a folder).
     ValueError
         Malformed content, NaN/inf, non-positive radii, duplicate centres or fewer than
         ``MIN_SPHERES`` spheres; the message names the file and line.
@@ -229,6 +229,8 @@ def read_packing(path: str | os.PathLike, *, units: str = "m") -> Packing:
     if units not in UNITS:
         raise ValueError(f"unknown length unit {units!r}; choose one of {', '.join(UNITS)}")
     p = Path(path)
+    if p.is_dir():
+        raise IsADirectoryError(f"packing {p} is a folder, not a file: give the packing file")
     if not p.is_file():
         raise FileNotFoundError(f"packing file not found: {p}")
     suffix = p.suffix.lower()

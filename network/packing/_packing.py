@@ -15,8 +15,9 @@ import scipy.sparse as sp
 
 from .._deferred import csgraph, spatial
 
-__all__ = ["MIN_SPHERES", "PLAUSIBLE_DIAMETER_M", "Packing", "check_grains", "grain_volumes",
-           "scale_warning", "validate_spheres"]
+__all__ = ["MIN_SPHERES", "PLAUSIBLE_DIAMETER_M", "DegeneratePackingError", "Packing",
+           "check_grains", "check_three_dimensional", "grain_volumes", "scale_warning",
+           "validate_spheres"]
 
 #: Fewest spheres that make a three-dimensional Delaunay tessellation with an interior.
 MIN_SPHERES = 5
@@ -184,6 +185,39 @@ def validate_spheres(centers, radii, lines, source, *, check_duplicates=True):
             a, b = sorted((int(order[k]), int(order[k + 1])))
             raise ValueError(f"{source}: row {lines[b]}: duplicate centre {centers[b].tolist()} "
                              f"(same as row {lines[a]})")
+
+
+class DegeneratePackingError(ValueError):
+    """The sphere centres span less than three dimensions (coplanar or collinear): there is no
+    3-D tessellation of them, an input fault (``bad_input``: exit 2 in a CLI)."""
+
+    bad_input = True
+
+
+#: Relative size (to the largest) below which a singular value of the centred coordinates
+#: counts as zero in :func:`check_three_dimensional`.
+FLAT_RTOL = 1e-10
+
+
+def check_three_dimensional(centers, source: str = "") -> None:
+    """:class:`DegeneratePackingError` when the centres (N, 3) lie in one plane or on one line.
+
+    The rank of the centred coordinates, from their singular values (a value below
+    :data:`FLAT_RTOL` times the largest counts as zero); ``source`` prefixes the message.
+
+    >>> try:
+    ...     check_three_dimensional([[0, 0, 0], [1, 0, 0], [0, 1, 0], [1, 1, 0]])
+    ... except DegeneratePackingError as e:
+    ...     print(e)
+    the sphere centres are coplanar: no 3-D tessellation
+    """
+    c = np.asarray(centers, dtype=float)
+    s = np.linalg.svd(c - c.mean(axis=0), compute_uv=False) if c.shape[0] > 1 else np.zeros(1)
+    rank = int(np.sum(s > FLAT_RTOL * s.max())) if s.max() > 0 else 0
+    if rank < 3:
+        shape = {2: "coplanar", 1: "collinear"}.get(rank, "all at one point")
+        raise DegeneratePackingError(f"{source + ': ' if source else ''}the sphere centres are "
+                                     f"{shape}: no 3-D tessellation")
 
 
 def check_grains(centers, radii, grain_id, lines, source) -> None:

@@ -33,6 +33,7 @@ import numpy as np
 import scipy.sparse as sp
 
 from .._deferred import beside, csgraph, import_now, spatial
+from ..packing import DegeneratePackingError, check_three_dimensional
 from ._simplex import CHUNK, column_norm, cross_components, edge_determinants
 
 __all__ = ["ENGINES", "FACES", "GMSH_MIN_CENTRES", "QHULL_OPTIONS", "delaunay"]
@@ -66,7 +67,8 @@ def delaunay(pts: np.ndarray, *, engine: str = "auto", qhull_options: str = QHUL
     Returns ``(simplices (Nt, 4) int64, neighbors (Nt, 4) int64, engine used)``: neighbour k of
     tetrahedron t is the one across the face opposite vertex k, -1 on the convex hull.
     ``threads`` > 1: gmsh's check computes its convex hull on a second thread while gmsh runs.
-    Raises ``ValueError`` when Qhull fails (coplanar or degenerate input).
+    Raises :class:`~network.packing.DegeneratePackingError` (a ``ValueError``) when Qhull fails:
+    the centres coplanar or collinear (said so), or otherwise degenerate.
     """
     if engine not in ENGINES:
         raise ValueError(f"unknown Delaunay engine {engine!r}; choose one of {ENGINES}")
@@ -79,8 +81,13 @@ def delaunay(pts: np.ndarray, *, engine: str = "auto", qhull_options: str = QHUL
     try:
         dt = spatial.Delaunay(pts, qhull_options=qhull_options)
     except spatial.QhullError as e:
-        raise ValueError(f"Delaunay tessellation failed for {pts.shape[0]} centres "
-                         f"(coplanar or degenerate input?): {str(e).splitlines()[0]}") from e
+        why = f"Delaunay tessellation failed for {pts.shape[0]} centres"
+        try:
+            check_three_dimensional(pts)
+        except DegeneratePackingError as flat:
+            raise DegeneratePackingError(f"{flat} ({why}: coplanar or degenerate input)") from e
+        raise DegeneratePackingError(f"{why} (coplanar or degenerate input?): "
+                                     f"{str(e).splitlines()[0]}") from e
     simp = np.ascontiguousarray(dt.simplices, dtype=np.int64)
     neigh = np.ascontiguousarray(dt.neighbors, dtype=np.int64)
     return simp, neigh, "qhull"

@@ -11,9 +11,10 @@ import logging
 
 import numpy as np
 
-__all__ = ["AXES", "MIN_INTERIOR_DIAMETERS", "OUTSIDE_BED_DIAMETERS", "Region", "axis_index",
-           "bed_members",
-           "check_inside_bed", "default_region", "sample_region"]
+from ..packing import MIN_SPHERES
+
+__all__ = ["AXES", "MIN_INTERIOR_DIAMETERS", "NoInteriorError", "OUTSIDE_BED_DIAMETERS", "Region",
+           "axis_index", "bed_members", "check_inside_bed", "default_region", "sample_region"]
 
 AXES = {"x": 0, "y": 1, "z": 2}
 
@@ -82,6 +83,15 @@ MIN_INTERIOR_DIAMETERS = 2.0
 log = logging.getLogger(__name__)
 
 
+class NoInteriorError(ValueError):
+    """The packing leaves no default interior sample: ``reason`` says why, ``advice`` (the
+    CLIs' options) what to give instead; the message is both."""
+
+    def __init__(self, reason: str, advice: str, sep: str = "; "):
+        super().__init__(f"{reason}{sep}{advice}")
+        self.reason, self.advice = reason, advice
+
+
 def bed_members(packing) -> np.ndarray:
     """Spheres of the bed (bool, (N,)): along every axis the sorted sphere surfaces of a packed
     bed leave no empty band wider than :data:`OUTSIDE_BED_DIAMETERS` mean diameters; spheres
@@ -128,6 +138,13 @@ def default_region(packing, *, margin: float | None = None, cylinder: bool = Fal
         Flow axis (matters for a cylindrical container only).
     """
     bed = bed_members(packing)
+    if bed.sum() < MIN_SPHERES:
+        gap = OUTSIDE_BED_DIAMETERS * packing.grain_diameter
+        raise NoInteriorError(
+            f"no bed to take a sample from: the spheres lie apart (no two near contact?), "
+            f"{int(bed.sum())} of the {packing.n} without an empty band wider than "
+            f"{OUTSIDE_BED_DIAMETERS:g} mean diameters ({gap:.3g} m) between them, fewer than "
+            f"{MIN_SPHERES} (radii too small for their spacing?)", "give an explicit --sample box")
     lo, hi = packing.extent(None if bed.all() else bed)
     if not bed.all():
         apart = np.flatnonzero(~bed)
@@ -139,18 +156,19 @@ def default_region(packing, *, margin: float | None = None, cylinder: bool = Fal
     if m < 0:
         raise ValueError(f"margin must be >= 0, got {m}")
     if np.any(hi - lo <= 2 * m):
-        raise ValueError(f"margin {m:g} leaves no interior in a packing of extent {hi - lo}")
+        raise NoInteriorError(f"margin {m:g} leaves no interior in a packing of extent "
+                              f"{hi - lo}", "give a smaller --margin or an explicit --sample box")
     d = packing.grain_diameter
     thin = np.flatnonzero(hi - lo - 2 * m < MIN_INTERIOR_DIAMETERS * d)
     if thin.size:
         k = int(thin[0])
         w = float(hi[k] - lo[k] - 2 * m)
-        raise ValueError(
+        raise NoInteriorError(
             f"a margin of {m:.4g} (kept from the walls on every side) leaves an interior only "
             f"{w:.3g} ({w / d:.2f} mean diameters) thick along {'xyz'[k]}, where the packing is "
             f"{hi[k] - lo[k]:.4g} thick: too thin for a sample away from the walls (the "
-            f"tessellation has no walls). Give a smaller --margin (the wall layer then enters "
-            f"the sample) or an explicit --sample box")
+            f"tessellation has no walls)", "Give a smaller --margin (the wall layer then enters "
+            "the sample) or an explicit --sample box", sep=". ")
     lo, hi = lo + m, hi - m
     if container is not None and container.get("kind") == "cylinder":
         c = np.asarray(container.get("center_xy", 0.5 * (lo[:2] + hi[:2])), dtype=float)
