@@ -337,15 +337,14 @@ class GridTable:
 
     def at_throats(self, radii, sides, *, errors=True, chunk=CHUNK):
         """``self(grid_coordinates(*lookup_order(radii, sides)))`` (one answer for every vertex
-        order), coordinates made chunk by chunk; radii, sides (N, 3) float arrays."""
-        r, s = lookup_order(radii, sides)
-
+        order), both made chunk by chunk; radii, sides (N, 3) float arrays."""
         def cols(lo, hi):
-            r0, r1, r2 = r[lo:hi, 0], r[lo:hi, 1], r[lo:hi, 2]
+            r, s = lookup_order(radii[lo:hi], sides[lo:hi])
+            r0, r1, r2 = r[:, 0], r[:, 1], r[:, 2]
             inv = 1.0 / ((r0 + r1 + r2) * (1.0 / 3.0))
-            return [(s[lo:hi, 0] - r0 - r1) * inv, (s[lo:hi, 1] - r0 - r2) * inv,
-                    (s[lo:hi, 2] - r1 - r2) * inv, r0 * inv - 1.0, r1 * inv - 1.0]
-        return self._chunks(len(r), cols, False, chunk, errors)
+            return [(s[:, 0] - r0 - r1) * inv, (s[:, 1] - r0 - r2) * inv,
+                    (s[:, 2] - r1 - r2) * inv, r0 * inv - 1.0, r1 * inv - 1.0]
+        return self._chunks(len(radii), cols, False, chunk, errors)
 
     def _chunks(self, n, cols, _log, chunk, errors):
         v = np.empty(n)
