@@ -97,6 +97,9 @@ def read_fan(path) -> tuple[np.ndarray, np.ndarray]:
             raise ValueError(f"--fan {path}: missing column(s) {', '.join(missing)} (header "
                              f"{','.join(FAN_COLUMNS)}: airflow m^3/s, static pressure Pa)")
         for i, row in enumerate(reader, start=2):
+            if None in row:                 # DictReader's key for the fields past the header
+                raise ValueError(f"--fan {path} row {i}: {len(FAN_COLUMNS) + len(row[None])} "
+                                 f"values, the header has {len(FAN_COLUMNS)}")
             vals = []
             for c in FAN_COLUMNS:
                 text = (row.get(c) or "").strip()
@@ -113,9 +116,9 @@ def read_fan(path) -> tuple[np.ndarray, np.ndarray]:
     if len(rows) < 2:
         raise ValueError(f"--fan {path}: needs at least two rows, got {len(rows)}")
     a = np.array(sorted(rows))
-    if np.any(np.diff(a[:, 0]) == 0):
-        raise ValueError(f"--fan {path}: airflow {a[np.diff(a[:, 0]) == 0][0, 0]:g} m^3/s "
-                         "appears twice")
+    twice = np.flatnonzero(np.diff(a[:, 0]) == 0)
+    if twice.size:
+        raise ValueError(f"--fan {path}: airflow {a[twice[0], 0]:g} m^3/s appears twice")
     return a[:, 0], a[:, 1]
 
 

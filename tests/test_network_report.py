@@ -74,6 +74,12 @@ def test_fan_file_bad_rows_are_named(tmp_path):
     f.write_text("airflow_m3_s,static_pressure_pa\n0,500\nabc,20\n")
     with pytest.raises(ValueError, match="row 3: airflow_m3_s 'abc' is not a number"):
         read_fan(f)
+    f.write_text("airflow_m3_s,static_pressure_pa\n0,2000\n1,1800\n1,1700\n2,1500\n")
+    with pytest.raises(ValueError, match="airflow 1 m\\^3/s appears twice"):   # was IndexError
+        read_fan(f)
+    f.write_text("airflow_m3_s,static_pressure_pa\n0,2000\n1,1800,5\n2,1500\n")
+    with pytest.raises(ValueError, match="row 3: 3 values, the header has 2"):
+        read_fan(f)
 
 
 def test_bad_input_exits_2(tmp_path, capsys):
