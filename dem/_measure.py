@@ -158,6 +158,11 @@ def porosity_in_region(centers, radii, region, *, chunk=256):
     return 1.0 - solid / region.volume
 
 
+#: relative distance within which two spheres touch for :func:`coordination_numbers`: spheres
+#: placed touching (a lattice written to a file) land within rounding of r_i + r_j, either side
+CONTACT_RTOL = 1e-9
+
+
 def coordination_numbers(centers, radii, *, cutoff_m=None, contact_tol_m=0.0, select=None):
     """Coordination number of each selected particle.
 
@@ -167,7 +172,8 @@ def coordination_numbers(centers, radii, *, cutoff_m=None, contact_tol_m=0.0, se
     radii : (N,) array, m
     cutoff_m : float, optional
         Count neighbours whose centre distance is below this (thesis: 1.05 d_max).
-        If None, count true contacts: distance < r_i + r_j + contact_tol_m.
+        If None, count true contacts: distance < (r_i + r_j)(1 + :data:`CONTACT_RTOL`)
+        + contact_tol_m (touching to rounding counts: a file's simple cubic lattice gives 6).
     select : (N,) bool array, optional
         Particles whose coordination is returned (neighbours are counted among all).
 
@@ -178,11 +184,12 @@ def coordination_numbers(centers, radii, *, cutoff_m=None, contact_tol_m=0.0, se
     centers = np.asarray(centers, dtype=float)
     radii = np.asarray(radii, dtype=float)
     n = len(radii)
-    reach = cutoff_m if cutoff_m is not None else 2 * radii.max() + contact_tol_m
+    reach = (cutoff_m if cutoff_m is not None
+             else 2 * radii.max() * (1 + CONTACT_RTOL) + contact_tol_m)
     pairs = cKDTree(centers).query_pairs(reach, output_type="ndarray")
     if cutoff_m is None and len(pairs):
         i, j = pairs[:, 0], pairs[:, 1]
         d = np.linalg.norm(centers[j] - centers[i], axis=1)
-        pairs = pairs[d < radii[i] + radii[j] + contact_tol_m]
+        pairs = pairs[d < (radii[i] + radii[j]) * (1 + CONTACT_RTOL) + contact_tol_m]
     z = np.bincount(pairs.ravel(), minlength=n)
     return z if select is None else z[select]
