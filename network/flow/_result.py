@@ -222,7 +222,8 @@ def combined_summary(results, *, seconds: dict | None = None, packing=None) -> d
 
     One axis: its :meth:`FlowResult.summary`. Several: the arithmetic mean of the directional
     permeabilities, :math:`\bar k = \tfrac13 \sum_a k_a`, the gradient :math:`\mu v/\bar k`
-    (Pa/m) and drop over the depth (Pa) it gives, the anisotropy :math:`k_a/\bar k`, and every
+    (Pa/m) and drop over the depth (Pa) it gives (Stokes, said in ``pressure_gradient_note``; with
+    inertia each axis has its own under ``by_axis``), the anisotropy :math:`k_a/\bar k`, and every
     axis's own summary under ``by_axis``. ``seconds`` is merged into the ``seconds`` entry.
     With the three axes, the diagonal of the permeability tensor ``permeability_tensor_m2``
     (k_xx, k_yy, k_zz, m²) and ``horizontal_to_vertical_resistance`` =
@@ -250,6 +251,9 @@ def combined_summary(results, *, seconds: dict | None = None, packing=None) -> d
         "k_over_d2": k / first.sauter_diameter_m**2,
         "pressure_gradient_pa_per_m": grad,
         "pressure_drop_pa": grad * first.depth_m,
+        "pressure_gradient_note": "Stokes, mu v / the mean k" + (
+            "; each axis's value with inertia is under by_axis"
+            if any("pressure_gradient_stokes_pa_per_m" in b for b in by.values()) else ""),
         "porosity": first.porosity,
         "porosity_std": first.porosity_std,
         "n_pores": max(r.n_pores for r in results),
