@@ -72,3 +72,18 @@ def test_ordinary_throats_keep_their_numbers():
                                            0.005935162017756895, 0.00922221395079946,
                                            0.007085161350289585, 0.009949641855307953],
                                rtol=1e-10)
+
+
+@pytest.mark.parametrize("radii, sides", [
+    ([1.0, 1.0, 0.01], [2.0, 1.01, 1.01]),          # a fine touching two unit spheres, type d
+    ([100.0, 1.0, 1.0], [100.5, 101.2, 2.5]),       # two unit spheres beside a 100x larger one
+])
+def test_a_fine_is_closed_on_its_own_scale(radii, sides):
+    # at a closing width of 0.01 r_bar these lost 8.5 % and 9.8 % of Q* (the fine's passages
+    # closed on the large spheres' scale, with an error estimate of 1e-5); now the width scales
+    # with the smallest disk below 0.25 r_bar: the same Q* as a 20x narrower width to 1e-4
+    a = throats.solve_fem([radii], [sides], rtol=1e-3)
+    b = throats.solve_fem([radii], [sides], rtol=1e-5, delta=0.0005)
+    assert a.status[0] == "ok" and abs(a.qstar[0] / b.qstar[0] - 1) < 1e-4
+    rs, _ = throats.canonical_form([radii], [sides])
+    assert throats._solve.closing_width(rs)[0] == pytest.approx(0.01 * rs.min() / 0.25)
