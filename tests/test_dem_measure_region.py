@@ -4,9 +4,8 @@ against exact volumes, and a whole region against network's exact sphere-region 
 import numpy as np
 import pytest
 
-from dem import Container, Region, porosity_in_region
+from dem import Container, Region, generate_spheres, porosity_in_region
 from dem._cut_volume import cut_volume
-from dem._fill import generate_spheres
 
 V1 = 4.0 / 3.0 * np.pi
 
