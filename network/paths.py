@@ -44,7 +44,7 @@ from .conductance import POLICIES
 from .flow import DEFAULT_DEPTH_M, asabe_d272_gradient, ergun_gradient, solve_network
 from .packing import UNITS, Packing, random_packing
 from .pores import (NoInteriorError, Region, axis_index, default_region, region_porosity,
-                    tessellate, tie_groups)
+                    tessellate)
 
 _ALL = ("widest", "narrowest", "maximin", "shortest")
 #: Thesis values (Tables 4.1-4.5) printed beside ours (pressures: over 0.25 m of soybeans).
@@ -419,9 +419,8 @@ def _pressure_along(args, x, r, source, tess, graph, paths):
                         policy=args.policy, velocity_m_s=args.velocity[0], porosity_points=0,
                         depth_m=args.depth, viscosity_pa_s=args.viscosity,
                         region=Region(lo + m, hi - m))
-    labels, n_groups = tie_groups(tess)
-    p_all = pore_pressure_array(tess.n_pores, res.pore_ids, res.pressure_pa,
-                                None if n_groups == tess.n_pores else labels)
+    # the solver's own pore bodies (merged tetrahedra): its pore_ids are their labels
+    p_all = pore_pressure_array(tess.n_pores, res.pore_ids, res.pressure_pa, res.pore_groups)
     grad = res.pressure_gradient_pa_per_m
     print(f"network model ({args.policy}) at {args.velocity[0]:g} m/s: gradient {grad:.4g} Pa/m, "
           f"{res.pressure_drop_pa:.4g} Pa over {res.depth_m:g} m ({time.perf_counter() - t:.1f} s)")

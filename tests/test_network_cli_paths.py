@@ -129,3 +129,16 @@ def test_plot_without_matplotlib_names_the_extra(monkeypatch, tmp_path, capsys):
     assert main([SCENE, "--plot", str(tmp_path / "p.png")]) == 2
     err = capsys.readouterr().err
     assert err.count("\n") == 1 and "pip install '.[plot]'" in err
+
+
+def test_pressure_along_the_paths_falls_with_height(tmp_path):
+    # --pressure read the solver's pressures by tetrahedron while the solver had merged
+    # tetrahedra into pore bodies: scrambled values, 18 of 40 drops negative (the audit)
+    out = tmp_path / "p.json"
+    assert main([SCENE, "--entries", "6", "--kind", "shortest", "--pressure",
+                       "--json", str(out)]) == 0
+    along = json.loads(out.read_text())["pressure_along_paths"]
+    assert len(along) >= 4
+    for a in along:
+        pos, pr = np.array(a["position_m"]), np.array(a["pressure_pa"])
+        assert a["dp_pa"] > 0 and np.corrcoef(pos, pr)[0, 1] < -0.9
