@@ -30,6 +30,7 @@ from __future__ import annotations
 
 import dataclasses
 import json
+import math
 import os
 import platform
 import time
@@ -55,6 +56,8 @@ THESIS = {
     "branched_mfx3_average_pa": {"0.013": 2.74, "0.027": 5.65},
     "measured_pa": {"0.013": 2.44, "0.027": 6.80},
 }
+#: Most entry points (each traces up to four paths; 1e8 ran out of memory, 1e6 took minutes)
+MAX_ENTRIES = 10_000
 #: Bed depth of the thesis's measured and modelled pressure drops (Table 4.5), m.
 THESIS_DEPTH_M = 0.25
 CONVENTIONS = {
@@ -171,11 +174,11 @@ def main(argv=None) -> int:
 
 def _check_options(args) -> None:
     """Options and output paths, before the packing is read (ValueError names the option)."""
-    if args.entries is not None and args.entries < 1:
-        raise ValueError(f"--entries n must be >= 1 (number of entry points), got "
-                         f"{args.entries}")
-    if any(not u > 0 for u in args.velocity):
-        raise ValueError(f"--velocity must be > 0 m/s, got {args.velocity}")
+    if args.entries is not None and not 1 <= args.entries <= MAX_ENTRIES:
+        raise ValueError(f"--entries n must be 1-{MAX_ENTRIES} (entry points: 1e8 ran out of "
+                         f"memory), got {args.entries}")
+    if any(not (math.isfinite(u) and u > 0) for u in args.velocity):
+        raise ValueError(f"--velocity must be finite and > 0 m/s, got {args.velocity}")
     if args.seed < 0:
         raise ValueError(f"--seed must be an integer >= 0, got {args.seed}")
     if args.standin:

@@ -15,8 +15,8 @@ SCENE = "network/data/soybean_default.csv"
 @pytest.mark.parametrize("argv, words", [
     ([], "give PACKING or --standin"),
     (["no/such/packing.csv"], "no/such/packing.csv"),
-    ([SCENE, "--entries", "0"], "n must be >= 1"),
-    ([SCENE, "--velocity", "0.013", "-0.02"], "--velocity must be > 0"),
+    ([SCENE, "--entries", "0"], "n must be 1-10000"),
+    ([SCENE, "--velocity", "0.013", "-0.02"], "--velocity must be finite and > 0"),
     (["--standin", "0.04", "0", "0.06"], "three box sides > 0"),
 ])
 def test_bad_input_exits_2_with_one_line(argv, words, capsys):

@@ -92,8 +92,11 @@ def test_units_mm_gives_the_same_paths(bed, tmp_path, capsys):
 
 
 @pytest.mark.parametrize("argv, words", [
-    ([SCENE, "--entries", "0"], "--entries n must be >= 1"),
-    ([SCENE, "--entries", "-3"], "--entries n must be >= 1 (number of entry points), got -3"),
+    ([SCENE, "--entries", "0"], "--entries n must be 1-10000"),
+    ([SCENE, "--entries", "-3"], "--entries n must be 1-10000 (entry points: 1e8 ran out of "
+                                 "memory), got -3"),
+    ([SCENE, "--entries", "100000000"], "--entries n must be 1-10000"),
+    ([SCENE, "--velocity", "inf"], "--velocity must be finite and > 0 m/s, got [inf]"),
     ([SCENE, "--entry", "0.5", "0.02"], "--entry 0.5 0.02 lies outside the bed, which spans x"),
     ([SCENE, "--entry", "0.02", "0.5", "--axis", "X"], "spans y -1.117e-05..0.072987, z"),
     ([SCENE, "--depth", "0"], "--depth must be finite and > 0"),
