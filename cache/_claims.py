@@ -79,10 +79,15 @@ def claim(store, keys, *, solver_version, rtol, owner, done_statuses):
 
 
 def release(store, owner):
-    """Drop every claim of ``owner`` (its run ended); never raises."""
+    """Drop every claim of ``owner`` (its run ended), and the void ones of other runs (lease
+    run out, or a process on this host that is gone: a run killed with ``kill -9`` left its
+    claims in the table for good); never raises."""
     try:
         with store.transaction():
             store.conn.execute(_SCHEMA)
-            store.conn.execute("DELETE FROM claims WHERE owner = ?", (owner,))
+            others = [o for (o,) in store.conn.execute("SELECT DISTINCT owner FROM claims")]
+            gone = [owner] + [o for o in others if o != owner and not _alive(o)]
+            store.conn.executemany("DELETE FROM claims WHERE owner = ?", [(o,) for o in gone])
+            store.conn.execute("DELETE FROM claims WHERE expires < ?", (time.time(),))
     except Exception:  # noqa: BLE001 - a claim left behind expires on its own
         pass

@@ -34,6 +34,7 @@ import throats
 from throats.solve import OneLineParser, check_output
 
 from ._csvio import read_throat_csv, row_problems, write_csv
+from ._interp import GRIDS
 from ._lookup import POLICIES, lookup_qstar
 from ._store import CacheFileError
 
@@ -88,6 +89,9 @@ def _main(argv):
             raise ValueError(f"--rtol must be in (0, 1), got {args.rtol}")
         if args.workers < 1:
             raise ValueError(f"--workers must be >= 1, got {args.workers}")
+        if args.grid is not None and args.grid not in GRIDS:
+            raise ValueError(f"--grid {args.grid}: no such grid; the grids are "
+                             f"{', '.join(GRIDS)}")
         check_output(args.out)
         if args.db is not None and not os.path.isfile(args.db):
             check_output(args.db, "--db")      # to be created: its folder must exist, writable

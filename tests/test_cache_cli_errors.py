@@ -71,6 +71,8 @@ LOOKUP = [
     (["--csv", "cols.csv", "--out", "o.csv"], "missing column(s)"),
     (["--csv", "missing.csv", "--out", "o.csv"], "missing.csv"),
     (["--csv", "good.csv", "--out", "o.csv", "--policy", "table"], "invalid choice: 'table'"),
+    (["--csv", "good.csv", "--out", "o.csv", "--grid", "G1"],       # was served by the estimate
+     "--grid G1: no such grid; the grids are tiny, g2, g1, x1, d1"),
 ]
 
 

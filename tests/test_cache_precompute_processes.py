@@ -109,6 +109,8 @@ def test_workers_exit_after_kill_9_of_the_parent_and_a_rerun_finishes(tmp_path):
     with open_store(db) as store:
         summ = precompute_throats(store, r, s)
         assert store.count() == 300
+        # and the rerun cleared them (they stayed in the table for good before session 21)
+        assert store.conn.execute("SELECT COUNT(*) FROM claims").fetchone()[0] == 0
     assert summ.solved == 300 - before and summ.extra["remaining"] == 0
 
 
