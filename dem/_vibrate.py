@@ -5,7 +5,8 @@ The floor and side walls of the bin move together,
 .. math:: z_w(t) = A \sin(\omega t), \qquad \dot z_w(t) = A\omega\cos(\omega t),
           \qquad \Gamma = A\omega^2 / g \quad (\text{thesis Eq. 3.11}),
 
-for ``duration_s``; the walls then stop at z = 0 and the bed settles to equilibrium
+for ``duration_s`` (to the end of its half period: the walls pass z = 0 there); the walls then
+stop at z = 0 and the bed settles to equilibrium
 (mean unbalanced-force ratio below ``tol``) before the final measurement. Porosity
 histories are measured in the floor's frame: measurement spheres (B1–B5) and the
 interior region (two mean diameters from the walls, the floor and the initial surface).
@@ -28,6 +29,8 @@ __all__ = ["vibrate_bed", "VibrationResult", "intensity_g", "rest_motion", "REST
 
 log = logging.getLogger(__name__)
 G = 9.81
+#: fewest time steps a vibration period must have (1e6 Hz gave 0.07 of a step per period)
+MIN_STEPS_PER_PERIOD = 20
 
 
 def intensity_g(freq_hz, amplitude_m):
@@ -131,6 +134,10 @@ def vibrate_bed(centers, radii, container, *, freq_hz=15.0, amplitude_m=0.002, d
     vp = float(sphere_volume(radii).sum())
     sim = make_simulation(container, centers, radii, material=material, lid=False, mass_scale=mass_scale,
                           dt_safety=dt_safety, threads=threads)
+    if sim.dt * freq_hz > 1.0 / MIN_STEPS_PER_PERIOD:
+        raise ValueError(f"a frequency of {freq_hz:g} Hz is not resolved by the time step "
+                         f"{sim.dt:.3g} s ({1 / (sim.dt * freq_hz):.3g} steps a period, at least "
+                         f"{MIN_STEPS_PER_PERIOD})")
     sim.bounds_m[1, 2] += 2 * amplitude_m + 0.1  # bed may dilate upwards
     sim.bounds_m[0, 2] -= amplitude_m
     if resume is None and rest_tol is not None:
@@ -185,6 +192,13 @@ def vibrate_bed(centers, radii, container, *, freq_hz=15.0, amplitude_m=0.002, d
             next_ckpt += checkpoint_every_s
             checkpoint({"state": sim.get_state(), "history": {k: list(v) for k, v in hist.items()},
                         "snapshots": dict(snaps), "next_record_s": next_rec, "next_checkpoint_s": next_ckpt})
+    # stop at a zero of the floor's motion (a whole number of half periods, within half a step):
+    # a duration or a steady stop off it moved the floor by up to A at once, into the bed or away
+    t_end = np.ceil((sim.time_s - dt) * 2 * freq_hz) / (2 * freq_hz)
+    while sim.time_s < t_end - 0.5 * dt:
+        sim.z_offset_m = amplitude_m * np.sin(omega * sim.time_s)
+        sim.wall_vz_m_s = amplitude_m * omega * np.cos(omega * sim.time_s)
+        sim.step()
     vib_wall = time.perf_counter() - t0
     vib_steps, vib_time = sim.steps, sim.time_s
     sim.z_offset_m = 0.0
