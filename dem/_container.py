@@ -98,12 +98,14 @@ class Container:
         return np.array([lo, hi])
 
     def interior(self, margin_m, top_m):
-        """Region at least ``margin_m`` from the side walls (x only for a box thinner than
-        4 margins in y), the floor and the bed top ``top_m``."""
+        """Region at least ``margin_m`` from the side walls (x only for a slab: y thinner than
+        4 margins and than half of x, as the thesis's rect-bin), the floor and the bed top
+        ``top_m``."""
         z = (margin_m, top_m - margin_m)
         if self.kind == "box":
             lx, ly = self.size_m
-            my = margin_m if ly > 4 * margin_m else 0.0
+            slab = ly <= 4 * margin_m and (ly < 0.5 * lx or ly <= 2 * margin_m)
+            my = 0.0 if slab else margin_m     # a small square box keeps its y margin too
             return Region("box", (-lx / 2 + margin_m, -ly / 2 + my, z[0]), (lx / 2 - margin_m, ly / 2 - my, z[1]))
         return Region("cylinder", (0, 0, z[0]), (0, 0, z[1]), radius=self.size_m[0] / 2 - margin_m)
 

@@ -59,3 +59,14 @@ def test_region_porosity_against_network_exact():
                                            radius=0.011, center_xy=(mid[0], mid[1])))
     theirs, err = region_porosity(Packing(c, r), NetRegion(lo, hi, radius=0.011), 2)
     assert mine == pytest.approx(theirs, abs=2e-6 + err)
+
+
+def test_interior_keeps_a_small_square_box_off_its_walls():
+    # the y margin was dropped whenever y was under 4 margins, so a 0.05 m square box counted
+    # its wall layers as interior (porosity 0.4210 against 0.3808 with both margins); only a
+    # slab like the thesis's rect-bin (0.25 x 0.02 m) is measured wall to wall in y
+    m = 0.0129
+    sq = Container("box", (0.05, 0.05), 0.04).interior(m, 0.035)
+    assert sq.lo[:2] == pytest.approx((-0.025 + m, -0.025 + m))
+    slab = Container("box", (0.25, 0.02), 0.25).interior(m, 0.2)
+    assert slab.lo[:2] == pytest.approx((-0.125 + m, -0.01)) and slab.hi[1] == pytest.approx(0.01)
