@@ -153,6 +153,17 @@ def write_html(path, r: dict, png: dict) -> None:
                      f"{s:.2f} &plusmn; {se:.2f} at {u:.3g} m/s" for s, se, u in
                      zip(band["slopes"], band["slope_stderrs"], band["velocities_m_s"]))
                  + f" from {len(band['beds'])} beds of {html.escape(band['packer'])}.")
+    bn = r["bin"]
+    way = ("vertical airflow (z), depth" if bn["flow_axis"] == "z"
+           else "horizontal airflow (x), thickness crossed")
+    size = (f"{way} {bn['depth_m']:g} m, "
+            + (f"diameter {bn['diameter_m']:g} m, " if bn.get("diameter_m") else "")
+            + f"floor {bn['floor_area_m2']:.4g} m^2, {bn['grain_mass_t']:.4g} t")
+    a = r.get("airflow")
+    if a:
+        op_text = (f"Airflow asked: {a['airflow_m3_min_t']:.4g} m^3/(min t) = "
+                   f"{a['velocity_m_s']:.4g} m/s, {a['airflow_m3_s']:.4g} m^3/s, static pressure "
+                   f"{a['static_pressure_pa']:.4g} Pa. " + op_text)
     imgs = "".join(f'<p><img alt="{n}" src="data:image/png;base64,'
                    f'{base64.b64encode(b).decode("ascii")}"></p>' for n, b in png.items())
     doc = f"""<!DOCTYPE html>
@@ -166,8 +177,7 @@ table{{border-collapse:collapse}}td,th{{border:1px solid #aaa;padding:2px 6px;te
 {r['bulk_density_kg_m3']:.1f} kg/m^3 (kernel density {r['particle_density_kg_m3']:g} kg/m^3,
 {html.escape(r['particle_density_source'])}).</p>
 <h2>Resistance curve</h2>{curve}<p>{band_text}</p><ul>{fits}</ul>
-<h2>System curve</h2><p>Depth {r['bin']['depth_m']:g} m, floor {r['bin']['floor_area_m2']:.4g}
-m^2, {r['bin']['grain_mass_t']:.4g} t; static pressure of the grain only.</p>{system}
+<h2>System curve</h2><p>{html.escape(size)}; static pressure of the grain only.</p>{system}
 <p>{html.escape(op_text)}</p>
 <h2>Plots</h2>{imgs}
 </body></html>

@@ -223,9 +223,13 @@ def test_axis_x_puts_the_horizontal_curve_into_the_system_curve(tmp_path, capsys
     out = tmp_path / "x.json"
     assert main(["--grain", "soybean", "--velocities", "0.01,0.1", "--no-band", "--no-figures",
                  "--axis", "X", "--depth", "2", "--floor-area", "3", "--airflow", "0.05", "m/s",
-                 "--json", str(out), "-q"]) == 0
+                 "--json", str(out), "--html", str(tmp_path / "x.html"), "-q"]) == 0
     r = json.loads(out.read_text())
     assert r["bin"]["flow_axis"] == "x"
+    # the HTML says so too, and the airflow asked (it read as a vertical bin before)
+    page = (tmp_path / "x.html").read_text()
+    assert "horizontal airflow (x), thickness crossed 2 m, floor 3 m^2" in page
+    assert "Airflow asked: " in page and "= 0.05 m/s" in page
     by_u = {p["velocity_m_s"]: p for p in r["points"]}
     assert sorted(by_u) == [0.01, 0.05, 0.1]
     for s in r["system_curve"]:
