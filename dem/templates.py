@@ -200,7 +200,7 @@ def template_from_axes(axes_m, *, max_spheres=9, min_spheres=5, name="grain", so
 
 
 #: sphere counts tried, in order, for a library grain: the default range first (5-9), more only
-#: when 9 spheres miss the 2 % (shelled corn: 11, barley: 14; rough rice: none up to 15)
+#: when 9 spheres miss the 2 % (shelled corn: 11, barley: 12; rough rice: none up to 15)
 LIBRARY_MAX_SPHERES = (9, 11, 13, 15)
 
 
