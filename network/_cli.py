@@ -178,9 +178,12 @@ def progress_log(args, fmt: str = "[%(relativeCreated)7.0f ms] %(message)s") -> 
     root.setLevel(min(root.level or logging.WARNING, logging.INFO))
 
 
-def run(body, parser: argparse.ArgumentParser, argv=None) -> int:
+def run(body, parser: argparse.ArgumentParser, argv=None, *,
+        interrupted: str | None = None) -> int:
     """Parse ``argv``, call ``body(args)`` with numpy/scipy warnings captured, return its exit
     code; a :class:`CliError` (or any other exception: exit 1) becomes one ``error:`` line.
+    Ctrl-C is exit 1 with one ``error: interrupted`` line, or ``interrupted: <interrupted>``
+    where that text is given.
 
     Captured warnings do not reach the terminal; when there were any, one line says how many
     and quotes the first (the checks of the result decide whether it is good). The library's
@@ -193,14 +196,14 @@ def run(body, parser: argparse.ArgumentParser, argv=None) -> int:
     root.addHandler(lines)
     _INSTALLED.append(lines)
     try:
-        return _run(body, parser, argv, debug)
+        return _run(body, parser, argv, debug, interrupted)
     finally:
         while len(_INSTALLED) > mark:
             root.removeHandler(_INSTALLED.pop())
         root.setLevel(level)
 
 
-def _run(body, parser, argv, debug) -> int:
+def _run(body, parser, argv, debug, interrupted=None) -> int:
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always")
         try:
@@ -209,8 +212,8 @@ def _run(body, parser, argv, debug) -> int:
             print(f"error: {' '.join(str(exc).split())}", file=sys.stderr)
             code = exc.code
         except KeyboardInterrupt:
-            print("error: interrupted; no output written after the interruption",
-                  file=sys.stderr)
+            print(f"interrupted: {interrupted}" if interrupted else
+                  "error: interrupted; no output written after the interruption", file=sys.stderr)
             code = EXIT_FAILED
         except Exception as exc:  # noqa: BLE001 - the convention: one line, no traceback
             if debug:

@@ -39,18 +39,29 @@ from __future__ import annotations
 
 import argparse
 import json
+import math
 import sys
+import tempfile
 from pathlib import Path
 
+from ._cli import EXIT_OK, CliParser, bad_input, check_outputs, computing, run
 from .benchmarks import (REF_LATTICE_CASES, REF_RANDOM_POROSITIES, baseline_source, has_grid,
                          inertial_lines, inertial_speed, inertial_validation, lattice_case,
                          machine, per_packing, policies, policy_lines, references,
                          references_table, run_one, scaling, scaling_exponent)
 from .conductance import MODELS, POLICIES
 
+#: fewest spheres of a generated packing (``network.packing.random_packing``'s own limit)
+MIN_SPHERES = 5
+#: the parts that each run alone (the help says so): any two of them are refused
+ALONE = ("references_only", "inertial", "per_packing")
+INTERRUPTED = ("the benchmark stopped; no JSON report written (packings generated so far are "
+               "kept in --workdir)")
 
-def main(argv=None) -> int:
-    ap = argparse.ArgumentParser(prog="python -m network.bench", description=__doc__.split("\n")[0])
+
+def build_parser() -> CliParser:
+    """The options of ``python -m network.bench``."""
+    ap = CliParser(prog="python -m network.bench", description=__doc__.split("\n")[0])
     ap.add_argument("--sizes", type=int, nargs="*", default=None,
                     help="sphere counts of the scaling part (default 5000 20000 100000; add "
                          "500000 for the full run; --per-packing: default 5000 20000)")
@@ -96,7 +107,7 @@ def main(argv=None) -> int:
     ap.add_argument("--seed", type=int, default=1, help="seed of the generated packings (default 1)")
     ap.add_argument("--repeats", type=int, default=None,
                     help="repeats per size (minimum reported; default 2, --per-packing 7)")
-    ap.add_argument("--timeout", type=float, default=1800.0, help="per-size limit, s")
+    ap.add_argument("--timeout", type=float, default=1800.0, help="per-size limit, s, > 0")
     ap.add_argument("--json", dest="json_out", default="network_bench.json",
                     help="output JSON path (default network_bench.json)")
     ap.add_argument("--inertial", action="store_true",
@@ -121,18 +132,73 @@ def main(argv=None) -> int:
                          "the paired speed-up, on this host, beside the one the issue asks for")
     ap.add_argument("--one", default=None, help=argparse.SUPPRESS)
     ap.add_argument("--no-trace", action="store_true", help=argparse.SUPPRESS)
-    args = ap.parse_args(argv)
-    if args.inertial_workers is not None and args.inertial_workers < 1:
-        ap.error(f"--inertial-workers must be >= 1, got {args.inertial_workers}")
-    if (args.yade or args.baseline) and (not args.per_packing or args.inertial):
-        ap.error("--yade and --baseline go with --per-packing (and not --inertial)")
-    if args.references_only and args.skip_references:
-        ap.error("--references-only and --skip-references exclude each other")
-    if args.ref_repeats < 1 or args.ref_spheres < 1:
-        ap.error("--ref-repeats and --ref-spheres must be >= 1")
-    for eps in args.ref_random:
+    return ap
+
+
+def main(argv=None) -> int:
+    """Run the benchmark: 0 done; SystemExit(1) the computation failed or was interrupted,
+    SystemExit(2) bad input (one ``error:`` line naming the option, before any work)."""
+    code = run(_main, build_parser(), argv, interrupted=INTERRUPTED)
+    if code != EXIT_OK:
+        raise SystemExit(code)
+    return code
+
+
+def _at_least(option: str, values, low) -> None:
+    for v in values:
+        if v is not None and v < low:
+            raise ValueError(f"{option} must be >= {low}, got {v}")
+
+
+def _porosities(option: str, values) -> None:
+    for eps in values:
         if not 0.36 <= eps < 1.0:
-            ap.error(f"--ref-random porosity {eps} outside [0.36, 1)")
+            raise ValueError(f"{option} porosity {eps} outside [0.36, 1)")
+
+
+def _check_workdir(path: Path) -> None:
+    """ValueError unless ``--workdir`` is a folder that takes new files, or can be made as one
+    (its nearest existing parent a writable folder)."""
+    here = path
+    while not here.exists() and here != here.parent:
+        here = here.parent
+    if not here.is_dir():
+        raise ValueError(f"--workdir {path}: {here} is not a folder")
+    try:
+        tempfile.TemporaryFile(dir=here, prefix=".grainflow-").close()
+    except OSError as exc:
+        raise ValueError(f"--workdir {path}: folder {here} is not writable "
+                         f"({exc.strerror or exc})") from None
+
+
+def _check(args) -> None:
+    """Every option, before any work (ValueError names the option and its value)."""
+    alone = [f"--{k.replace('_', '-')}" for k in ALONE if getattr(args, k)]
+    if len(alone) > 1:
+        raise ValueError(f"{' and '.join(alone)} exclude each other: each runs alone "
+                         "(see --help)")
+    if args.inertial_workers is not None and args.inertial_workers < 1:
+        raise ValueError(f"--inertial-workers must be >= 1, got {args.inertial_workers}")
+    if (args.yade or args.baseline) and not args.per_packing:
+        raise ValueError("--yade and --baseline go with --per-packing (and not --inertial)")
+    if args.references_only and args.skip_references:
+        raise ValueError("--references-only and --skip-references exclude each other")
+    _at_least("--ref-repeats", [args.ref_repeats], 1)
+    _at_least("--workers", [args.workers], 1)
+    for opt in ("--sizes", "--policy-spheres", "--inertial-spheres", "--ref-spheres"):
+        value = getattr(args, opt[2:].replace("-", "_"))
+        _at_least(opt, value if isinstance(value, list) else [value], MIN_SPHERES)
+    _at_least("--seed", [args.seed], 0)
+    _at_least("--ref-seed", [args.ref_seed], 0)
+    if not (math.isfinite(args.timeout) and args.timeout > 0):
+        raise ValueError(f"--timeout must be a finite number of seconds > 0, got {args.timeout}")
+    _porosities("--ref-random", args.ref_random)
+    _porosities("--fe-random", args.fe_random)
+    if args.db is not None and Path(args.db).is_dir():
+        raise ValueError(f"--db {args.db}: is a folder, give the table's file")
+    parts_3 = not (args.skip_references or args.inertial or args.per_packing or args.one)
+    if args.db is not None and parts_3 and not Path(args.db).is_file():
+        raise ValueError(f"--db {args.db}: no such file (part 3 reads the table)")
     if args.references_only:
         args.skip_policies = True
         args.sizes = []
@@ -140,21 +206,30 @@ def main(argv=None) -> int:
         args.sizes = [5000, 20000] if args.per_packing else [5000, 20000, 100000]
     if args.repeats is None:
         args.repeats = 7 if args.per_packing else 2
-    if args.repeats < 1:
-        ap.error(f"--repeats must be >= 1, got {args.repeats}")
-    if args.baseline:
-        try:            # the last check: a commit is extracted here, removed by per_packing
-            args.baseline = baseline_source(args.baseline)
-        except ValueError as exc:
-            ap.error(str(exc))
+    _at_least("--repeats", [args.repeats], 1)
 
+
+def _main(args) -> int:
+    with bad_input():
+        _check(args)
+        if not args.one:
+            check_outputs(json=args.json_out)
+            args.workdir = Path(args.workdir or Path.home() / ".cache" / "grainflow" / "bench")
+            _check_workdir(args.workdir)
+        if args.baseline:   # the last check: a commit is extracted here, removed by per_packing
+            args.baseline = baseline_source(args.baseline)
+    with computing():
+        return _work(args)
+
+
+def _work(args) -> int:
     if args.one:  # child process of the scaling part
         row = run_one(Path(args.one), args.policy, args.db, args.repeats, trace=not args.no_trace,
                       model=args.model)
         print(json.dumps(row))
         return 0
 
-    workdir = Path(args.workdir or Path.home() / ".cache" / "grainflow" / "bench")
+    workdir = args.workdir
     workdir.mkdir(parents=True, exist_ok=True)
     if args.inertial:
         report = {"machine_start": machine()}
