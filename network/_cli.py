@@ -340,13 +340,19 @@ def check_output_list(pairs, inputs=()) -> None:
         if key in seen:
             raise ValueError(f"{opt} {p}: the same file as {seen[key]}; give another name")
         seen[key] = f"{opt} {p}"
-        try:
-            tempfile.TemporaryFile(dir=folder, prefix=".grainflow-").close()
-        except OSError as exc:
-            raise ValueError(f"{opt} {p}: folder {folder} is not writable "
-                             f"({exc.strerror or exc})") from None
+        check_writable_folder(folder, f"{opt} {p}")
         if path.exists() and not os.access(path, os.W_OK):
             raise ValueError(f"{opt} {p}: file exists and is not writable")
+
+
+def check_writable_folder(folder, what: str) -> None:
+    """ValueError naming ``what`` unless a file can be made in ``folder``: tried with a temporary
+    file, removed at once (``os.access`` says yes to root even on ``/proc``)."""
+    try:
+        tempfile.TemporaryFile(dir=folder, prefix=".grainflow-").close()
+    except OSError as exc:
+        raise ValueError(f"{what}: folder {folder} is not writable "
+                         f"({exc.strerror or exc})") from None
 
 
 def packing_inputs(args) -> list:

@@ -41,10 +41,10 @@ import argparse
 import json
 import math
 import sys
-import tempfile
 from pathlib import Path
 
-from ._cli import EXIT_OK, CliParser, bad_input, check_outputs, computing, run
+from ._cli import (EXIT_OK, CliParser, bad_input, check_outputs, check_writable_folder, computing,
+                   run)
 from .benchmarks import (REF_LATTICE_CASES, REF_RANDOM_POROSITIES, baseline_source, has_grid,
                          inertial_lines, inertial_speed, inertial_validation, lattice_case,
                          machine, per_packing, policies, policy_lines, references,
@@ -164,11 +164,7 @@ def _check_workdir(path: Path) -> None:
         here = here.parent
     if not here.is_dir():
         raise ValueError(f"--workdir {path}: {here} is not a folder")
-    try:
-        tempfile.TemporaryFile(dir=here, prefix=".grainflow-").close()
-    except OSError as exc:
-        raise ValueError(f"--workdir {path}: folder {here} is not writable "
-                         f"({exc.strerror or exc})") from None
+    check_writable_folder(here, f"--workdir {path}")
 
 
 def _check(args) -> None:
