@@ -18,17 +18,20 @@
    in its box that g1 and the grids before it cannot serve (FE at ``rtol=1e-4``): its error and
    the shape-factor estimate's.
 
-Prints a table and writes JSON (with load average, platform, CPU count, timestamp).
+Prints a table and writes JSON (with load average, platform, CPU count, timestamp).  Exit
+status: 0 done, 1 failed or interrupted (Ctrl-C: nothing written), 2 bad options or files (one
+``error:`` line, checked before any work).
 """
 
 from __future__ import annotations
 
-import argparse
 import datetime as _dt
 import json
+import math
 import os
 import platform
 import shutil
+import sqlite3
 import sys
 import tempfile
 import time
@@ -44,17 +47,26 @@ from ._lookup import (default_db_path, grid_from_store, load_grid_table, lookup_
                       read_grid_file, shipped_grid_path)
 from ._orbits import EXTENSION_GRIDS
 from ._routes import table_routes
-from ._store import open_store
+from ._store import CacheFileError, open_store
+from .lookup import OneLineParser, check_output
+
+#: the arrays of a ``--reference`` file
+REFERENCE_KEYS = ("radii", "sides", "q_ref", "q_fe", "t_fe", "c_fe")
 
 
 def _pct(err):
     err = np.asarray(err, float)
     err = err[np.isfinite(err)]
     if not len(err):
-        return {"n": 0}
+        return {"n": 0, "median": None, "p90": None, "p99": None, "max": None}
     p = np.percentile(err, [50, 90, 99, 100])
     return {"n": int(len(err)), "median": float(p[0]), "p90": float(p[1]), "p99": float(p[2]),
             "max": float(p[3])}
+
+
+def _f(v, spec):
+    """``v`` formatted with ``spec``; '-' for a statistic of an empty set (None)."""
+    return "-" if v is None else format(v, spec)
 
 
 def _timed(fn, repeat):
@@ -68,24 +80,100 @@ def _timed(fn, repeat):
 
 
 def build_parser():
-    p = argparse.ArgumentParser(prog="python -m cache.bench", description=__doc__.split("\n")[0])
-    p.add_argument("--db", default=None, help="table with grid(s) (default: cache.default_db_path())")
-    p.add_argument("--n-fe", type=int, default=300, help="held-out throats solved by FE")
-    p.add_argument("--seed", type=int, default=2024, help="seed of the held-out throats (default 2024)")
-    p.add_argument("--n-batch", type=int, default=1_000_000, help="rows in the throughput batch")
-    p.add_argument("--repeat", type=int, default=3, help="timing repeats, best reported (default 3)")
-    p.add_argument("--rtols", default="3e-2,1e-2,3e-3,1e-3", help="rtol values for table+fe")
+    p = OneLineParser(prog="python -m cache.bench", description=__doc__.split("\n")[0])
+    p.add_argument("--db", default=None,
+                   help="table with grid(s), read only (default: cache.default_db_path()); a "
+                        "missing file in an existing folder: the shipped grids only")
+    p.add_argument("--n-fe", type=int, default=300,
+                   help="held-out throats solved by FE, >= 1 (default 300)")
+    p.add_argument("--seed", type=int, default=2024,
+                   help="seed of the held-out throats, >= 0 (default 2024)")
+    p.add_argument("--n-batch", type=int, default=1_000_000,
+                   help="rows in the throughput batch, >= 1 (default 1000000)")
+    p.add_argument("--repeat", type=int, default=3,
+                   help="timing repeats, >= 1, best reported (default 3)")
+    p.add_argument("--rtols", default="3e-2,1e-2,3e-3,1e-3",
+                   help="comma-separated rtol values for table+fe, each in (0, 1) "
+                        "(default 3e-2,1e-2,3e-3,1e-3)")
     p.add_argument("--reference", default=None,
-                   help="npz to cache the held-out FE reference in (reused when it exists)")
+                   help="npz to cache the held-out FE reference in (reused when it exists; "
+                        "else written, its folder must exist)")
     p.add_argument("--n-extension", type=int, default=200,
-                   help="held-out shapes for the extension grid, 0: none (default 200)")
-    p.add_argument("--out", default="cache_bench.json", help="output JSON path (default cache_bench.json)")
+                   help="held-out shapes for the extension grid, >= 0, 0: none (default 200)")
+    p.add_argument("--out", default="cache_bench.json",
+                   help="output JSON path, its folder must exist (default cache_bench.json)")
     return p
 
 
-def main(argv=None) -> int:
-    args = build_parser().parse_args(argv)
+def _check(args):
+    """(db path, rtols, reference arrays or None), every option checked before any work;
+    ValueError naming the option and value."""
+    for opt, v, lo in (("--n-fe", args.n_fe, 1), ("--n-batch", args.n_batch, 1),
+                       ("--repeat", args.repeat, 1), ("--n-extension", args.n_extension, 0),
+                       ("--seed", args.seed, 0)):
+        if v < lo:
+            raise ValueError(f"{opt} must be >= {lo}, got {v}")
+    try:
+        rtols = [float(v) for v in args.rtols.split(",") if v.strip()]
+    except ValueError:
+        rtols = []
+    if not rtols or not all(math.isfinite(v) and 0 < v < 1 for v in rtols):
+        raise ValueError(f"--rtols {args.rtols}: give comma-separated numbers, each in (0, 1)")
+    check_output(args.out, "--out")
     db = Path(args.db) if args.db else default_db_path()
+    if db.is_dir():
+        raise ValueError(f"--db {db}: is a folder, give a table file")
+    if db.exists():
+        try:
+            with open_store(db, create=False) as st:
+                st.grid_names()
+        except (CacheFileError, OSError, sqlite3.Error) as e:
+            raise ValueError(f"--db {db}: not a readable throat table ({e})") from None
+    elif args.db is not None:
+        if not db.parent.is_dir():
+            raise ValueError(f"--db {db}: no such file, and no folder {db.parent}")
+        print(f"note: --db {db} does not exist: the shipped grids only", file=sys.stderr)
+    ref = None
+    if args.reference:
+        rp = Path(args.reference)
+        if rp.is_dir():
+            raise ValueError(f"--reference {rp}: is a folder, give an .npz file")
+        if not rp.exists():
+            check_output(rp, "--reference")              # written once its FE solves finish
+            return db, rtols, None
+        try:
+            z = np.load(rp)
+            ref = {k: np.asarray(z[k], float) for k in REFERENCE_KEYS}
+        except Exception as e:      # junk: not an npz, pickled, or missing arrays
+            raise ValueError(f"--reference {rp}: not a reference written by cache.bench "
+                             f"({type(e).__name__}: {e})") from None
+        n = len(ref["radii"])
+        if ref["radii"].shape != (n, 3) or ref["sides"].shape != (n, 3) or n == 0 or \
+                ref["q_ref"].shape != (n,) or ref["q_fe"].shape != (n,):
+            raise ValueError(f"--reference {rp}: arrays of inconsistent shapes")
+    return db, rtols, ref
+
+
+def main(argv=None) -> int:
+    """Run the benchmark; exit 0 done, 1 failed or interrupted (Ctrl-C), 2 bad options."""
+    try:
+        args = build_parser().parse_args(argv)
+        try:
+            db, rtols, ref = _check(args)
+        except ValueError as e:
+            print(f"error: {e}", file=sys.stderr)
+            return 2
+        return _bench(args, db, rtols, ref)
+    except (RuntimeError, CacheFileError, sqlite3.Error) as e:
+        print(f"failed, nothing written: {e}", file=sys.stderr)
+        return 1
+    except KeyboardInterrupt:
+        print("interrupted: nothing written to --out (a new --reference is written only once "
+              "its FE solves finish)", file=sys.stderr)
+        return 1
+
+
+def _bench(args, db, rtols, loaded):
     version = throats.SOLVER_VERSION
     res = {"timestamp": _dt.datetime.now(_dt.timezone.utc).isoformat(timespec="seconds"),
            "platform": platform.platform(), "python": sys.version.split()[0],
@@ -94,10 +182,9 @@ def main(argv=None) -> int:
 
     # 1. held-out throats and their FE reference -------------------------------------------
     ref_path = Path(args.reference) if args.reference else None
-    if ref_path and ref_path.exists():
-        z = np.load(ref_path)
-        r, s, q_ref, q_fe = z["radii"], z["sides"], z["q_ref"], z["q_fe"]
-        t_fe, c_fe = float(z["t_fe"]), float(z["c_fe"])
+    if loaded is not None:
+        r, s, q_ref, q_fe = (loaded[k] for k in ("radii", "sides", "q_ref", "q_fe"))
+        t_fe, c_fe = float(loaded["t_fe"]), float(loaded["c_fe"])
     else:
         r, s = network.sample_throats(args.n_fe, rng=args.seed)
         ref = throats.solve_fem(r, s, rtol=1e-4)
@@ -111,6 +198,8 @@ def main(argv=None) -> int:
     good = np.isfinite(q_ref) & (q_ref > 0)
     r, s, q_ref, q_fe = r[good], s[good], q_ref[good], q_fe[good]
     n = len(r)
+    if n == 0:
+        raise RuntimeError("no held-out throat has a finite positive reference Q*")
     res["n_heldout"] = n
     rows = []
 
@@ -166,7 +255,7 @@ def main(argv=None) -> int:
         lk, w, c = _timed(lambda: lookup_qstar(r, s, db=db, policy="table-only", table=t), 1)
         rows.append((f"table-only [{best}]", _pct(rel(lk.qstar)), w[0] / n, c[0] / n,
                      float(np.mean(lk.source == "shape-factor"))))
-        for rt in [float(v) for v in args.rtols.split(",") if v]:
+        for rt in rtols:
             with tempfile.TemporaryDirectory() as tmp:
                 scratch = Path(tmp) / "scratch.sqlite"
                 if db.exists():
@@ -212,13 +301,14 @@ def main(argv=None) -> int:
           f"{'max':>8s} {'est>=err':>8s}")
     for k, v in res["tables"].items():
         e = v["error_all"]
-        print(f"{k:34s} {v['nodes']:7d} {v['coverage']:6.3f} {e['median']:8.2e} {e['p90']:8.2e} "
-              f"{e['p99']:8.2e} {e['max']:8.2e} {v['estimate_bounds_error'] or float('nan'):8.3f}")
+        print(f"{k:34s} {v['nodes']:7d} {v['coverage']:6.3f} {_f(e['median'], '.2e'):>8} "
+              f"{_f(e['p90'], '.2e'):>8} {_f(e['p99'], '.2e'):>8} {_f(e['max'], '.2e'):>8} "
+              f"{_f(v['estimate_bounds_error'], '.3f'):>8}")
     print(f"\n{'method':40s} {'wall s/th':>9s} {'cpu s/th':>9s} {'med err':>9s} {'p99 err':>9s} "
           f"{'max err':>9s} {'FE/SF':>6s}")
     for m, e, sec, cpu, f in rows:
-        print(f"{m:40s} {sec:9.2e} {cpu:9.2e} {e['median']:9.2e} {e['p99']:9.2e} {e['max']:9.2e} "
-              f"{f:6.3f}")
+        print(f"{m:40s} {sec:9.2e} {cpu:9.2e} {_f(e['median'], '.2e'):>9} "
+              f"{_f(e['p99'], '.2e'):>9} {_f(e['max'], '.2e'):>9} {f:6.3f}")
     for key in ("throughput_table_only", "throughput_interp_kernel", "throughput_shape_factor"):
         if key in res:
             v = res[key]
@@ -230,8 +320,8 @@ def main(argv=None) -> int:
               f"that the tables before it do not serve (FE rtol=1e-4): served {ext['served']}")
         for k in ("table", "shape_factor"):
             e = ext[k]
-            print(f"  {k:14s} median {e['median']:.2e}  p90 {e['p90']:.2e}  p99 {e['p99']:.2e}  "
-                  f"max {e['max']:.2e}")
+            print(f"  {k:14s} median {_f(e['median'], '.2e')}  p90 {_f(e['p90'], '.2e')}  "
+                  f"p99 {_f(e['p99'], '.2e')}  max {_f(e['max'], '.2e')}")
     for k in ("db_bytes", "shipped_g1_bytes", "shipped_g2_bytes", "table_rows",
               "precompute_solve_seconds"):
         if k in res:

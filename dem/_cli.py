@@ -10,6 +10,7 @@ of failures to exit codes, the project's convention: 2 for bad input (``ValueErr
 
 from __future__ import annotations
 
+import argparse
 import math
 import os
 import sys
@@ -22,7 +23,7 @@ from ._integrate import DemInstabilityError
 from ._perf import tune_malloc
 
 __all__ = ["EXIT_BAD_INPUT", "EXIT_FAILED", "EXIT_UNSTABLE", "run_main", "progress_printer",
-           "resolve_container", "check_output", "check_seed"]
+           "resolve_container", "check_output", "check_seed", "OneLineParser"]
 
 EXIT_BAD_INPUT = 2
 #: A computation that failed: unstable, not converged, interrupted (the same code as network's).
@@ -30,13 +31,22 @@ EXIT_FAILED = 1
 EXIT_UNSTABLE = EXIT_FAILED
 
 
-def run_main(parser, body, argv=None) -> int:
+class OneLineParser(argparse.ArgumentParser):
+    """``ArgumentParser`` whose usage errors are one ``error:`` line and exit 2."""
+
+    def error(self, message):
+        print(f"error: {message} (see {self.prog} --help)", file=sys.stderr)
+        raise SystemExit(EXIT_BAD_INPUT)
+
+
+def run_main(parser, body, argv=None, *, interrupted=None) -> int:
     """Parse ``argv`` with ``parser`` and return ``body(args)``, mapping failures to exit codes.
 
     A ``ValueError`` or ``OSError`` prints ``error: ...`` and returns 2; a
     ``DemInstabilityError`` prints ``unstable: ...`` and Ctrl-C ``interrupted: ...``, both
     returning 1 (what was written before stays: packings are written whole at the end, the
-    vibration study keeps its checkpoints). argparse's own errors exit 2 as usual.
+    vibration study keeps its checkpoints; ``interrupted`` replaces that line's text).
+    argparse's own errors exit 2 as usual.
     """
     tune_malloc()
     args = parser.parse_args(argv)
@@ -49,8 +59,9 @@ def run_main(parser, body, argv=None) -> int:
         print(f"unstable, not written: {e}", file=sys.stderr)
         return EXIT_UNSTABLE
     except KeyboardInterrupt:
-        print("interrupted: nothing more written (a packing is written whole at the end; a "
-              "vibration study resumes from its last checkpoint)", file=sys.stderr)
+        print("interrupted: " + (interrupted or "nothing more written (a packing is written "
+              "whole at the end; a vibration study resumes from its last checkpoint)"),
+              file=sys.stderr)
         return EXIT_FAILED
 
 

@@ -20,18 +20,20 @@ count and a timestamp.
 
 from __future__ import annotations
 
-import argparse
 import json
+import math
 import os
 import platform
+import subprocess
 import sys
 import time
+from pathlib import Path
 
 import numpy as np
 
+from ._cli import EXIT_FAILED, OneLineParser, check_output, run_main
 from ._container import Container, make_simulation
 from ._procedures import pack_bed
-from ._perf import tune_malloc
 from .clumps import ClumpSimulation
 from .templates import library_template
 from .vibrate import main as vibrate_main
@@ -121,7 +123,6 @@ def grain_pack_time(n_grains, *, seed=1, porosity=0.40985, out_dir=None, warm_up
     G soybeans at ``porosity`` (side (G V_g / (1 - porosity))^(1/3)), run as a subprocess after a
     warm-up of min(20, G) grains that fills numba's cache (``warm_up``). Returns the command, its wall
     and CPU seconds (s), the load averages, and the packing summary's steps, spheres and porosity."""
-    import subprocess
     import tempfile
     side = float((n_grains * library_template("soybean").volume_m3 / (1 - porosity)) ** (1 / 3))
     out_dir = out_dir or tempfile.mkdtemp(prefix="grain_pack_")
@@ -195,19 +196,20 @@ def study_row(out_dir, *, threads=None) -> dict:
             "particle_steps_per_s": st["n_spheres"] * sum(steps) / vib_wall if vib_wall > 0 else None}
 
 
-def main(argv=None) -> int:
-    tune_malloc()
-    p = argparse.ArgumentParser(prog="python -m dem.bench", description=__doc__.split("\n")[0])
-    p.add_argument("--n", type=int, nargs="+", default=[1000, 2000, 5000, 10000, 20000, 50000],
-                   help="sphere counts timed (default 1000 ... 50000)")
-    p.add_argument("--repeat", type=int, default=3, help="timing repeats, best and median reported (default 3)")
-    p.add_argument("--steps", type=int, default=None, help="steps per timing (default max(20, 2e6 / N))")
+def _parser():
+    p = OneLineParser(prog="python -m dem.bench", description=__doc__.split("\n")[0])
+    p.add_argument("--n", type=int, nargs="+", default=None,
+                   help="sphere counts timed, each >= 1 (default 1000 2000 5000 10000 20000 50000)")
+    p.add_argument("--repeat", type=int, default=3,
+                   help="timing repeats, >= 1, best and median reported (default 3)")
+    p.add_argument("--steps", type=int, default=None,
+                   help="steps per timing, >= 1 (default max(20, 2e6 / N))")
     p.add_argument("--threads", type=int, default=None,
-                   help="threads of the step kernels (default: chosen by timing, see dem._threads)")
+                   help="threads of the step kernels, >= 1 (default: chosen by timing, see dem._threads)")
     p.add_argument("--mass-scale-study", action="store_true",
                    help="instead of the rates: pack one bed at each --scales mass scale and compare")
-    p.add_argument("--scales", type=float, nargs="+", default=[1.0, 10.0, 100.0],
-                   help="--mass-scale-study: density scalings (default 1 10 100)")
+    p.add_argument("--scales", type=float, nargs="+", default=None,
+                   help="--mass-scale-study only: density scalings, finite and > 0 (default 1 10 100)")
     p.add_argument("--grains", type=int, nargs="+", default=None,
                    help="instead of the sphere rates: grain-engine rates for these soybean grain counts")
     p.add_argument("--grain-pack", type=int, default=None, metavar="G",
@@ -216,8 +218,60 @@ def main(argv=None) -> int:
                    help="instead of the rates: run (or resume, or reuse) the thesis vibration study on the "
                         "representative 0.10 x 0.25 m cylinder in DIR (about an hour on two cores) and print "
                         "its row against issue 17's one-hour target")
-    p.add_argument("--json", default="dem_bench.json", help="output JSON path (default dem_bench.json)")
-    args = p.parse_args(argv)
+    p.add_argument("--json", default="dem_bench.json",
+                   help="output JSON path, its folder must exist (default dem_bench.json, in the current folder)")
+    return p
+
+
+def _check_args(args) -> None:
+    """ValueError naming the option for any bad value or combination, before any work."""
+    def positive(opt, vals):
+        for v in vals:
+            if v is not None and v < 1:
+                raise ValueError(f"{opt} must be >= 1, got {v}")
+
+    positive("--n", args.n or [])
+    positive("--repeat", [args.repeat])
+    positive("--steps", [args.steps])
+    positive("--threads", [args.threads])
+    positive("--grains", args.grains or [])
+    positive("--grain-pack", [args.grain_pack])
+    for v in args.scales or []:
+        if not (math.isfinite(v) and v > 0):
+            raise ValueError(f"--scales must be finite and > 0, got {v:g}")
+    modes = [opt for opt, on in (("--study", args.study), ("--mass-scale-study", args.mass_scale_study),
+                                 ("--grains", args.grains), ("--grain-pack", args.grain_pack)) if on]
+    if len(modes) > 1 and set(modes) != {"--grains", "--grain-pack"}:
+        raise ValueError(f"{' and '.join(modes)}: one kind of run at a time (--grains goes with "
+                         "--grain-pack only)")
+    if args.n and modes:
+        raise ValueError(f"--n: the sphere rates only, not with {modes[0]}")
+    if args.scales and not args.mass_scale_study:
+        raise ValueError("--scales: only with --mass-scale-study")
+    if args.study:
+        check_output(Path(args.study) / "study.json", "--study")
+    check_output(args.json, "--json")
+    folder = Path(args.json).parent
+    if not folder.is_dir():
+        raise ValueError(f"--json {args.json}: folder {folder} does not exist")
+
+
+def main(argv=None) -> int:
+    """Run the benchmark; exit 0 done, 1 failed or interrupted (Ctrl-C), 2 bad input."""
+    return run_main(_parser(), _bench, argv,
+                    interrupted="nothing written (--json is written at the end)")
+
+
+def _bench(args) -> int:
+    _check_args(args)
+    try:
+        return _run(args)
+    except (RuntimeError, subprocess.CalledProcessError) as e:
+        print(f"failed, nothing written: {e}", file=sys.stderr)
+        return EXIT_FAILED
+
+
+def _run(args) -> int:
     meta = {"loadavg_before": os.getloadavg(), "platform": platform.platform(), "cpu_count": os.cpu_count(),
             "python": sys.version.split()[0], "numpy": np.__version__,
             "timestamp": time.strftime("%Y-%m-%dT%H:%M:%SZ", time.gmtime())}
@@ -236,7 +290,7 @@ def main(argv=None) -> int:
                   f"(checkpoints without it) and {r['wall_s']['network_steps_untimed']} network steps done before",
                   flush=True)
     elif args.mass_scale_study:
-        result["mass_scale_study"] = mass_scale_study(tuple(args.scales))
+        result["mass_scale_study"] = mass_scale_study(tuple(args.scales or (1.0, 10.0, 100.0)))
     elif args.grains or args.grain_pack:
         print(f"{'grains':>7} {'spheres':>8} {'contacts':>9} {'ms/step':>8} {'s-steps/s best':>15} {'median':>12} "
               f"{'per CPU-s':>12} {'threads':>8} {'load':>5}")
@@ -258,7 +312,7 @@ def main(argv=None) -> int:
         print(f"{'N':>7} {'pairs':>8} {'contacts':>9} {'ms/step':>8} {'p-steps/s best':>15} {'median':>12} "
               f"{'per CPU-s':>12} {'threads':>8}")
         rows = []
-        for n in args.n:
+        for n in args.n or [1000, 2000, 5000, 10000, 20000, 50000]:
             r = rate(n, steps=args.steps, repeat=args.repeat, threads=args.threads)
             rows.append(r)
             print(f"{r['n']:7d} {r['pairs']:8d} {r['contacts']:9d} {r['ms_per_step_best']:8.2f} "

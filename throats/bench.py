@@ -4,6 +4,9 @@ shape-factor estimate.
     python -m throats.bench [--n 200] [--seed 1] [--rtols 1e-2 3e-3 1e-3 1e-4]
                             [--json throats_bench.json] [--fit]
 
+Exit status: 0 done, 1 interrupted (Ctrl-C: nothing written), 2 bad options (one ``error:``
+line, checked before any work).
+
 Throats: ``--n`` interior Delaunay faces of random 5.5–7.5 mm packings
 (``network.sample_throats``, the project's one sampler) plus hand-made hard cases (tangent
 and overlapping disks, gaps of 1e-4 r̄, a disk across the opposite side, slivers, large
@@ -19,8 +22,8 @@ Prints a table and writes JSON with load average, platform, CPU count and a time
 
 from __future__ import annotations
 
-import argparse
 import json
+import math
 import os
 import platform
 import sys
@@ -34,6 +37,7 @@ from ._area import open_area_perimeter
 from ._geometry import canonical_form, contact_type
 from ._shape_factor import shape_factor_qstar
 from ._solve import SOLVER_VERSION, solve_fem
+from .solve import OneLineParser, check_output
 
 HARD_CASES = {
     # name: (radii, sides)
@@ -180,6 +184,11 @@ def fit(n=1600, seed=2026, rtol=1e-4):
                               float(np.percentile(err[ct[ok] == t], 95))) for t in c})
 
 
+def _f(v, spec):
+    """``v`` formatted with ``spec``; '-' for a statistic of an empty set (None)."""
+    return "-" if v is None else format(v, spec)
+
+
 def _table(out):
     lines = [f"throats bench  (solver {out['solver_version']}, load "
              f"{out['loadavg_start'][0]:.2f}, {out['cpu_count']} CPUs, {out['timestamp']})",
@@ -190,9 +199,10 @@ def _table(out):
             ms, e = row["ms_per_throat"], row["error"]
             cover = row.get("estimate_covers_error")
             cpu = row.get("cpu_ms_per_throat", {}).get("median")
-            lines.append(f"{name:<18} {g:<8} {ms['median']:>13.4g} {ms['p95']:>8.4g} "
-                         f"{'' if cpu is None else f'{cpu:.4g}':>10} "
-                         f"{e['median']:>11.2e} {e['p95']:>9.2e} {e['max']:>9.2e} "
+            lines.append(f"{name:<18} {g:<8} {_f(ms['median'], '.4g'):>13} "
+                         f"{_f(ms['p95'], '.4g'):>8} {'' if cpu is None else f'{cpu:.4g}':>10} "
+                         f"{_f(e['median'], '.2e'):>11} {_f(e['p95'], '.2e'):>9} "
+                         f"{_f(e['max'], '.2e'):>9} "
                          f"{'' if cover is None else f'{cover:.2f}':>8}")
     sf = out["results"]["shape-factor"]["packing"]["throughput_per_s"]
     lines.append(f"shape-factor throughput: best {sf['best']:.3g}/s, median {sf['median']:.3g}/s")
@@ -204,15 +214,44 @@ def _table(out):
     return "\n".join(lines)
 
 
-def main(argv=None) -> int:
-    p = argparse.ArgumentParser(prog="python -m throats.bench", description=__doc__.split("\n")[0])
-    p.add_argument("--n", type=int, default=200, help="packing throats (default 200)")
-    p.add_argument("--seed", type=int, default=1, help="packing seed (default 1)")
+def _parser():
+    p = OneLineParser(prog="python -m throats.bench", description=__doc__.split("\n")[0])
+    p.add_argument("--n", type=int, default=200, help="packing throats, >= 1 (default 200)")
+    p.add_argument("--seed", type=int, default=1, help="packing seed, >= 0 (default 1)")
     p.add_argument("--rtols", type=float, nargs="+", default=[1e-2, 3e-3, 1e-3, 1e-4],
-                   help="FE tolerances compared (default 1e-2 3e-3 1e-3 1e-4)")
-    p.add_argument("--json", default="throats_bench.json", help="output JSON path")
-    p.add_argument("--fit", action="store_true", help="refit the shape-factor constants")
-    args = p.parse_args(argv)
+                   help="FE tolerances compared, each in (0, 1) (default 1e-2 3e-3 1e-3 1e-4)")
+    p.add_argument("--json", default="throats_bench.json", metavar="OUT.json",
+                   help="output JSON path, its folder must exist (default throats_bench.json, "
+                        "written in the current folder)")
+    p.add_argument("--fit", action="store_true",
+                   help="refit the shape-factor constants and print them (writes nothing)")
+    return p
+
+
+def main(argv=None) -> int:
+    """Run the benchmark; exit 0 done, 1 interrupted (Ctrl-C), 2 bad options."""
+    try:
+        return _main(argv)
+    except KeyboardInterrupt:
+        print("interrupted: nothing written (--json is written at the end)", file=sys.stderr)
+        return 1
+
+
+def _main(argv):
+    args = _parser().parse_args(argv)
+    try:
+        if args.n < 1:
+            raise ValueError(f"--n must be >= 1, got {args.n}")
+        if args.seed < 0:
+            raise ValueError(f"--seed must be >= 0, got {args.seed}")
+        for rt in args.rtols:
+            if not (math.isfinite(rt) and 0 < rt < 1):
+                raise ValueError(f"--rtols must each be in (0, 1), got {rt:g}")
+        if not args.fit:
+            check_output(args.json, "--json")
+    except ValueError as e:
+        print(f"error: {e}", file=sys.stderr)
+        return 2
     if args.fit:
         print(json.dumps(fit(), indent=1))
         return 0
