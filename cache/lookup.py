@@ -31,7 +31,7 @@ import sys
 import numpy as np
 
 import throats
-from throats.solve import OneLineParser, check_output
+from throats.solve import OneLineParser, check_output, run_interruptible
 
 from ._csvio import read_throat_csv, row_problems, write_csv
 from ._interp import GRIDS
@@ -72,12 +72,8 @@ def build_parser():
 
 def main(argv=None) -> int:
     """Run the command; exit 0 every row answered, 1 some row not (or Ctrl-C), 2 bad input."""
-    try:
-        return _main(argv)
-    except KeyboardInterrupt:
-        print("interrupted: nothing written to the output (FE results already stored in the "
-              "table are kept)", file=sys.stderr)
-        return 1
+    return run_interruptible(_main, argv, "interrupted: nothing written to the output (FE "
+                             "results already stored in the table are kept)")
 
 
 def _main(argv):

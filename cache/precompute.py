@@ -34,7 +34,7 @@ import sqlite3
 import sys
 
 import throats
-from throats.solve import OneLineParser, check_output
+from throats.solve import OneLineParser, check_output, run_interruptible
 
 from ._build import precompute_grid, precompute_throats, resolve_solver
 from ._csvio import read_throat_csv, row_problems
@@ -82,12 +82,9 @@ def build_parser():
 
 def main(argv=None) -> int:
     """Run the command; exit 0 done, 1 interrupted, 2 bad input (one ``error:`` line)."""
-    try:
-        return _main(argv)
-    except KeyboardInterrupt:   # before or after the solve loop (that one reports itself)
-        print("interrupted: no shape was being solved; what earlier batches stored is kept",
-              file=sys.stderr)
-        return 1
+    # Ctrl-C before or after the solve loop (that one reports itself)
+    return run_interruptible(_main, argv, "interrupted: no shape was being solved; what "
+                             "earlier batches stored is kept")
 
 
 def _check(args):

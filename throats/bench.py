@@ -37,7 +37,7 @@ from ._area import open_area_perimeter
 from ._geometry import canonical_form, contact_type
 from ._shape_factor import shape_factor_qstar
 from ._solve import SOLVER_VERSION, solve_fem
-from .solve import OneLineParser, check_output
+from .solve import OneLineParser, check_output, run_interruptible
 
 HARD_CASES = {
     # name: (radii, sides)
@@ -230,11 +230,8 @@ def _parser():
 
 def main(argv=None) -> int:
     """Run the benchmark; exit 0 done, 1 interrupted (Ctrl-C), 2 bad options."""
-    try:
-        return _main(argv)
-    except KeyboardInterrupt:
-        print("interrupted: nothing written (--json is written at the end)", file=sys.stderr)
-        return 1
+    return run_interruptible(_main, argv, "interrupted: nothing written (--json is written at "
+                             "the end)")
 
 
 def _main(argv):

@@ -41,7 +41,7 @@ from ._geometry import contact_type, mean_radius, validate_throats
 from ._shape_factor import FIT, shape_factor_qstar
 from ._solve import solve_fem
 
-__all__ = ["OneLineParser", "check_output", "main"]
+__all__ = ["OneLineParser", "check_output", "main", "run_interruptible"]
 
 COLUMNS = ["r1", "r2", "r3", "l12", "l13", "l23"]
 METHODS = ("fem", "shape-factor")
@@ -162,13 +162,18 @@ def _read_csv(path):
     return rows, fields, vals, parse_err
 
 
+def run_interruptible(body, argv, message: str) -> int:
+    """``body(argv)``'s exit status; Ctrl-C prints ``message`` (one line) and gives 1."""
+    try:
+        return body(argv)
+    except KeyboardInterrupt:
+        print(message, file=sys.stderr)
+        return 1
+
+
 def main(argv=None) -> int:
     """Run the command; exit 0 every row answered, 1 some row not (or Ctrl-C), 2 bad input."""
-    try:
-        return _main(argv)
-    except KeyboardInterrupt:
-        print("interrupted: nothing written", file=sys.stderr)
-        return 1
+    return run_interruptible(_main, argv, "interrupted: nothing written")
 
 
 def _main(argv):
