@@ -87,3 +87,15 @@ def test_a_fine_is_closed_on_its_own_scale(radii, sides):
     assert a.status[0] == "ok" and abs(a.qstar[0] / b.qstar[0] - 1) < 1e-4
     rs, _ = throats.canonical_form([radii], [sides])
     assert throats._solve.closing_width(rs)[0] == pytest.approx(0.01 * rs.min() / 0.25)
+
+
+def test_solve_fem_takes_any_finite_length_unit():
+    # the open area and contact type were computed on the given lengths (their squares overflow
+    # from a unit of about 1e155); the CLI worked around it, now solve_fem itself uses r_bar
+    ref = throats.solve_fem([[1.0, 0.9, 1.1]], [[2.05, 2.3, 1.95]])
+    for scale in (1e-300, 1e300):
+        sol = throats.solve_fem([[scale, 0.9 * scale, 1.1 * scale]],
+                                [[2.05 * scale, 2.3 * scale, 1.95 * scale]])
+        assert sol.qstar[0] == pytest.approx(ref.qstar[0], rel=1e-12)
+        assert sol.open_area[0] == pytest.approx(ref.open_area[0], rel=1e-12)
+        assert sol.contact_type[0] == ref.contact_type[0] and sol.status[0] == "ok"

@@ -408,9 +408,9 @@ def solve_fem(radii, sides, *, rtol=1e-3, workers=1, progress=False, delta=DELTA
     ctype = np.full(n, "", dtype=object)
     idx = np.flatnonzero(ok)
     if idx.size:
-        rbar = mean_radius(r[idx])
-        area[idx] = open_area(r[idx], s[idx]) / rbar**2
-        ctype[idx] = contact_type(r[idx], s[idx])
+        rbar = mean_radius(r[idx])[:, None]     # in units of r̄: any finite length unit
+        area[idx] = open_area(r[idx] / rbar, s[idx] / rbar)
+        ctype[idx] = contact_type(r[idx] / rbar, s[idx] / rbar)
         closed = area[idx] <= 1e-14
         qstar[idx[closed]] = 0.0
         est[idx[closed]] = 0.0

@@ -106,9 +106,10 @@ def _parser():
 def _compute(radii, sides, method, rtol, workers, progress):
     """Per-row results as a dict of (N,) arrays (open_area in input units²).
 
-    Valid rows are solved in units of their mean radius r̄ (Q* is scale-free) and the open
-    area scaled back by r̄², so any finite positive length unit gives the same Q*; an area
-    beyond the float range (unit ~1e155 and up) is written empty.
+    Q* and the open area are computed in units of the mean radius r̄ (``solve_fem`` does so
+    itself; the shape-factor rows here), the area scaled back by r̄², so any finite positive
+    length unit gives the same Q*; an area beyond the float range (unit ~1e155 and up) is
+    written empty.
     """
     t0 = time.perf_counter()
     ok, msg = validate_throats(radii, sides)
@@ -116,7 +117,7 @@ def _compute(radii, sides, method, rtol, workers, progress):
     rbar[ok] = mean_radius(radii[ok])
     r_star, s_star = radii / rbar[:, None], sides / rbar[:, None]
     if method == "fem":
-        sol = solve_fem(r_star, s_star, rtol=rtol, workers=workers, progress=progress)
+        sol = solve_fem(radii, sides, rtol=rtol, workers=workers, progress=progress)
         with np.errstate(over="ignore", under="ignore", invalid="ignore"):
             area = sol.open_area * rbar**2
         return dict(qstar=sol.qstar, open_area=area,
