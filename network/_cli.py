@@ -18,7 +18,6 @@ from __future__ import annotations
 import argparse
 import atexit
 import contextlib
-import json
 import logging
 import os
 import re
@@ -362,11 +361,8 @@ def packing_inputs(args) -> list:
         return []
     path = Path(args.packing)
     out = [("the packing file", path)]
-    try:
-        if "container" in json.loads(path.with_suffix(".json").read_text()):
-            out.append(("the packing's companion JSON (its container)", path.with_suffix(".json")))
-    except (OSError, ValueError, TypeError):
-        pass
+    if path.is_file() and read_container(path) is not None:
+        out.append(("the packing's companion JSON (its container)", path.with_suffix(".json")))
     return out
 
 
