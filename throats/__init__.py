@@ -27,7 +27,7 @@ Command line: ``python -m throats.solve`` (one throat as JSON, or a CSV of throa
 ``--method fem|shape-factor``); ``python -m throats.bench`` (time per throat against error).
 
 Method (closing rule for passages narrower than 0.01 r̄, curved quadratic gmsh triangles,
-Lagrange P3/P4, the error estimate, and what each was measured to cost) in
+Lagrange P3/P4, the error estimate, and what each costs) in
 ``docs/throats-method.md``; modules, lowest first: ``_geometry``, ``_boundary``, ``_area``,
 ``_shape_factor``, ``_mesh``, ``_trimesh``, ``_solve``.
 """

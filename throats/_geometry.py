@@ -198,7 +198,7 @@ def validate_throats(radii, sides):
     A row is invalid when it holds NaN/inf, a radius or side <= 0, or sides that violate the
     triangle inequality or form a (nearly) collinear triangle (area <= 1e-9 * longest side²).
     Every other row is a triangle of disks and has an answer, deep overlaps included (a disk
-    containing another vertex, r_i >= l_ij: open, or closed with Q* = 0; issue 13 item 9).
+    containing another vertex, r_i >= l_ij: open, or closed with Q* = 0).
 
     Parameters
     ----------

@@ -11,10 +11,9 @@ region (:mod:`throats._area`), and one constant :math:`c_t` per contact type t =
 fitted to finite-element Q* (``python -m throats.bench --fit``); types b and c with a deep
 overlap (a pair closer than :math:`r_i + r_j - 0.2\bar r`, two spheres of one multi-sphere
 grain) have their own (``FIT["deep"]``).  :data:`FIT` records the fit:
-the constants were fitted at commit 1404360 on throats of the packer ``throats._sampling``
-(deleted since; the project's one sampler is now ``network.sample_throats``), and their error
-was measured again on ``network.sample_throats`` throats.  Both records, and how to refit,
-are in ``docs/throats-shape-factor.md``.  A screening estimate (median error about 0.2, 95th
+the constants come from a fit at commit 1404360 on sampled packing throats, and their error
+is measured on ``network.sample_throats`` throats.  Both records, and how to refit, are in
+``docs/throats-shape-factor.md``.  A screening estimate (median error about 0.2, 95th
 percentile about 0.5), not a substitute for the FE solve.
 
 References
@@ -37,7 +36,7 @@ FIT = {
     "c": {"a": 0.6868, "b": 0.7511, "c": 0.8293, "d": 0.9215},
     # c_t = exp(median(log(Q*_FE / (A*^3 / P*^2)))) over the throats of type t
     "data": ("fitted at commit 1404360 on 1600 interior Delaunay faces of random 5.5-7.5 mm "
-             "packings of the former throats._sampling.sample_throats(1600, rng=2026) "
+             "packings of that commit's throats._sampling.sample_throats(1600, rng=2026) "
              "(400 spheres, solid fraction 0.57, overlap relaxation; 572 a, 690 b, 289 c, 49 d), "
              "Q*_FE from solve_fem(rtol=1e-4), SOLVER_VERSION 1.0; versions up to 1.3 move "
              "those Q* by < 1e-4, far below the fit error"),

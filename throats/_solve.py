@@ -47,8 +47,8 @@ logger = logging.getLogger(__name__)
 #: bump whenever results could change (the cache keys on it)
 SOLVER_VERSION = "1.3"
 #: smallest disk (units of r̄) closed at the full closing width; a smaller one scales it
-#: (:func:`closing_width`; session 21, within 1.3's tables: their radii are >= 0.5 r̄ but for
-#: d1's third vertex, whose cells the table+fe policy sends to FE)
+#: (:func:`closing_width`; the shipped tables' radii are >= 0.5 r̄ but for d1's third vertex,
+#: whose cells the table+fe policy sends to FE)
 SMALL_RADIUS = 0.25
 
 _FORMS = {}

@@ -165,8 +165,8 @@ def _run(n, seed, rtols, repeats):
 def fit(n=1600, seed=2026, rtol=1e-4):
     """Refit the shape-factor constants c_t = exp(median(log(Q_FE/(A^3/P^2)))) per type.
 
-    Throats from ``network.sample_throats(n, rng=seed)``; the shipped constants were fitted on
-    the former ``throats._sampling`` packer (``docs/throats-shape-factor.md``).
+    Throats from ``network.sample_throats(n, rng=seed)``; the shipped constants come from the
+    throat sampler of commit 1404360 (``docs/throats-shape-factor.md``).
     """
     r, s = network.sample_throats(n, rng=seed)
     sol = solve_fem(r, s, rtol=rtol, progress=True)
