@@ -1,5 +1,5 @@
 """Work claims: concurrent precompute runs on one table split the shapes instead of each
-solving all of them (issue 13).
+solving all of them.
 
 Before a batch is submitted, the run claims its shapes in the table ``claims`` in one
 ``BEGIN IMMEDIATE`` transaction: shapes already stored or claimed by another live run are left

@@ -303,7 +303,7 @@ def lookup_qstar(radii, sides, *, db=None, policy="table+fe", rtol=1e-3, workers
         elif solver_version is None:
             solver_version = _build.default_solver()[1]
         if policy in ("table-only", "table+fe"):
-            # FE values already stored in the table beat interpolation (issue 13 item 3)
+            # FE values already stored in the table beat interpolation
             pending = _stored_first(r, s, pending, q, err, src, msg, db=db, rtol=rtol,
                                     solver_version=solver_version)
             injected = table is not None

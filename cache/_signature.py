@@ -12,7 +12,7 @@ and the table key is ``round(s / QUANTUM)`` as five int64 (QUANTUM = 1e-9 r̄): 
 share a key when their shapes agree to 1e-9 r̄, far below any solver tolerance.  Every writer
 and reader computes the key with this one function from float64 lengths; files that carry
 shapes between commands must hold them losslessly (17 significant digits, ``repr``): a length
-written with 9 digits moves the key (issue 13, docs/cache-table.md).  Solver
+written with 9 digits moves the key (docs/cache-table.md).  Solver
 settings (``SOLVER_VERSION``, ``rtol``) are stored beside the key and are part of the unique
 index, so a changed solver never serves a stale value.
 """
