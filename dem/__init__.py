@@ -64,12 +64,12 @@ __all__ = [
     "vibrate_bed", "VibrationResult",
     "Region", "porosity_in_spheres", "porosity_in_region", "coordination_numbers",
     "read_packing", "write_packing",
-    # added by issue 12 (public names the tests and CLIs use instead of private modules)
+    # walls, generation and measuring helpers (the tests and CLIs use these, not private modules)
     "PlaneWall", "CylinderWall", "generate_spheres", "default_measure_spheres", "surface_height",
     "lens_volume", "sphere_volume", "intensity_g", "rest_motion",
-    # the grain library (issue 16): kernel axes, densities, porosity, friction, each sourced
+    # the grain library: kernel axes, densities, porosity, friction, each sourced
     "GRAINS", "GRAIN_FIELDS", "Grain", "Sourced", "grain",
-    # multi-sphere grains (issue 15): templates from measured axes, the rigid-grain engine
+    # multi-sphere grains: templates from measured axes, the rigid-grain engine
     "ClumpSimulation", "LIBRARY_MAX_SPHERES", "ROW_SPACING", "TEMPLATE_GRAINS", "Template",
     "check_template", "library_template", "read_template", "resolve_template", "sphere_template",
     "template_from_axes",

@@ -1,4 +1,4 @@
-r"""Packing multi-sphere grains (issue 15 items 1 and 3) with :class:`dem.clumps.ClumpSimulation`.
+r"""Packing multi-sphere grains with :class:`dem.clumps.ClumpSimulation`.
 
 Procedure (the 'sediment' idea of :mod:`dem._procedures` for grains): N grains from the target
 porosity, :math:`N = \lfloor(1-φ)V/V_g\rfloor`; their bounding spheres placed by random

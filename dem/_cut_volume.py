@@ -13,8 +13,7 @@ region's cross-section: for a cylinder the two-circle overlap (closed form); for
 disk's edge meets a face, an edge or a corner (:math:`\rho` = the distance to it), so each
 integral is split there and Gauss-Legendre (6 points) runs on each piece. Error against exact
 volumes (caps, octants, a sphere in a cylinder about its axis) below 2e-6 of the sphere's volume
-(``tests/test_dem_measure_region.py``); the point count it replaces (2 176 points in the ball)
-was off by up to 4.5 %.
+(``tests/test_dem_measure_region.py``); a 2 176-point count in the ball is off by up to 4.5 %.
 """
 
 from __future__ import annotations

@@ -121,7 +121,7 @@ def particle_update(x, v, w, r, ms, gforce, first_start, second_start, by_second
                 tx += t_pair[k, 0] * rp
                 ty += t_pair[k, 1] * rp
                 tz += t_pair[k, 2] * rp
-        # walls: summed apart, wall by wall, then added (the order of the former bincount form)
+        # walls: summed apart, wall by wall, then added (one fixed order: the same bits always)
         wfx = wfy = wfz = 0.0
         wtx = wty = wtz = 0.0
         hits = 0

@@ -4,8 +4,8 @@ The kernels sum every particle's forces in a fixed order, so one thread and two 
 bits; only the speed differs. On an idle two-core machine two threads take a 20 000-sphere step
 in about half the time. On a shared one they can be far slower: a parallel loop waits at its
 end for its slowest thread, and a thread that loses its core to another process for a time
-slice stalls the step (measured at load 4-5 with OpenMP threads: 0.8e6 particle-steps/s
-on two threads against 8.8e6 on one; ``docs/dem-speed.md``). :class:`ThreadChooser` therefore
+slice stalls the step, and on a busy machine two threads can run several times slower than one
+(``docs/dem-speed.md``). :class:`ThreadChooser` therefore
 times a few steps with each candidate, keeps the faster, and probes again later.
 """
 

@@ -170,7 +170,7 @@ def mass_scale_study(scales=(1.0, 10.0, 100.0), *, seed=1, settle_time_s=0.3, gr
 #: The vibration study's representative scene (docs/dem-vibration.md: a cylinder 0.10 m across at
 #: the thesis's 0.25 m fill height; it compacts as the full 0.15 m bin within 0.0024 porosity).
 STUDY_ARGS = ["--study", "thesis", "--scene", "cylinder", "--size", "0.1", "--height", "0.25", "--seed", "1"]
-#: Issue 17's target for the five-intensity study on two cores, s.
+#: Target for the five-intensity study on two cores (one hour), s.
 STUDY_TARGET_S = 3600.0
 
 
@@ -217,7 +217,7 @@ def _parser():
     p.add_argument("--study", metavar="DIR", default=None,
                    help="instead of the rates: run (or resume, or reuse) the thesis vibration study on the "
                         "representative 0.10 x 0.25 m cylinder in DIR (about an hour on two cores) and print "
-                        "its row against issue 17's one-hour target")
+                        "its row against the one-hour target")
     p.add_argument("--json", default="dem_bench.json",
                    help="output JSON path, its folder must exist (default dem_bench.json, in the current folder)")
     return p

@@ -163,8 +163,8 @@ GRAINS: dict[str, Grain] = {
         "shelled_corn",
         axes_mm=Sourced((9.2476, 7.8684, 3.8572), _CORN_QPM,
                         "at 9 % w.b. (one quality-protein variety); 9.25-10.20 x 7.87-8.26 x "
-                        "3.86-4.71 mm over 9-25 % w.b.; issue 15 quotes about 12 x 8 x 4.5 mm "
-                        "(no source found for that triple)"),
+                        "3.86-4.71 mm over 9-25 % w.b.; the often quoted 12 x 8 x 4.5 mm has "
+                        "no source found"),
         axes_sd_mm=_missing("the axis standard deviations", _SD_SEARCH),
         particle_density_kg_m3=Sourced(1250.0, _CORN_DARFOUR,
                                        "five Ghanaian varieties; constant with moisture"),

@@ -39,7 +39,7 @@ __all__ = ["Template", "template_from_axes", "sphere_template", "library_templat
 
 #: largest centre spacing of the spheres of one row, in units of their radius (overlap 0.8 r)
 ROW_SPACING = 1.2
-#: the library grains issue 15 bundles templates for (axes and sources in dem.grains)
+#: the library grains with bundled templates (axes and sources in dem.grains)
 TEMPLATE_GRAINS = ("soybean", "wheat", "shelled_corn", "barley", "canola")
 
 
