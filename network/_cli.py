@@ -111,8 +111,8 @@ def warn(message: str) -> None:
     print(f"warning: {' '.join(str(message).split())}", file=sys.stderr)
 
 
-#: Largest particle Reynolds number the inertial law was checked at (issue 14: against the
-#: Beetstra law to 200, against the resolved flow to 93; docs/inertial-flow.md)
+#: Largest particle Reynolds number the inertial law is checked at (against the Beetstra law
+#: to 200, against the resolved flow to 93; docs/inertial-flow.md)
 RE_P_CHECKED = 200.0
 
 
@@ -122,7 +122,7 @@ def warn_validity(reynolds_particle=None, pressure_drop_pa=None) -> None:
     drop above 10 % of :data:`~network._air.P_ATM_PA` (the air's density changes by as much;
     the model takes it constant)."""
     if reynolds_particle is not None and reynolds_particle > RE_P_CHECKED:
-        warn(f"Re_p {reynolds_particle:.3g} is beyond the {RE_P_CHECKED:g} the inertial law was "
+        warn(f"Re_p {reynolds_particle:.3g} is beyond the {RE_P_CHECKED:g} the inertial law is "
              "checked to: the result is an extrapolation (docs/inertial-flow.md)")
     if pressure_drop_pa is not None and pressure_drop_pa > 0.1 * P_ATM_PA:
         warn(f"a pressure drop of {pressure_drop_pa:.3g} Pa is {pressure_drop_pa / P_ATM_PA:.0%} "
@@ -231,7 +231,7 @@ def finish(code: int):
     """End the command process with exit status ``code`` without tearing the interpreter down.
 
     An ordinary exit frees every module, array and solver hierarchy one by one: 0.05-0.1 s
-    after a 5 000-sphere solve (``docs/network-bench.md``, session 15). By the time a command
+    after a 5 000-sphere solve (``docs/network-bench.md``). By the time a command
     returns its outputs are written and closed (its ``with`` blocks) and every future of its
     worker threads awaited, so ``finish`` flushes stdout and stderr, runs the ``atexit``
     handlers (logging's flush, multiprocessing's clean-up), flushes again (what a handler

@@ -12,7 +12,7 @@ fits, per velocity,
 (one intercept per seed family, one common slope S: a family's own offset, from its random
 arrangement, does not leak into S). :func:`band_gradients` then gives
 g(ε + Δε) = g(ε) exp(S Δε) at Δε = -0.02, -0.01, +0.01, +0.02. Near ε = 0.40 the soybean
-size gives S ≈ -11 to -13 (issue 16 quotes -11).
+size gives S ≈ -11 to -13.
 """
 
 from __future__ import annotations

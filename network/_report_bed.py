@@ -1,4 +1,4 @@
-r"""Which bed ``network.report`` solves, and packing a new one with ``dem.pack`` (issue 16 item 2).
+r"""Which bed ``network.report`` solves, and packing a new one with ``dem.pack``.
 
 The bed is chosen before anything is written (:func:`plan_bed`), in this order:
 

@@ -1,6 +1,6 @@
 r"""The porosity of ``network.report``: which one, why, and how the prediction gets there.
 
-A report is for one porosity ε (issue 16 item 3), chosen in this order and named in
+A report is for one porosity ε, chosen in this order and named in
 ``porosity_source``: the user's ``--porosity``; else the grain's measured loose-fill bulk
 porosity (the middle of the range in :data:`network._grains.BED`, the condition D272's data were
 taken in); else, for a grain without one, the packing's own. The network is solved on a packing

@@ -1,6 +1,6 @@
 """``python -m network.bench``: speed against error of the network model.
 
-Three parts (issue 4, item 10; issue 7, item 4), each a module of ``network.benchmarks``:
+Three parts, each a module of ``network.benchmarks``:
 
 1. **Policies** — one packing (``--policy-spheres``) solved with each conductance model
    (``--models``) and Q* policy (``--policies``), each against its own fresh copy of the table
@@ -84,7 +84,7 @@ def build_parser() -> CliParser:
     ap.add_argument("--ref-lattices", nargs="*", type=lattice_case, default=None,
                     metavar="KIND:PHI",
                     help="lattice cases of part 3, e.g. sc:0.45 fcc:touch (default the 13 cases "
-                         "of issue 7)")
+                         "of REF_LATTICE_CASES: sc, bcc and fcc from dilute to touching)")
     ap.add_argument("--ref-random", nargs="*", type=float, default=list(REF_RANDOM_POROSITIES),
                     metavar="POROSITY",
                     help="random-packing porosities of part 3 (default 0.36 0.40 0.45; none "

@@ -1,4 +1,4 @@
-"""``python -m network.report``: the engineer's report of a grain bed (issue 16 items 2 and 3).
+"""``python -m network.report``: the engineer's report of a grain bed.
 
 Examples
 --------

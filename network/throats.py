@@ -14,7 +14,7 @@ Examples
 The packing is read in ``--units`` (``--sample``, ``--margin`` too); the CSV is in metres, with
 17 significant digits so that the values read back are the tessellation's bit for bit and the
 cache's shape keys (``cache.shape_keys``, quantum 1e-9 r̄) match those ``network.solve`` looks
-up (9 digits moved keys and sent every throat to FE again, issue 13). Exit 0
+up (9 digits would move keys and send every throat to FE). Exit 0
 done, 1 failed, 2 bad input: one ``error:`` line (docs/cli.md).
 """
 

@@ -35,8 +35,7 @@ __all__ = ["DEM_BEDS", "INERTIAL_LAWS", "INERTIAL_REYNOLDS", "dem_bed_file", "in
 INERTIAL_REYNOLDS = (1.0, 2.0, 5.0, 10.0, 20.0, 50.0, 100.0, 200.0)
 
 
-#: Settled beds of equal 6 mm spheres from the project's DEM packer (issue 14 item 5's "DEM
-#: packings of your own"): name -> ``python -m dem.pack`` options beside :data:`DEM_BED_BOX`.
+#: Settled beds of equal 6 mm spheres from the project's DEM packer: name -> ``python -m dem.pack`` options beside :data:`DEM_BED_BOX`.
 #: 'dense': frictionless sedimentation and taps (solid fraction 0.635 in the sample box);
 #: 'lid': grown under a lid with friction 0.47, then settled (0.593); 'loose': friction 1.0
 #: throughout, more headroom (0.575; friction 2.0 and headroom 1.0 gave 0.584, no looser).

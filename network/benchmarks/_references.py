@@ -1,4 +1,4 @@
-"""Part 3 of ``python -m network.bench`` (issue 7, item 4): k against published / computed Stokes k.
+"""Part 3 of ``python -m network.bench``: k against published / computed Stokes k.
 
 Every conductance model × Q* policy on lattices (SC against Zick & Homsy 1982, BCC/FCC against
 this project's Stokes FE of the unit cell) and on random monodisperse packings (against the LBM
@@ -26,11 +26,11 @@ from ._table import copy_table, drop_table, table_totals
 __all__ = ["FE_POLICIES", "REF_LATTICE_CASES", "REF_RANDOM_POROSITIES", "lattice_case",
            "references", "references_table"]
 
-#: Lattice cases of issue 7: (lattice, solid fraction); pi/6 is touching simple cubic.
+#: Lattice cases: (lattice, solid fraction); pi/6 is touching simple cubic.
 REF_LATTICE_CASES = (("sc", 0.3), ("sc", 0.45), ("sc", math.pi / 6),
                      ("bcc", 0.3), ("bcc", 0.4), ("bcc", 0.5), ("bcc", 0.6), ("bcc", 0.66),
                      ("fcc", 0.3), ("fcc", 0.45), ("fcc", 0.55), ("fcc", 0.65), ("fcc", 0.72))
-#: Porosities of the random-packing cases of issue 7.
+#: Porosities of the random-packing cases.
 REF_RANDOM_POROSITIES = (0.36, 0.40, 0.45)
 #: Policies that run FE solves (opt-in per porosity on random packings, see --fe-random).
 FE_POLICIES = ("table+fe", "fe-only")

@@ -32,8 +32,8 @@ def section_estimate(rho, sides):
 
     Against FE on the simple-cubic section (right isosceles triangle, legs 1, equal disks
     :math:`\rho`): -0.7, -1.2, -2.8, -4.5, -7.5, -13, -24 % at :math:`\rho` = 0.05, 0.1, 0.2, 0.25,
-    0.3, 0.35, 0.4 (the cell model is a dilute theory), where the previous estimate
-    :math:`A^3/(2P_w^2)` was 18, 7.1, 3.2, 2.5, 2.1, 1.7, 1.4 times FE. Used for ratios
+    0.3, 0.35, 0.4 (the cell model is a dilute theory), where the wetted-perimeter estimate
+    :math:`A^3/(2P_w^2)` is 18, 7.1, 3.2, 2.5, 2.1, 1.7, 1.4 times FE. Used for ratios
     :math:`Q(h)/Q(h')` along one conduit: all sections share the triangle, so the ratio
     depends on the solid fractions alone. :math:`f` falls to 0 as :math:`(1-\phi)^3/3` when
     the disks close the section.

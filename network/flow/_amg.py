@@ -5,9 +5,9 @@ matrix :math:`\tilde A = D^{-1/2} A D^{-1/2}` (near-null space :math:`D^{1/2}\ma
 The unknowns are renumbered by reverse Cuthill-McKee (SciPy's ``csgraph``) before the hierarchy
 is built: pyamg's greedy aggregation and the Gauss-Seidel sweeps follow the node order, and a
 banded order smooths better, with smaller aggregates (operator complexity 1.67 -> 1.83), than
-the tessellation's. Setup and solve in a fresh process: 5 000 spheres 0.14-0.20 -> 0.12-0.13 s,
-20 000 0.58-0.69 -> 0.57-0.60 s (40 -> 31 CG iterations), 100 000 4.6-5.9 -> 3.8-4.2 s, 1e6
-93 -> 63 s (``docs/network-bench.md``, "Session 14"). It is built on
+the tessellation's: at 20 000 spheres CG takes 31 iterations in this order against 40 in the
+tessellation's, and setup plus solve take about a third less time at 1e6 spheres
+(``docs/network-bench.md``). It is built on
 the first solve; later right-hand sides reuse it. If CG has not converged after
 150 iterations the hierarchy is rebuilt once with ``strength='evolution'`` and kept: later
 solves with the same matrix start from it and never rebuild. :meth:`AMGSolver.preconditioner`

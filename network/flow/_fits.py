@@ -33,7 +33,7 @@ def _rms_rel(pred, grad):
 
 def fit_curve(velocity_m_s, gradient_pa_per_m, *, viscosity_pa_s, density_kg_m3, porosity,
               diameter_m) -> dict:
-    """Darcy/Forchheimer, D272 and Ergun fits of a curve (JSON keys of issue 14).
+    """Darcy/Forchheimer, D272 and Ergun fits of a curve (JSON keys :data:`FIT_KEYS`).
 
     >>> u = np.array([0.01, 0.1, 1.0]); gr = 2.0 * u + 3.0 * 1.2 * u**2
     >>> f = fit_curve(u, gr, viscosity_pa_s=1.0, density_kg_m3=1.2, porosity=0.4, diameter_m=0.01)

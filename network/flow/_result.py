@@ -80,7 +80,7 @@ class FlowResult:
         return density_kg_m3 * velocity_m_s * self.sauter_diameter_m / self.viscosity_pa_s
 
     def curve_points(self) -> list[dict]:
-        """The inertial points as JSON-ready dicts (issue 14 keys), ascending velocity."""
+        """The inertial points as JSON-ready dicts, ascending velocity."""
         if self.inertial is None:
             return []
         rho = self.inertial["density_kg_m3"]
@@ -138,7 +138,7 @@ class FlowResult:
         return out
 
     def summary(self) -> dict:
-        """Every scalar as a JSON-ready dict (keys named in issue 4, item 7)."""
+        """Every scalar as a JSON-ready dict, one key per number with its unit in the name."""
         return {
             "axis": self.axis,
             "conductance_model": self.conductance_model,
@@ -199,7 +199,7 @@ class FlowResult:
         return point.dp_pa / self.length_m * whole / self.permeability_m2
 
     def _inertial_summary(self) -> dict:
-        """Inertial value at ``velocity_m_s`` with the Stokes values beside it (issue 14)."""
+        """Inertial value at ``velocity_m_s`` with the Stokes values beside it."""
         if self.inertial is None:
             return {}
         pt = self.inertial["points"][0]

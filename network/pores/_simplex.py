@@ -3,7 +3,7 @@ r"""Tetrahedron geometry in closed form, row by row: lengths, edge determinants,
 numpy's batched ``linalg.det`` and ``linalg.solve`` factor every 3x3 matrix by LAPACK's LU one
 call at a time; for the 124 000 tetrahedra of a 20 000-sphere packing that is 38 ms (det) and
 65 ms (solve), where the cofactor forms below take a few vector operations (measured in
-``docs/network-bench.md``, "Session 14"). Their round-off is that of a 3x3 cofactor expansion,
+``docs/network-bench.md``). Their round-off is that of a 3x3 cofactor expansion,
 a few units in the last place of :math:`|e_1||e_2||e_3|`, as LU's is; the results differ from
 LAPACK's in the last bits only.
 """
