@@ -7,7 +7,7 @@ Each layer imports only the layers above it in this list (``tests/test_layers.py
 ``conductance``        Q* by policy (the only importer of ``cache``), thesis and conduit models
 ``flow``               assemble → constrain → solve → verify; :func:`solve_network`, the one
                        pipeline, and :class:`FlowResult`; Darcy/core k; Ergun, K-C, ASABE D272
-``airpaths``           airflow paths, tortuosity, the branched-path model, plots
+``paths``              airflow paths, tortuosity, the branched-path model, plots
 ``validation``         reference permeabilities and validation cases through the one pipeline
 CLIs                   ``python -m network.solve`` (permeability and pressure drop; the bundled
                        soybean scene by default), ``network.throats``, ``network.paths``,
@@ -24,7 +24,6 @@ if _sys.argv[:1] == ["-m"]:     # python -m network.<command>: a command process
     _lean_imports()
 
 from ._air import MU_AIR_PA_S, RHO_AIR_KG_M3
-from .airpaths import AirflowPath, BranchedResult, branched_pressure_drop, trace_paths
 from .conductance import (MODELS, POLICIES, ConductanceResult, QstarResult, thesis_conductance,
                           throat_conductance, throat_qstar)
 from .flow import (AMGSolver, FlowResult, InertialPoint, SolveInfo, apply_pressure_bc,
@@ -34,6 +33,7 @@ from .flow import (AMGSolver, FlowResult, InertialPoint, SolveInfo, apply_pressu
                    write_network_vtu)
 from .packing import (Packing, default_packing_path, lattice_packing, lattice_radius,
                       random_packing, read_container, read_packing, write_packing_csv)
+from .paths import AirflowPath, BranchedResult, branched_pressure_drop, trace_paths
 from .pores import (QHULL_OPTIONS, Region, SampleNetwork, Tessellation, default_region,
                     prune_disconnected, region_porosity, sample_throats, select_sample,
                     tessellate, tie_groups)

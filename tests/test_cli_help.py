@@ -26,8 +26,11 @@ def _parser_of(module_name, monkeypatch):
         raise _Parsed(self)
 
     monkeypatch.setattr(argparse.ArgumentParser, "parse_known_args", grab)
+    module = importlib.import_module(module_name)
+    if hasattr(module, "__path__"):     # a subpackage's command is its __main__
+        module = importlib.import_module(module_name + ".__main__")
     with pytest.raises(_Parsed) as got:
-        importlib.import_module(module_name).main([])
+        module.main([])
     return got.value.args[0]
 
 

@@ -7,7 +7,8 @@ Rules (issue 12):
   the pipeline and may import the public API (the package itself, never a private module) of the
   packages below or beside it;
 * inside a package, subpackages form layers (``LAYERS``): a module imports only its own layer
-  and the layers before it; the module import graph has no cycle;
+  and the layers before it (a subpackage's ``__main__`` is a command, in the top layer); the
+  module import graph has no cycle;
 * inside ``network`` only the ``conductance`` layer imports ``cache``;
 * no import of a project module inside a function (matplotlib and other optional libraries may
   stay lazy); no import of another module's ``_private`` name;
@@ -38,9 +39,9 @@ LAYERS = {
         {"pores"},
         {"conductance"},
         {"flow"},
-        {"airpaths"},
+        {"paths"},
         {"validation"},
-        {"__init__", "_cli", "solve", "throats", "paths", "curve", "report", "_report_band",
+        {"__init__", "_cli", "solve", "throats", "curve", "report", "_report_band",
          "_report_porosity", "_report_bed",
          "_report_system", "_report_html", "bench", "benchmarks",
          "__main__"},
@@ -140,6 +141,8 @@ def test_no_private_names_of_other_modules(package):
 def _layer_of(package, module):
     parts = module.split(".")
     key = parts[1] if len(parts) > 1 else "__init__"
+    if parts[-1] == "__main__":       # a subpackage's command (python -m network.paths)
+        key = "__main__"
     for i, layer in enumerate(LAYERS[package]):
         if key in layer:
             return i

@@ -7,7 +7,7 @@ import sys
 import numpy as np
 import pytest
 
-from network.paths import STANDIN_POROSITY, main, standin_packing
+from network.paths.__main__ import STANDIN_POROSITY, main, standin_packing
 
 SCENE = "network/data/soybean_default.csv"
 

@@ -5,7 +5,7 @@ open areas of a face (Eqs. 3.18, 3.23, 3.24)."""
 import numpy as np
 import pytest
 
-from network.airpaths import (
+from network.paths import (
     OMEGA_A,
     AirflowPath,
     bed_depth,

@@ -6,7 +6,7 @@ in a linear field, and the branched model's table against its single evaluations
 import numpy as np
 import pytest
 
-from network.airpaths import (
+from network.paths import (
     FaceGraph,
     branched_path_pressure_drop,
     branched_table,

@@ -3,7 +3,7 @@
 import numpy as np
 import pytest
 
-from network.airpaths import (
+from network.paths import (
     branched_pressure_drop,
     branching_multiplier,
     equivalent_diameter,

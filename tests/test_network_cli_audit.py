@@ -11,8 +11,9 @@ import sys
 import numpy as np
 import pytest
 
-from network import _cli, curve, paths, random_packing, read_packing, solve, throats
+from network import _cli, curve, random_packing, read_packing, solve, throats
 from network.packing import DegeneratePackingError, Packing
+from network.paths import __main__ as paths
 from network.pores import tessellate
 
 MAINS = {"solve": solve.main, "curve": curve.main, "throats": throats.main, "paths": paths.main}

@@ -10,7 +10,8 @@ import warnings
 import numpy as np
 import pytest
 
-from network import _cli, curve, default_packing_path, paths, solve, throats
+from network import _cli, curve, default_packing_path, solve, throats
+from network.paths import __main__ as paths
 
 PARSERS = {"solve": solve.build_parser, "curve": curve.build_parser,
            "throats": throats.build_parser, "paths": paths._parser}

@@ -10,7 +10,7 @@ import pytest
 
 from network import random_packing
 from network.flow import asabe_d272_gradient
-from network.paths import main
+from network.paths.__main__ import main
 from network.solve import main as solve_main
 
 SCENE = "network/data/soybean_default.csv"

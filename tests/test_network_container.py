@@ -12,7 +12,8 @@ import numpy as np
 import pytest
 
 from network import (Packing, random_packing, read_container, write_packing_csv)
-from network import curve, paths, report, solve, throats
+from network import curve, report, solve, throats
+from network.paths import __main__ as paths
 
 
 @pytest.fixture(scope="module")

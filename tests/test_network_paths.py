@@ -7,7 +7,7 @@ import numpy as np
 import pytest
 
 from network import Packing, tessellate
-from network.airpaths import (
+from network.paths import (
     EXIT_FACES,
     bed_depth,
     branched_path_pressure_drop,
@@ -30,7 +30,7 @@ from network.airpaths import (
     walk_paths,
 )
 from network.packing import lattice_packing, random_packing
-from network.paths import main
+from network.paths.__main__ import main
 
 
 # ------------------------------------------------------------------ Eqs. 3.25-3.27
@@ -199,7 +199,7 @@ def test_maximin_is_the_shortest_path_of_its_bottleneck_on_a_lattice():
     # on a simple-cubic lattice all windows of one kind have one area up to rounding: the
     # maximin path kept only faces >= its bottleneck bit for bit and came out up to 22 % longer
     # than the shortest path with the same bottleneck (the third audit)
-    from network.airpaths import face_graph, random_entry_points, trace_paths
+    from network.paths import face_graph, random_entry_points, trace_paths
     from network.packing import Packing, lattice_packing
     from network.pores import tessellate
 

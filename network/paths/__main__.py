@@ -37,15 +37,15 @@ import time
 
 import numpy as np
 
-from ._cli import (CliParser, add_air, add_packing, bad_input, check_common, check_outputs,
-                   check_plot, computing, finish, load_packing, packing_inputs, run)
-from .airpaths import (bed_depth, branched_table, face_graph, plot_paths, pore_pressure_array,
-                       pressure_along_path, random_entry_points, trace_paths)
-from .conductance import POLICIES
-from .flow import DEFAULT_DEPTH_M, asabe_d272_gradient, ergun_gradient, solve_network
-from .packing import UNITS, Packing, random_packing
-from .pores import (NoInteriorError, Region, axis_index, default_region, region_porosity,
-                    tessellate)
+from .._cli import (CliParser, add_air, add_packing, bad_input, check_common, check_outputs,
+                    check_plot, computing, finish, load_packing, packing_inputs, run)
+from . import (bed_depth, branched_table, face_graph, plot_paths, pore_pressure_array,
+               pressure_along_path, random_entry_points, trace_paths)
+from ..conductance import POLICIES
+from ..flow import DEFAULT_DEPTH_M, asabe_d272_gradient, ergun_gradient, solve_network
+from ..packing import UNITS, Packing, random_packing
+from ..pores import (NoInteriorError, Region, axis_index, default_region, region_porosity,
+                     tessellate)
 
 _ALL = ("widest", "narrowest", "maximin", "shortest")
 #: Thesis values (Tables 4.1-4.5) printed beside ours (pressures: over 0.25 m of soybeans).

@@ -21,7 +21,8 @@ pressure along it (:func:`pressure_along_path`).
 Modules: ``_geometry`` (angles, lengths, smoothing, face areas), ``_faces`` (the face graph,
 slivers, entry points), ``_record`` (:class:`AirflowPath`), ``_build`` (the thesis's
 construction), ``_walks`` (walks and graph paths, :func:`trace_paths`), ``_branched`` (the
-branched-path model, docs/airpaths-branched.md), ``_along`` (models along a path), ``_plots``.
+branched-path model, docs/airpaths-branched.md), ``_along`` (models along a path), ``_plots``;
+``__main__`` is the command ``python -m network.paths``.
 """
 
 from ._along import (branched_path_pressure_drop, branched_table, pore_pressure_array,
