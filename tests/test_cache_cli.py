@@ -1,4 +1,4 @@
-"""cache.lookup and throats.solve CSV output: one meaning of each column (issue 13 item 3)."""
+"""cache.lookup and throats.solve CSV output: one meaning of each column."""
 
 import csv
 

@@ -1,4 +1,4 @@
-"""cache.precompute, cache.lookup and throats.solve as a new user (issue 13): bad input exits
+"""cache.precompute, cache.lookup and throats.solve as a new user: bad input exits
 2 with one ``error:`` line naming the row, value or file, and nothing is written."""
 
 import csv

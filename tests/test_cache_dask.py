@@ -1,4 +1,4 @@
-"""Distributed precompute on Dask (issue 18 item 1): a LocalCluster of two workers fills the same
+"""Distributed precompute on Dask: a LocalCluster of two workers fills the same
 table as the serial run, bit for bit; an interrupted run resumes without solving anything twice;
 a lost worker's batches are solved elsewhere; an unreachable scheduler is one line, exit 2,
 nothing written.  Skipped only when dask.distributed is not installed (extra ``grainflow[dask]``)."""

@@ -80,7 +80,7 @@ def test_lookup_order_keeps_the_shape_puts_the_odd_radius_third_for_every_vertex
     assert np.array_equal(np.stack(lookup_order(rp, sp)), np.stack((rp, sp)))   # idempotent
 
 
-# windows of the shelled-corn clump bed (session 18's 2028-grain cube) that g1 cannot serve, in
+# windows of the shelled-corn clump bed (a 2028-grain cube) that g1 cannot serve, in
 # units of r̄: radius deviations to -0.373 (a half-size end sphere) and gaps to 3.2 r̄
 #: x1 against FE (rtol 1e-4) on these: within 0.07 % (the estimate: +29 %, +191 %, +130 %)
 TOL_X1 = 0.01

@@ -159,7 +159,7 @@ def test_clis_round_trip(tmp_path, monkeypatch, capsys):
     with open(src, "a", newline="") as fh:
         csv.writer(fh).writerow([40, 1, 1, 1, 1, 1, 5])   # not a triangle
     db = tmp_path / "cli.sqlite"
-    # precompute refuses the file before writing anything (issue 13), naming the row
+    # precompute refuses the file before writing anything, naming the row
     assert precompute_cli.main(["--db", str(db), "--csv", str(src), "--quiet"]) == 2
     assert "in.csv row 42: sides" in capsys.readouterr().err and not db.exists()
     assert precompute_cli.main(["--db", str(db), "--csv", str(good), "--quiet"]) == 0
@@ -207,4 +207,4 @@ def test_shipped_table_serves_current_solver_within_its_estimate(tmp_path):
     # docs/cache-error-estimate.md): here 11 of 12, the twelfth 5 % over its estimate
     assert np.mean(err <= res.error_estimate) >= 10 / 12
     assert np.all(err <= 2 * res.error_estimate)
-    assert np.median(err) < 3e-3  # issue 3 target: median <= 0.3 %
+    assert np.median(err) < 3e-3  # target: median <= 0.3 %

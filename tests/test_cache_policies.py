@@ -60,7 +60,7 @@ def test_table_only_is_within_its_estimate_of_fe_and_never_solves(heldout, tmp_p
     err = np.abs(res.qstar / fe.qstar - 1)
     # the estimate bounds the error against FE (FE's own rtol 1e-3 included)
     assert np.all(err <= res.error_estimate + RTOL_FE)
-    assert np.median(err) < 3e-3                      # issue 3 target: median <= 0.3 %
+    assert np.median(err) < 3e-3                      # target: median <= 0.3 %
     assert not (tmp_path / "t.sqlite").exists()      # table-only never creates a table
 
 
@@ -101,10 +101,10 @@ def test_fe_only_equals_solve_fem_and_reuses_its_rows(heldout, tmp_path):
 
 
 def test_table_error_estimate_is_honest_on_packing_throats(tmp_path):
-    # issue 13 item 4: g1's estimate, calibrated on network.sample_throats(1600, rng=2026)
+    # g1's estimate, calibrated on network.sample_throats(1600, rng=2026)
     # (docs/cache-error-estimate.md), on 160 other throats against FE at rtol 1e-4: it covers
-    # about 96 % of the errors (the former safety factor 2 covered 100 % with a median margin
-    # of 7x and sent 87 % of the rows to FE at rtol 3e-3; calibrated: 64-67 %)
+    # about 96 % of the errors with a median margin under 5x, and sends 64-67 % of the rows to
+    # FE at rtol 3e-3 (a flat safety factor 2 covers 100 % with a 7x margin and sends 87 %)
     r, s = network.sample_throats(160, rng=13)
     ref = throats.solve_fem(r, s, rtol=1e-4).qstar
     res = cache.lookup_qstar(r, s, db=tmp_path / "t.sqlite", policy="table-only")
@@ -112,7 +112,7 @@ def test_table_error_estimate_is_honest_on_packing_throats(tmp_path):
     est = res.error_estimate
     assert set(res.source) == {"interp"}
     assert np.mean(err <= est) >= 0.9
-    assert np.median(est / err) < 5          # the former estimate: 7x at the median
+    assert np.median(est / err) < 5          # a flat safety factor 2: 7x at the median
     rtol = 3e-3
     sent = est > rtol
     assert sent.mean() < 0.8
@@ -122,7 +122,7 @@ def test_table_error_estimate_is_honest_on_packing_throats(tmp_path):
 
 
 def test_table_policies_use_values_already_stored_in_the_db(heldout, tmp_path):
-    # issue 13 item 3: a stored FE value is served exactly (it was up to 1.3 % off before)
+    # a stored FE value is served exactly (interpolation is up to 1.3 % off there)
     r, s, fe = heldout
     db = tmp_path / "t.sqlite"
     interp = cache.lookup_qstar(r, s, db=db, policy="table-only").qstar

@@ -1,4 +1,4 @@
-"""cache.precompute as processes (issue 13): Ctrl-C stops cleanly and says what was saved,
+"""cache.precompute as processes: Ctrl-C stops cleanly and says what was saved,
 workers do not outlive a parent killed with kill -9, two runs on one table split the work."""
 
 import json
@@ -109,7 +109,7 @@ def test_workers_exit_after_kill_9_of_the_parent_and_a_rerun_finishes(tmp_path):
     with open_store(db) as store:
         summ = precompute_throats(store, r, s)
         assert store.count() == 300
-        # and the rerun cleared them (they stayed in the table for good before session 21)
+        # and the rerun cleared them: no claim outlives its run
         assert store.conn.execute("SELECT COUNT(*) FROM claims").fetchone()[0] == 0
     assert summ.solved == 300 - before and summ.extra["remaining"] == 0
 

@@ -1,5 +1,5 @@
 """Throats exported by network.throats and precomputed by cache.precompute are reused exactly
-by cache.lookup_qstar and network.solve (issue 13 item 5): one signature, one rounding."""
+by cache.lookup_qstar and network.solve: one signature, one rounding."""
 
 import json
 

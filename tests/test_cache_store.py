@@ -43,7 +43,7 @@ def _permute(r, s, p):
 @pytest.mark.parametrize("perm", PERMS)
 @pytest.mark.parametrize("scale", [1.0, 3.25e-3])
 def test_signature_invariant_under_permutation_and_scale(perm, scale):
-    # source: definition of the shape (issue 3, item 1): Q* depends on shape only
+    # source: definition of the shape: Q* depends on shape only
     r, s = _random_throats(50, 1)
     r0, s0 = r.copy(), s.copy()
     rp, sp = _permute(r * scale, s * scale, perm)

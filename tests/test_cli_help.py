@@ -1,5 +1,4 @@
-"""Every command's ``--help`` explains every option (issue 13: "``--help`` of every command
-explains every option").
+"""Every command's ``--help`` explains every option.
 
 Each CLI's ``main([])`` is run up to the moment it parses its arguments: the parser it built is
 captured there, so the test reads the real parser of every command, whichever function builds it.

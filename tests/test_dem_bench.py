@@ -1,4 +1,4 @@
-"""dem.bench: the rate scene and the JSON it writes (issue 12: benchmarks get tests)."""
+"""dem.bench: the rate scene and the JSON it writes (benchmarks get tests)."""
 
 import importlib
 import json

@@ -1,4 +1,4 @@
-"""dem command lines follow the project's exit codes (issue 13): 0 done, 1 computation failed
+"""dem command lines follow the project's exit codes: 0 done, 1 computation failed
 (unstable, not converged, interrupted), 2 bad input."""
 
 import json
@@ -27,7 +27,7 @@ def test_bad_input_exits_2(tmp_path, capsys):
 
 def test_ctrl_c_exits_1_with_one_line_and_writes_nothing(tmp_path, capsys, monkeypatch):
     """Ctrl-C during the packing: one ``interrupted:`` line, exit 1, no packing (it is written
-    whole at the end) and no traceback (issue 13)."""
+    whole at the end) and no traceback."""
     def interrupted(*args, **kwargs):
         raise KeyboardInterrupt
 

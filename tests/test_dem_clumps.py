@@ -1,4 +1,4 @@
-"""Rigid multi-sphere grains (dem.clumps, issue 15 items 1 and 6): free rotation, an analytic
+"""Rigid multi-sphere grains (dem.clumps): free rotation, an analytic
 clump-clump contact, and one-sphere templates against the sphere engine."""
 
 import numpy as np

@@ -1,4 +1,4 @@
-"""Contact-law and integrator checks against closed forms (dem engineer, issue 5 item 7)."""
+"""Contact-law and integrator checks against closed forms."""
 
 import numpy as np
 import pytest

@@ -1,4 +1,4 @@
-"""One packing-reader contract for every command (issue 13): dem's reader (``dem.vibrate``, the
+"""One packing-reader contract for every command: dem's reader (``dem.vibrate``, the
 vibration study) reads and refuses the same files as ``network.read_packing``, naming the same
 row; ``dem.vibrate`` turns each refusal into one ``error:`` line and exit 2.
 

@@ -1,5 +1,5 @@
 """The compiled step (dem._kernels, dem._neighbors, dem._threads): Newton's laws on a settled
-drop, the same numbers for any thread count, the contact law's closed forms (issue 17 item 1)."""
+drop, the same numbers for any thread count, the contact law's closed forms."""
 
 import numpy as np
 import pytest

@@ -123,11 +123,11 @@ def test_search_passes_over_a_bed_not_at_equilibrium(monkeypatch):
 
 @pytest.mark.parametrize("target, count_phi", [(0.2, 0.35), (0.9, 0.5), (0.42, 0.42)])
 def test_far_targets_count_grains_within_range_and_name_reach(monkeypatch, target, count_phi):
-    """A target far outside what grains reach no longer sets the grain count: 0.2 overfilled the
-    bin (N = 0.8 V/V_g: the closed-box end blew up, exit 1 after 46 s) and 0.9 left a bed too thin
-    for network's region (reachable range 'nan-nan'). N comes from the target clipped to
-    COUNT_POROSITY_RANGE; the ends are packed and the reachable range named (ValueError: exit 2).
-    On a real soybean bed (0.08 x 0.08 x 0.05 m box) 0.2 now ends in 42 s with 0.3211-0.4000."""
+    """A target far outside what grains reach does not set the grain count: 0.2 would overfill
+    the bin (N = 0.8 V/V_g: the closed-box end blows up) and 0.9 would leave a bed too thin for
+    network's region. N comes from the target clipped to COUNT_POROSITY_RANGE; the ends are
+    packed and the reachable range named (ValueError: exit 2). On a real soybean bed
+    (0.08 x 0.08 x 0.05 m box) 0.2 ends with the reachable range 0.3211-0.4000."""
     seen = []
     law = _fake(lambda lam: 0.40 + 0.01 * lam, [])
 

@@ -1,4 +1,4 @@
-"""Packing procedures of dem.pack (issue 5, rect-bin target interior porosity 0.408 ± 0.01).
+"""Packing procedures of dem.pack (rect-bin target interior porosity 0.408 ± 0.01).
 
 The full rect-bin is measured by ``python -m dem.pack --scene rect-bin`` (numbers in
 docs/dem-packing.md); here a 0.06 × 0.02 m slab with rect-bin's thickness (about three

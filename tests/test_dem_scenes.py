@@ -1,4 +1,4 @@
-"""Scenes, packing procedure, measurements and file I/O of dem (issue 5 items 1, 2, 4, 7)."""
+"""Scenes, packing procedure, measurements and file I/O of dem."""
 
 import numpy as np
 import pytest
@@ -119,7 +119,7 @@ def test_same_seed_same_packing_and_io_roundtrip(tmp_path, tiny_bed):
 
 
 def test_vibration_records_histories(tiny_bed):
-    # amplitude 0: the library allows a control run (the CLI refuses A <= 0, issue 17)
+    # amplitude 0: the library allows a control run (the CLI refuses A <= 0)
     res = vibrate_bed(tiny_bed.centers, tiny_bed.radii, TINY, freq_hz=15, amplitude_m=0.0, duration_s=0.02,
                   record_every_s=0.005, snapshot_times_s=[0.01], max_settle_steps=200)
     # 0.02 s recorded every 0.005 s, plus the initial and the post-settling records
@@ -148,7 +148,7 @@ def test_clis_refuse_bad_arguments_and_vibrate_runs(tmp_path, tiny_bed, capsys):
                      "--settle-steps", "200"]) == 0
     assert (out / "vib_1mm.csv").exists() and (out / "series.json").exists()
     assert "1.81 g" in capsys.readouterr().out
-    # issue 17, bad input: each a one-line error and exit 2
+    # bad input: each a one-line error and exit 2
     for bad, match in [(["--amplitude", "0"], "amplitudes must be > 0"), (["--amplitude", "-0.001"], "> 0"),
                        (["--amplitude", "0.001", "--freq", "0"], "--freq must be > 0"),
                        (["--intensity", "10.5"], "above 10 g")]:

@@ -1,4 +1,4 @@
-"""Size spread of multi-sphere grains (issue 15 item 2): each grain is its template scaled by
+"""Size spread of multi-sphere grains: each grain is its template scaled by
 f = 1 + cv z (z standard normal cut at 2.5); cv = 0 is the packing without spread, bit for bit."""
 
 import json

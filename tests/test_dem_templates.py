@@ -1,4 +1,4 @@
-"""Multi-sphere grain templates (issue 15 item 2): axes and volume within 2 %, one body, bad input."""
+"""Multi-sphere grain templates: axes and volume within 2 %, one body, bad input."""
 
 import numpy as np
 import pytest

@@ -1,4 +1,4 @@
-"""Vibration checks of issue 17 item 4, resumable runs and the study command (dem.study)."""
+"""Vibration checks, resumable runs and the study command (dem.study)."""
 
 import importlib
 import json

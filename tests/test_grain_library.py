@@ -1,4 +1,4 @@
-"""The grain library (issue 16 item 1): every value sourced or marked not found, every number
+"""The grain library: every value sourced or marked not found, every number
 physically sensible, the D272 soybean check of the thesis, and one set of grain names."""
 
 import math
@@ -109,7 +109,7 @@ def test_d272_soybean_gives_the_thesis_check():
     assert dp(0.027, 0.25) == pytest.approx(5.18, abs=0.005)
 
 
-#: issue 16 item 1: the D272.3 pairs of the secondary source (stored file id 70324629401, a
+#: the D272.3 pairs of the secondary source (stored file id 70324629401, a
 #: port of the fan-sizing spreadsheet Resistencia_Fluxo_de_Ar.xls), corn's confirmed by a second
 #: (id 70970216257)
 SECONDARY = {"wheat": (27000.0, 8.77, "Trigo"), "shelled_corn": (20700.0, 30.4, "Milho"),

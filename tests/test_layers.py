@@ -1,6 +1,6 @@
 """The code's architecture, read with ``ast``: layer order, no cycles, small modules.
 
-Rules (issue 12):
+Rules:
 
 * packages: ``throats`` <- ``cache`` <- ``network``; ``dem`` stands apart (it imports no other
   project package and none imports it). A benchmark (``<package>/bench.py``) is a tool on top of

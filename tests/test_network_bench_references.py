@@ -1,4 +1,4 @@
-"""Part 3 of ``python -m network.bench`` (issue 7, item 4): error against the references.
+"""Part 3 of ``python -m network.bench``: error against the references.
 
 Runs the references part on one lattice case (SC, phi = 0.45) and one small random packing,
 checks that every number in the JSON is what the validation helpers give directly, that FE
@@ -85,7 +85,7 @@ def test_fe_only_reproduces_exact_qstar_and_pays_fe_every_repeat(report):
     assert fe["fe_solves"] == [6, 6]
     assert sc["cells"]["thesis/fe-only"]["fe_solves"] == [1, 1]
     assert sc["cells"]["conduit/shape-factor"]["fe_solves"] == [0, 0]
-    # thesis model (L = 2 rbar) with FE Q*: about half of the exact value (issue 7)
+    # thesis model (L = 2 rbar) with FE Q*: about half of the exact value
     assert 0.45 < sc["cells"]["thesis/fe-only"]["ratio"] < 0.55
     for cell in sc["cells"].values():
         assert cell["repeats"] == 2 and len(cell["seconds_all"]) == 2

@@ -80,8 +80,8 @@ def test_exponent_needs_two_sizes():
 
 def test_per_packing_rows(run):
     """``--per-packing``: the whole network.solve command timed per packing and mode, each row
-    with ordered min <= median <= max over its runs, the target and YADE's time where issue 18
-    gives them, the bundled scene last; the packing files of the scaling part are reused."""
+    with ordered min <= median <= max over its runs, the target and YADE's time where
+    they are known, the bundled scene last; the packing files of the scaling part are reused."""
     tmp, _ = run
     out = tmp / "per_packing.json"
     rc = bench.main(["--per-packing", "--sizes", str(SIZES[0]), "--repeats", "2",

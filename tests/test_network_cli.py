@@ -1,4 +1,4 @@
-"""CLIs: python -m network.solve / network.throats on the bundled scene (issue 4, items 7, 9)."""
+"""CLIs: python -m network.solve / network.throats on the bundled scene."""
 
 import json
 
@@ -46,7 +46,7 @@ def test_solve_default_scene(default_run, capsys):
     k, mu, v = out["permeability_m2"], out["viscosity_pa_s"], out["velocity_m_s"]
     assert np.isclose(out["pressure_gradient_stokes_pa_per_m"], mu * v / k)
     assert np.isclose(out["pressure_drop_stokes_pa"], 0.25 * mu * v / k)
-    assert out["pressure_drop_pa"] > out["pressure_drop_stokes_pa"]        # inertia (issue 14)
+    assert out["pressure_drop_pa"] > out["pressure_drop_stokes_pa"]        # inertia
     # ASABE D272 soybeans at 0.013 m/s over 0.25 m: 2.28 Pa (thesis 4.2.3)
     assert round(out["comparisons"]["asabe_d272"]["pressure_drop_pa"], 2) == 2.28
     assert vtu["pressure"].shape == (out["n_pores"],)

@@ -1,4 +1,4 @@
-"""The shared CLI conventions of network.solve/curve/throats/paths (issue 13): every option has
+"""The shared CLI conventions of network.solve/curve/throats/paths: every option has
 help with its unit or default, exit codes 0/1/2 with one ``error:`` line, numpy/scipy warnings
 captured, output folders and matplotlib checked before any work; curve and throats bad input."""
 

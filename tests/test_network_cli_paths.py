@@ -1,4 +1,4 @@
-"""``python -m network.paths`` (issue 13 item 6): tortuosity >= 1 for paths on the tessellation,
+"""``python -m network.paths``: tortuosity >= 1 for paths on the tessellation,
 entries checked, a path traced twice counted once, one stated depth for the comparisons; bad
 input exits 2 with one line."""
 

@@ -1,4 +1,4 @@
-"""``python -m network.solve`` as a new user runs it (issue 13): units, exit codes, one-line
+"""``python -m network.solve`` as a new user runs it: units, exit codes, one-line
 errors checked before any work, per-pore/per-throat CSV and the VTK files."""
 
 import json

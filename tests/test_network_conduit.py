@@ -75,7 +75,7 @@ def test_section_estimate_closed_form_and_symmetry():
     assert q == pytest.approx(At**2 * f / (2 * math.pi), rel=1e-12)
     # against FE (throats.solve_fem, rtol 1e-3) on the square-array section, legs 1, equal
     # disks: 0.13473, 0.081426, 0.033472 at rho = 0.05, 0.1, 0.2; the dilute cell model is
-    # within 0.7, 1.2, 2.8 % of them (the former A^3/(2 P^2) was 18, 7.1, 3.2 times off)
+    # within 0.7, 1.2, 2.8 % of them (the wetted-perimeter A^3/(2 P^2) is 18, 7.1, 3.2 times off)
     fe = np.array([0.13473, 0.081426, 0.033472])
     rr = np.array([0.05, 0.1, 0.2])
     est = section_estimate(np.repeat(rr[:, None], 3, 1), [[1.0, 1.0, math.sqrt(2)]] * 3)
@@ -124,7 +124,7 @@ def _fe_memo():
 
 
 #: Conduit model (default settings, exact Q* of every section) / exact Stokes permeability,
-#: read in the sample core, for every lattice case of issue 7: SC against Zick & Homsy (1982)
+#: read in the sample core, for every lattice case of the bench: SC against Zick & Homsy (1982)
 #: Table 2, BCC/FCC against network._references.computed_lattice_permeability. Pinned so
 #: that a change of the model shows up in every case.
 LATTICE_CASES = [
@@ -144,7 +144,7 @@ def _exact_lattice_k(kind, phi, r):
 
 
 def test_every_lattice_case_against_exact_stokes():
-    # issue 7 target: within 10 % from phi = 0.3 to touching. Met in 12 of 13 cases; BCC at
+    # target: within 10 % from phi = 0.3 to touching. Met in 12 of 13 cases; BCC at
     # phi = 0.3 is 12.9 % low (a known miss, analysed in network._conduit: no per-section
     # correction brings SC and BCC at phi = 0.3 within 10 % together). Asserted as measured,
     # not hidden: if a model change moves it, this test says so.
@@ -201,7 +201,7 @@ RANDOM_CASES = [(0.36, 1.054), (0.40, 1.014), (0.45, 1.043)]
 
 @pytest.mark.parametrize("porosity, expected", RANDOM_CASES)
 def test_random_packings_against_lbm_drag_law(porosity, expected):
-    # issue 7 target: within 10 % of the LBM law for random packings of porosity 0.36-0.45;
+    # target: within 10 % of the LBM law for random packings of porosity 0.36-0.45;
     # the thesis model is about a third of it (measured 0.30-0.33)
     from network.validation import random_sample_permeability
     from network.validation import beetstra_permeability

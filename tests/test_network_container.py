@@ -1,4 +1,4 @@
-"""The container in a packing's companion JSON (issue 13: "unknown container kinds are errors").
+"""The container in a packing's companion JSON ("unknown container kinds are errors").
 
 A ``container`` entry of an unknown kind, or with sizes that do not fit its kind, is refused by
 every network command with one ``error:`` line naming the file, exit 2, nothing written; a JSON

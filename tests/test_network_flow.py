@@ -1,4 +1,4 @@
-"""Assembly, condensation and the pyamg solve (issue 4, item 5; STYLE item 7)."""
+"""Assembly, condensation and the pyamg solve (STYLE item 7)."""
 
 import numpy as np
 import pytest
@@ -118,7 +118,7 @@ def test_isolated_free_pore_is_an_error():
 
 
 def test_amg_solver_builds_once_and_keeps_evolution():
-    """AMGSolver (issue 12): a second right-hand side reuses the hierarchy (no setup time, one
+    """AMGSolver: a second right-hand side reuses the hierarchy (no setup time, one
     build); under 1e12 contrast the evolution hierarchy, once built, is kept for later solves."""
     from network.flow import AMGSolver
     idx, c = grid_network(10, 10, 10)
@@ -168,7 +168,7 @@ def test_amg_setup_is_reproducible_and_leaves_numpy_random_alone():
 
 
 def test_finest_smoothing_weight_is_the_gershgorin_bound():
-    """The finest prolongator is smoothed with rho = max_i sum_j |a_ij| / a_ii (issue 18): 2 for
+    """The finest prolongator is smoothed with rho = max_i sum_j |a_ij| / a_ii: 2 for
     a condensed grid Laplacian, never below the largest eigenvalue of D^-1 A; a matrix that is
     not diagonally dominant (bound > 2) keeps pyamg's estimate. Both solve to the tolerance."""
     from network.flow import AMGSolver

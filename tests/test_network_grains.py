@@ -1,4 +1,4 @@
-"""Pore networks of multi-sphere grains (issue 15, network side): grain ids, solid pores,
+"""Pore networks of multi-sphere grains: grain ids, solid pores,
 grain diameters, and one-sphere grains reproducing the sphere results."""
 
 import numpy as np

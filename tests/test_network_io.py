@@ -1,4 +1,4 @@
-"""read_packing: formats and the messages for bad input (issue 4, item 1)."""
+"""read_packing: formats and the messages for bad input."""
 
 import numpy as np
 import pytest

@@ -1,4 +1,4 @@
-"""Lean imports of command processes (network._lean, issue 18 item 2): NumPy's f2py, testing
+"""Lean imports of command processes (network._lean): NumPy's f2py, testing
 and ma are deferred, SciPy's docstring tables skipped, and nothing a command computes changes."""
 
 from __future__ import annotations

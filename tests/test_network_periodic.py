@@ -45,9 +45,9 @@ def test_shifting_the_cell_does_not_change_k():
 ])
 def test_sample_permeability_does_not_depend_on_where_the_faces_fall(kind, phi, n_cells,
                                                                      expected):
-    """Issue 13 item 7: sliding the sample box over a lattice moved the whole-sample value by
-    11-14 % (SC 1.108 -> 1.228, FCC 0.882 -> 0.980); permeability_m2, read in the inset window
-    with each throat weighted by the part of its face inside it, stays within 0.3 %."""
+    """Sliding the sample box over a lattice moves the whole-sample value by 11-14 % (SC
+    1.108 -> 1.228, FCC 0.882 -> 0.980); permeability_m2, read in the inset window with each
+    throat weighted by the part of its face inside it, stays within 0.3 %."""
     from network.flow import solve_network
     from network.packing import lattice_packing
     from network.pores import Region, tessellate

@@ -171,13 +171,13 @@ def test_end_to_end_bundled_scene(tmp_path, capsys, monkeypatch):
         band = p["pressure_gradient_band_pa_per_m"]
         assert list(band) == ["-0.02", "-0.01", "+0.01", "+0.02"]
         assert band["-0.02"] > band["-0.01"] > p["pressure_gradient_pa_per_m"] > band["+0.02"]
-    assert -20 < r["band"]["slopes"][0] < -6            # issue 16: about -11 near 0.40
+    assert -20 < r["band"]["slopes"][0] < -6            # about -11 near 0.40
     op = r["operating_point"]
     assert op["found"] and 0.14 < op["airflow_m3_s"] < 0.2
 
 
 def test_done_when_wheat_from_the_bundled_bed(tmp_path, capsys, monkeypatch):
-    """Issue 16's done-when, with 2 velocities: `--grain wheat --depth 3 --diameter 6` runs on
+    """The wheat report, with 2 velocities: `--grain wheat --depth 3 --diameter 6` runs on
     the bundled wheat bed (network/data/wheat_grains.csv, made by dem.pack --porosity 0.402),
     reports for wheat's measured loose-fill 0.402 (middle of 0.391-0.413, Ramaj 2022), with
     the kernel density 1240 kg/m^3 (Int. Agrophys. 2003), and writes its figures."""
@@ -256,7 +256,7 @@ def test_measured_band_is_the_fit_of_the_grain_beds():
         coef, cov = np.polyfit(e, y, 1, cov=True)
         assert b["slopes"][j] == pytest.approx(coef[0], rel=1e-9)
         assert b["slope_stderrs"][j] == pytest.approx(np.sqrt(cov[0, 0]), rel=1e-6)
-    assert [round(x, 2) for x in b["slopes"]] == [-10.63, -10.12, -8.64]     # session 18 beds
+    assert [round(x, 2) for x in b["slopes"]] == [-10.63, -10.12, -8.64]     # band_wheat.json's beds
     assert measured_band("soybean") is None and len(data["beds"]) == 8
 
 

@@ -1,4 +1,4 @@
-"""The network model end to end: invariances, isotropy, pruning, tie-breaking (issue 4, item 8)."""
+"""The network model end to end: invariances, isotropy, pruning, tie-breaking."""
 
 import numpy as np
 import pytest
@@ -151,7 +151,7 @@ def test_region_validation():
 
 
 def test_conduit_model_hook(small_bed):
-    """'conduit' dispatches to the conduit model (issue 7) with its pore bodies contracted."""
+    """'conduit' dispatches to the conduit model with its pore bodies contracted."""
     res = solve_network(small_bed, conductance_model="conduit", policy="shape-factor",
                         porosity_points=0)
     assert res.conductance_model == "conduit" and res.check["ok"]
@@ -272,7 +272,7 @@ def test_core_permeability_of_a_lattice_does_not_drift_with_sample_size():
 
 
 def test_bad_options_are_refused_before_the_tessellation(small_bed, monkeypatch):
-    """Options are checked at the door (issue 12): a bad policy, model or viscosity never
+    """Options are checked at the door: a bad policy, model or viscosity never
     reaches the tessellation."""
     import network.flow._pipeline as pipeline
 
@@ -289,7 +289,7 @@ def test_bad_options_are_refused_before_the_tessellation(small_bed, monkeypatch)
 
 
 def test_threads_do_not_change_the_answer(small_bed):
-    """Conductance blocks on several threads and the porosity beside Qhull (issue 18): the same
+    """Conductance blocks on several threads and the porosity beside Qhull: the same
     conductances to the last bit, the same porosity, and a bad thread count refused."""
     tess = tessellate(small_bed)
     idx = np.arange(tess.n_throats)

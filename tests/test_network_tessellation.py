@@ -1,4 +1,4 @@
-"""tessellate: topology on hand-made cases, lattices with co-spherical points (issue 4, item 2)."""
+"""tessellate: topology on hand-made cases, lattices with co-spherical points."""
 
 import numpy as np
 import pytest

@@ -1,4 +1,4 @@
-"""python -m network.throats as a new user (issue 13): lossless lengths, bad input exits 2
+"""python -m network.throats as a new user: lossless lengths, bad input exits 2
 with one ``error:`` line and writes nothing, --help covers every option."""
 
 import numpy as np

@@ -1,4 +1,4 @@
-"""network.report packs a new bed (issue 16 item 2: "--seed or a new porosity packs anew").
+"""network.report packs a new bed ("--seed or a new porosity packs anew").
 
 The real packings are the smallest bed dem.pack makes in seconds: soybean in a 0.04 m box
 (258 six-sphere grains at porosity 0.40; a 0.025 or 0.035 m box leaves network's sample region
@@ -43,7 +43,7 @@ def test_pack_command_lets_slow_grains_settle(tmp_path):
 
 def test_packs_a_new_bed_then_reuses_it(tmp_path, monkeypatch):
     """--porosity 0.40 --seed 1: dem.pack packs the bed (reached within 0.005 of 0.40: 0.3969
-    on the session-4 host, 0.4020 on an AMD EPYC host; the DEM's host-compiled steps differ in
+    on one x86-64 host, 0.4020 on an AMD EPYC host; the DEM's host-compiled steps differ in
     last bits and a packing is chaotic), the report is for that bed's own porosity; the same
     command again reuses the bed (no packing: the CSV untouched, the numbers the same)."""
     monkeypatch.chdir(tmp_path)
@@ -66,7 +66,7 @@ def test_packs_a_new_bed_then_reuses_it(tmp_path, monkeypatch):
     assert abs(meta["porosity_network_region"] - 0.40) <= PACK_TOL
     assert meta["porosity_network_region"] == pytest.approx(float(reached.group(1)), abs=1e-4)
     assert r["n_grains"] == meta["n_grains"] and r["n_spheres"] == 6 * r["n_grains"]
-    assert 240 <= r["n_grains"] <= 280                   # 258 on the session-4 host
+    assert 240 <= r["n_grains"] <= 280                   # 258 on one x86-64 host
     # the report's porosity is the new bed's own (network's Monte Carlo), not moved
     assert r["porosity"] == r["porosity_packing"]
     assert abs(r["porosity"] - 0.40) <= PACK_TOL + 3 * r["porosity_packing_std"]
@@ -83,14 +83,14 @@ def test_packs_a_new_bed_then_reuses_it(tmp_path, monkeypatch):
     assert csv.stat().st_mtime_ns == stamp
     assert [p["pressure_gradient_pa_per_m"] for p in again["points"]] == pytest.approx(
         [p["pressure_gradient_pa_per_m"] for p in r["points"]], rel=1e-9)
-    # soybean at porosity 0.40: 4.30 and 57.45 Pa/m on the session-4 host's bed
+    # soybean at porosity 0.40: 4.30 and 57.45 Pa/m on one x86-64 host's bed
     g = [p["pressure_gradient_pa_per_m"] for p in r["points"]]
     assert 3.0 < g[0] < 6.0 and 40.0 < g[1] < 80.0 and g[1] / g[0] > 10.0
 
 
 def test_a_porosity_dem_pack_cannot_reach_exits_2(tmp_path, monkeypatch, capsys):
     """dem.pack's own refusal (exit 2, the range its two end packings reach: 0.3753-0.4074 for
-    the grain count of 0.45 on the session-4 host, 0.3880-0.4029 on an AMD EPYC host: chaotic
+    the grain count of 0.45 on one x86-64 host, 0.3880-0.4029 on an AMD EPYC host: chaotic
     packings of host-compiled steps) is the report's one error line; nothing written."""
     monkeypatch.chdir(tmp_path)
     beds, out = tmp_path / "a" / "beds", tmp_path / "r.json"

@@ -93,7 +93,7 @@ def test_validate_throats_flags_bad_rows_with_messages():
     s = np.array([[2.2, 2.2, 2.2], [2, 2, 2], [2, 2, 2], [1, 2, 3], [1, 5, 1], [2, 2, 2]])
     r0, s0 = r.copy(), s.copy()
     ok, msg = validate_throats(r, s)
-    # row 5, a disk containing another vertex, is a valid triangle of disks (issue 13 item 9)
+    # row 5, a disk containing another vertex, is a valid triangle of disks
     assert ok.tolist() == [True, False, False, False, False, True]
     assert msg[0] == "" and msg[5] == ""
     assert "non-finite" in msg[1] and "radius <= 0" in msg[2]

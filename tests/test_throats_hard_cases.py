@@ -1,4 +1,4 @@
-"""Throat hard cases (issue 13 item 9): every valid triangle of disks gets Q* (possibly 0)
+"""Throat hard cases: every valid triangle of disks gets Q* (possibly 0)
 with a status that says which case it was; ordinary throats keep their numbers."""
 
 import csv

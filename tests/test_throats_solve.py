@@ -35,7 +35,7 @@ def test_circle_duct_pi_over_8():
     q, est, n, status, _ = _solve_geometry(disk_geometry(1.0), 1e-4)
     assert status == "ok"
     err = abs(q / (np.pi / 8) - 1)
-    assert err < 5e-4          # issue 2: <= 0.05 %
+    assert err < 5e-4          # <= 0.05 %
     assert err <= est          # the estimate bounds the true error
 
 
