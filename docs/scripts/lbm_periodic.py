@@ -1,6 +1,6 @@
 r"""Lattice-Boltzmann reference for k/k_app(Re) of our own periodic random sphere packings.
 
-Research script for issue 14 (``docs/inertial-lbm.md``): a resolved flow computation on the very
+Research script (``docs/inertial-lbm.md``): a resolved flow computation on the very
 packing the network model uses, to tell whether the network's gap to Beetstra et al. (2007) is
 the network's physics or the law's application to our packings.
 

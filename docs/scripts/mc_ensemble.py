@@ -1,7 +1,7 @@
 r"""Does the packing protocol move the inertial excess? Network k/k_app on our random packings
-against the same packings taken to hard-sphere Monte Carlo configurations (issue 14 item 5).
+against the same packings taken to hard-sphere Monte Carlo configurations.
 
-Research script (``docs/inertial-flow.md``, "Session 17: the packing ensemble"). Beetstra et
+Research script (``docs/inertial-flow.md``, "Validation"; ``docs/inertial-lbm.md``). Beetstra et
 al. (2007) fitted their F1 term to lattice-Boltzmann runs on random arrays made by a hard-sphere
 Monte Carlo procedure (van der Hoef et al. 2005); ``network.random_packing`` grows radii and
 pushes overlaps apart instead, which leaves many pairs at contact. Our resolved flow lies

@@ -1,4 +1,4 @@
-"""YADE's FlowEngine on a packing CSV (x,y,z,r in m): the same-host timing of issue 18.
+"""YADE's FlowEngine on a packing CSV (x,y,z,r in m): timed beside ours on the same host.
 
 Run by YADE, not by Python (Debian: ``apt-get install yade``)::
 
@@ -10,7 +10,7 @@ FlowEngine's ``useSolver`` (default 3, CHOLMOD). Printed: the first ``emulateAct
 (triangulation, throat geometry, factorisation, solve: what "FlowEngine's time" means in
 ``docs/network-bench.md``), the second (re-triangulation and solve), the flux through the lower
 wall and the permeability q L / (A dp). The walls and FlowEngine's defaults are not tuned to
-this packing: compare the times, not the permeability (``docs/network-bench.md``, "Session 8").
+this packing: compare the times, not the permeability (``docs/network-bench.md``, "Per packing").
 Not part of the package.
 """
 import sys, time, numpy as np
