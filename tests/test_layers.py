@@ -41,9 +41,7 @@ LAYERS = {
         {"flow"},
         {"paths"},
         {"validation"},
-        {"__init__", "_cli", "solve", "throats", "curve", "report", "_report_band",
-         "_report_porosity", "_report_bed",
-         "_report_system", "_report_html", "bench", "benchmarks",
+        {"__init__", "_cli", "solve", "throats", "curve", "report", "bench", "benchmarks",
          "__main__"},
     ],
 }

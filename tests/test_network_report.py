@@ -7,8 +7,8 @@ import json
 import numpy as np
 import pytest
 
-from network._report_band import band_gradients, fit_log_slope, slope_at
-from network._report_system import (bulk_density, curve_range, operating_point, read_fan,
+from network.report.band import band_gradients, fit_log_slope, slope_at
+from network.report.system import (bulk_density, curve_range, operating_point, read_fan,
                                     system_rows, velocity_from_airflow)
 from network.report import main
 
@@ -123,7 +123,7 @@ def test_a_sphere_packing_moves_at_most_the_band_span(tmp_path, capsys, monkeypa
     """A packing without a recorded range (the 3000-sphere scene, own porosity 0.3990): the
     report moves along the band at most 0.02, so 0.43 is refused after the solve, before
     anything is written."""
-    from network._report_porosity import DATA_DIR
+    from network.report.porosity import DATA_DIR
     monkeypatch.chdir(tmp_path)
     assert main(["--packing", str(DATA_DIR / "soybean_default.csv"), "--porosity", "0.43",
                  "--velocities", "0.01,0.1", "--no-band", "-q"]) == 2
@@ -247,7 +247,7 @@ def test_measured_band_is_the_fit_of_the_grain_beds():
     """measured_band fits ln g = c + S e over the bundled wheat beds (one family): the slope and
     its standard error equal an independent numpy least-squares fit; grains without measured
     beds get None (the report then packs sphere beds)."""
-    from network._report_band import GRAIN_BANDS, measured_band
+    from network.report.band import GRAIN_BANDS, measured_band
     data = json.loads(GRAIN_BANDS["wheat"].read_text())
     b = measured_band("wheat")
     e = np.array([x["porosity"] for x in data["beds"]])
@@ -277,3 +277,94 @@ def test_results_outside_the_checked_range_are_warned(tmp_path, capsys, monkeypa
                  "--no-figures", "-q"]) == 0
     err = capsys.readouterr().err
     assert "beyond the 200" not in err and "of the atmosphere" not in err
+
+
+#: the bundled wheat report (--depth 3 --diameter 6 --velocities 0.01,0.1 --airflow 0.1
+#: m3/min/t): its printed table and key JSON numbers, pinned so that a change of the report's
+#: code that is meant to leave its behaviour alone is seen to do so
+WHEAT_PINNED_LINES = [
+    "Stokes k at the packing's own porosity: vertical 1.4283e-08 m^2, horizontal 1.4659e-08 m^2 "
+    "(horizontal/vertical resistance 0.974)",
+    "0.003708  0.944       4.93      4.805       11.6      3.582      6.098      5.483      "
+    "4.433      3.986",
+    "    0.01   2.55      13.54      13.21      32.12      9.957      16.69      15.03      "
+    "12.19      10.98",
+    "     0.1   25.5      184.8      181.2      428.8        142      223.2      203.1      "
+    "168.2        153",
+    "fits vertical: k 1.4806e-08 m^2, beta 4523 1/m; D272-style a 1.228e+04 Pa s^2/m^3, b 9.442 "
+    "s/m; Ergun A 206.3, B 2.015",
+    "airflow 0.1 m^3/(min t) = 0.003708 m/s: 0.1048 m^3/s, static pressure 14.79 Pa",
+]
+WHEAT_PINNED = {
+    "porosity_packing": 0.40002499999999996, "porosity_packing_std": 0.00109545652441117,
+    "sauter_diameter_m": 0.004100923213830399,
+    "k_z": 1.4282553226623287e-08, "k_x": 1.4658917433766208e-08,
+    "fit_k": 1.4806020860248584e-08, "fit_beta": 4523.171656834166,
+    "fit_k_x": 1.519179371543304e-08,
+    "g_z": [4.93014007930651, 13.538950293537857, 184.82954627559],
+    "g_x": [4.8052976390771835, 13.209542991034187, 181.23382852818062],
+    "ergun": [3.581632317414464, 9.956848680058203, 141.9916640299215],
+    "band_minus_002": [6.098196723375244, 16.689268247735434, 223.22063730717161],
+    "system_pa": [14.79042023791953, 40.61685088061357, 554.4886388267699],
+}
+
+
+@pytest.mark.slow
+def test_bundled_wheat_report_numbers_are_pinned(tmp_path, capsys, monkeypatch):
+    """The bundled wheat bed's report, printed lines to the last digit and JSON numbers to
+    1e-10: a code move that keeps behaviour keeps these (the solve is deterministic)."""
+    monkeypatch.chdir(tmp_path)
+    out = tmp_path / "w.json"
+    assert main(["--grain", "wheat", "--depth", "3", "--diameter", "6", "--velocities",
+                 "0.01,0.1", "--airflow", "0.1", "m3/min/t", "--no-figures", "--json", str(out),
+                 "-q"]) == 0
+    lines = capsys.readouterr().out.splitlines()
+    for want in WHEAT_PINNED_LINES:
+        assert want in lines, want
+    r = json.loads(out.read_text())
+    pts = r["points"]
+    got = {
+        "porosity_packing": r["porosity_packing"],
+        "porosity_packing_std": r["porosity_packing_std"],
+        "sauter_diameter_m": r["sauter_diameter_m"],
+        "k_z": r["permeability_stokes_m2"]["z"], "k_x": r["permeability_stokes_m2"]["x"],
+        "fit_k": r["fits"]["permeability_m2"], "fit_beta": r["fits"]["forchheimer_beta_per_m"],
+        "fit_k_x": r["fits_horizontal"]["permeability_m2"],
+        "g_z": [p["pressure_gradient_pa_per_m"] for p in pts],
+        "g_x": [p["pressure_gradient_horizontal_pa_per_m"] for p in pts],
+        "ergun": [p["ergun_pressure_gradient_pa_per_m"] for p in pts],
+        "band_minus_002": [p["pressure_gradient_band_pa_per_m"]["-0.02"] for p in pts],
+        "system_pa": [s["static_pressure_pa"] for s in r["system_curve"]],
+    }
+    for key, want in WHEAT_PINNED.items():
+        assert got[key] == pytest.approx(want, rel=1e-10, abs=0), key
+
+
+def test_report_options_are_keyword_only_frozen_and_checked():
+    """ReportOptions: keyword-only, frozen, defaults resolved from the grain library (wheat's
+    kernel density 1240 kg/m^3), and each impossible value refused naming its field."""
+    import dataclasses
+
+    from network.report import ReportOptions
+    with pytest.raises(TypeError):
+        ReportOptions("wheat")                                # keyword-only
+    o = ReportOptions(grain="Wheat", velocities_m_s=[0.01, 0.1])
+    assert o.grain == "wheat" and o.velocities_m_s == (0.01, 0.1)
+    assert o.particle_density_kg_m3 == 1240.0 and "Agrophys" in o.particle_density_source
+    assert o.depth_m == 0.25 and o.axis == "z" and o.band and o.fan is None
+    with pytest.raises(dataclasses.FrozenInstanceError):
+        o.depth_m = 3.0
+    for kw, msg in [({"depth_m": -1.0}, "depth_m must be a finite number > 0"),
+                    ({"velocities_m_s": [0.01, float("nan")]}, "velocities_m_s must be"),
+                    ({"porosity": 1.2}, r"porosity must be in \(0, 1\)"),
+                    ({"axis": "y"}, "axis must be 'z' or 'x'"),
+                    ({"airflow": (1.0, "cfs")}, "airflow unit 'cfs'"),
+                    ({"diameter_m": 6.0, "floor_area_m2": 3.0}, "not both"),
+                    ({"fan_airflow_m3_s": [0, 1], "fan_static_pressure_pa": [5, 1]},
+                     "a fan curve needs the bin"),
+                    ({"band_seed": -1}, "band_seed must be an integer >= 0"),
+                    ({"grain": "oats"}, "unknown grain 'oats'")]:
+        with pytest.raises(ValueError, match=msg):
+            ReportOptions(**{"grain": "wheat", **kw})
+    with pytest.raises(ValueError, match="no sourced kernel density for canola"):
+        ReportOptions(grain="canola")

@@ -19,7 +19,7 @@ from pathlib import Path
 import pytest
 
 from dem import TEMPLATE_GRAINS as DEM_TEMPLATES
-from network._report_bed import PACK_MAX_STEPS, PACK_TOL, TEMPLATE_GRAINS, pack_command
+from network.report.bed import PACK_MAX_STEPS, PACK_TOL, TEMPLATE_GRAINS, pack_command
 from network.report import main
 
 ROOT = Path(__file__).resolve().parent.parent

@@ -24,8 +24,8 @@ from pathlib import Path
 
 import numpy as np
 
-from .flow import DEFAULT_INERTIAL_LAW, solve_network
-from .packing import Packing, random_packing
+from ..flow import DEFAULT_INERTIAL_LAW, solve_network
+from ..packing import Packing, random_packing
 
 __all__ = ["BAND_OFFSETS", "fit_log_slope", "band_gradients", "slope_at", "pack_band",
            "measured_band", "GRAIN_BANDS"]
@@ -34,7 +34,7 @@ log = logging.getLogger(__name__)
 
 #: grains whose band was measured on their own DEM grain beds: network/data/band_<grain>.json
 #: (beds, gradients at three velocities, how they were made)
-GRAIN_BANDS = {"wheat": Path(__file__).resolve().parent / "data" / "band_wheat.json"}
+GRAIN_BANDS = {"wheat": Path(__file__).resolve().parents[1] / "data" / "band_wheat.json"}
 #: porosity offsets of the reported band
 BAND_OFFSETS = (-0.02, -0.01, 0.01, 0.02)
 #: interior porosity of random_packing beds ≈ WALL_OFFSET - solid fraction (the walls loosen

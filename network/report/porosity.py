@@ -5,7 +5,7 @@ A report is for one porosity ε, chosen in this order and named in
 porosity (the middle of the range in :data:`network._grains.BED`, the condition D272's data were
 taken in); else, for a grain without one, the packing's own. The network is solved on a packing
 of porosity :math:`\varepsilon_p` (its interior Monte-Carlo porosity); the prediction is moved to ε
-along the porosity band's computed slope S(U) (:mod:`network._report_band`), not by packing anew:
+along the porosity band's computed slope S(U) (:mod:`network.report.band`), not by packing anew:
 
 .. math:: g(U; \varepsilon) = g(U; \varepsilon_p)\,
    \exp\!\big(S(U)\,(\varepsilon - \varepsilon_p)\big), \qquad
@@ -24,12 +24,13 @@ from pathlib import Path
 
 import numpy as np
 
-from ._grains import BED
+from .._grains import BED
 
-__all__ = ["DATA_DIR", "MAX_SHIFT", "bundled_packing", "bundled_grains", "packing_meta",
+__all__ = ["DATA_DIR", "MAX_SHIFT", "UnreachablePorosity", "bundled_packing", "bundled_grains",
+           "packing_meta",
            "requested_porosity", "reachable_range", "check_reachable", "shift_factor"]
 
-DATA_DIR = Path(__file__).resolve().parent / "data"
+DATA_DIR = Path(__file__).resolve().parents[1] / "data"
 #: largest move along the band without a recorded reachable range (the band's span), porosity
 MAX_SHIFT = 0.02
 
@@ -96,14 +97,20 @@ def reachable_range(meta: dict) -> tuple[float, float] | None:
     return round(float(min(r)) - tol, 12), round(float(max(r)) + tol, 12)
 
 
+class UnreachablePorosity(ValueError):
+    """A porosity outside the range a packing of the grain reaches: bad input (exit 2)."""
+
+    bad_input = True
+
+
 def check_reachable(porosity: float, own: float | None, reach, grain: str) -> None:
-    """ValueError unless ``porosity`` lies in ``reach`` (or, without one, within MAX_SHIFT of
-    the packing's ``own`` porosity), naming the reachable range.
+    """:class:`UnreachablePorosity` unless ``porosity`` lies in ``reach`` (or, without one,
+    within MAX_SHIFT of the packing's ``own`` porosity), naming the reachable range.
 
     >>> check_reachable(0.45, None, (0.37, 0.43), "wheat")  # doctest: +ELLIPSIS
     Traceback (most recent call last):
     ...
-    ValueError: porosity 0.45 is outside the range a packing of wheat reaches: 0.3700-0.4300 (...)
+    network.report.porosity.UnreachablePorosity: porosity 0.45 is outside the range ...
     """
     if reach is not None:
         lo, hi = reach
@@ -116,8 +123,8 @@ def check_reachable(porosity: float, own: float | None, reach, grain: str) -> No
     else:
         return
     if not lo - 1e-12 <= porosity <= hi + 1e-12:
-        raise ValueError(f"porosity {porosity:g} is outside the range a packing of {grain} "
-                         f"reaches: {lo:.4f}-{hi:.4f} ({how})")
+        raise UnreachablePorosity(f"porosity {porosity:g} is outside the range a packing of "
+                                  f"{grain} reaches: {lo:.4f}-{hi:.4f} ({how})")
 
 
 def shift_factor(slope: float, slope_stderr: float, d_porosity: float) -> tuple[float, float]:

@@ -1,21 +1,9 @@
-"""``python -m network.report``: the engineer's report of a grain bed.
+"""The command line of ``python -m network.report``: its options, their checks, the printed report.
 
-Examples
---------
-    python -m network.report --grain wheat --depth 3 --diameter 6   # bundled wheat bed
-    python -m network.report --grain soybean --depth 3 --diameter 6 --fan fan.csv --html r.html
-    python -m network.report --grain wheat --porosity 0.41 --packing bed.csv --json r.json
-    python -m network.report --grain wheat --seed 2        # packs a new bed (dem.pack, minutes)
-
-The inertial resistance curve (vertical z and horizontal x) of a packing, with ASABE D272 and
-Ergun beside it and the fits of :func:`network.flow.fit_curve`; the porosity band (d ln(ΔP/L)/dε
-computed by packing and solving neighbouring porosities, :mod:`network._report_band`); the
-system curve of a bin and, with ``--fan``, its operating point (:mod:`network._report_system`).
-The porosity reported is the grain's measured loose-fill porosity, ``--porosity``, or the
-packing's own, moved along the band's slope (:mod:`network._report_porosity`); ``--seed`` or a
-porosity away from the bundled bed's packs a new bed with ``dem.pack`` (:mod:`network._report_bed`).
-Figures go to ``report_<grain>/`` unless ``--plot-dir``/``--no-figures`` say otherwise.
-Exit 0 done, 1 a solve failed, 2 bad input: one ``error:`` line (docs/cli.md, docs/report.md).
+:func:`main` parses and checks every option before any work (exit 2 naming it), plans or packs
+the bed (:mod:`network.report.bed`), turns the options into a :class:`ReportOptions`, has
+:func:`network.report.build.build_report` compute the report, prints it and writes the JSON,
+the figures and the HTML page. Exit 0 done, 1 a solve failed, 2 bad input.
 """
 
 from __future__ import annotations
@@ -26,26 +14,23 @@ from pathlib import Path
 
 import numpy as np
 
-from ._cli import (CliError, CliParser, add_air, add_sample, available_cores, bad_input,
-                   check_common, check_outputs, check_plot, computing, finish, load_packing,
-                   packing_inputs, progress_log, run, sample_box_m, warn_curve)
-from ._grains import BED, D272, GRAIN_ALIASES, grains_with_d272
-from ._report_bed import add_bed_options, bed_json, plan_bed, prepare_bed
-from ._report_band import BAND_OFFSETS, band_gradients, measured_band, pack_band, slope_at
-from ._report_porosity import (bundled_grains, bundled_packing, check_reachable, packing_meta,
-                               reachable_range, requested_porosity, shift_factor)
-from ._report_html import write_figures, write_html
-from ._report_system import (AIRFLOW_UNITS, bulk_density, curve_range, dense_system, floor_area,
-                             operating_point, read_fan, system_rows, velocity_from_airflow)
-from .curve import DEFAULT_VELOCITIES, parse_velocities
-from .flow import DEFAULT_DEPTH_M, asabe_d272_gradient, ergun_gradient, fit_curve, solve_network
-from .packing import UNITS, read_container
-from .pores import region_porosity, sample_region
+from .._cli import (CliError, CliParser, add_air, add_sample, bad_input, check_common,
+                    check_outputs, check_plot, computing, load_packing, packing_inputs,
+                    progress_log, run, sample_box_m, warn_curve)
+from .._grains import BED, D272, grains_with_d272
+from ..curve import DEFAULT_VELOCITIES, parse_velocities
+from ..flow import DEFAULT_DEPTH_M
+from ..packing import UNITS
+from .band import BAND_OFFSETS
+from .bed import add_bed_options, bed_json, plan_bed, prepare_bed
+from .build import build_report
+from .figures import write_figures, write_html
+from .options import ReportOptions, grain_key
+from .porosity import (bundled_grains, bundled_packing, check_reachable, packing_meta,
+                       reachable_range, requested_porosity)
+from .system import AIRFLOW_UNITS, read_fan
 
-#: below this porosity difference the packing's own porosity is the report's (no move)
-SAME_POROSITY = 5e-4
-KEYS = ["velocity_m_s", "reynolds_particle", "pressure_gradient_pa_per_m",
-        "apparent_permeability_m2", "converged"]
+__all__ = ["build_parser", "main", "print_report", "report_options"]
 
 
 def build_parser() -> CliParser:
@@ -107,14 +92,6 @@ def build_parser() -> CliParser:
     ap.add_argument("--no-figures", action="store_true", help="write no PNG files")
     ap.add_argument("--quiet", "-q", action="store_true", help="no stage progress on stderr")
     return ap
-
-
-def grain_key(name: str) -> str:
-    """Library name of a grain (aliases accepted); ValueError listing the known ones."""
-    key = GRAIN_ALIASES.get(str(name).lower(), str(name).lower())
-    if key not in D272:
-        raise ValueError(f"unknown grain {name!r}; known grains: {', '.join(D272)}")
-    return key
 
 
 def _check(args) -> dict:
@@ -187,148 +164,6 @@ def _check(args) -> dict:
             "airflow": airflow, "fan": fan, "velocities": parse_velocities(args.velocities),
             "porosity": target, "porosity_source": why, "reachable": reach,
             "plot_dir": plot_dir, "bed": bed}
-
-
-def _solve(args, packing, container, box, margin, axis, us, porosity=None):
-    region, us = sample_region(packing, box=box, margin=margin, container=container,
-                               axis=axis), sorted(us)
-    return solve_network(packing, axis=axis, region=region, viscosity_pa_s=args.viscosity,
-                         velocity_m_s=us[0], depth_m=args.depth, inertia=True,
-                         density_kg_m3=args.density, curve_velocities_m_s=us[1:],
-                         inertial_law=args.inertial_law, porosity=porosity,
-                         inertial_workers=available_cores(), threads=available_cores())
-
-
-def _fits(args, pts, porosity, d32):
-    """fit_curve over the converged points (as reported, at the report's porosity)."""
-    ok = [p for p in pts if p["converged"]]
-    if not ok:
-        return {}
-    return fit_curve([p["velocity_m_s"] for p in ok], [p["pressure_gradient_pa_per_m"] for p in ok],
-                     viscosity_pa_s=args.viscosity, density_kg_m3=args.density,
-                     porosity=porosity, diameter_m=d32)
-
-
-def _points(res):
-    return [{k: p[k] for k in KEYS} for p in res.curve_points()]
-
-
-def build_report(args, opts, path, packing) -> dict:
-    """All the numbers of the report (the JSON document)."""
-    t0 = time.perf_counter()
-    box, margin = sample_box_m(args)
-    container = None if box else read_container(path)
-    us = list(opts["velocities"])
-    # the porosity first (solve_network's): the airflow's velocity needs the bulk density
-    eps_z = region_porosity(packing, sample_region(packing, box=box, margin=margin,
-                                                   container=container, axis="z"), 2,
-                            n_points=200_000)
-    e_p, why = eps_z[0], opts["porosity_source"]
-    e = e_p if opts["porosity"] is None else opts["porosity"]
-    try:
-        check_reachable(e, e_p, opts["reachable"], opts["grain"])
-    except ValueError as exc:
-        raise CliError(str(exc), 2) from None
-    move = abs(e - e_p) > SAME_POROSITY
-    if move and args.no_band:
-        why = (f"the packing's own: --no-band gives no computed slope to move it to {e:.4f} "
-               f"({why})")
-        e, move = e_p, False
-    rho_b = bulk_density(opts["particle_density"], e)
-    u_air = None
-    if opts["airflow"]:
-        u_air = velocity_from_airflow(*opts["airflow"], depth_m=args.depth,
-                                      bulk_density_kg_m3=rho_b)
-        if all(abs(u_air - u) > 1e-12 * u for u in us):
-            us.append(u_air)
-    rz = _solve(args, packing, container, box, margin, "z", us, eps_z)
-    rx, d32 = _solve(args, packing, container, box, margin, "x", us), rz.sauter_diameter_m
-    pts, pts_x = _points(rz), _points(rx)
-    band = None
-    if not args.no_band and packing.n_grains < packing.n and not args.sphere_band:
-        band = measured_band(opts["grain"])     # the grain's own DEM beds, where bundled
-    if not args.no_band and band is None:
-        ub = sorted(us)
-        band = pack_band(packing, e_p, velocities_m_s=[ub[0], float(np.sqrt(ub[0] * ub[-1])),
-                                                     ub[-1]],
-                         seeds=(args.band_seed, args.band_seed + 1),
-                         viscosity_pa_s=args.viscosity,
-                         density_kg_m3=args.density, inertial_law=args.inertial_law)
-    c = D272[opts["grain"]]
-    for p, px in zip(pts, pts_x):
-        u = p["velocity_m_s"]
-        f, sig = 1.0, 0.0
-        if move:
-            f, sig = shift_factor(slope_at(u, band["velocities_m_s"], band["slopes"]),
-                                  slope_at(u, band["velocities_m_s"], band["slope_stderrs"]),
-                                  e - e_p)
-        p["pressure_gradient_packing_pa_per_m"] = p["pressure_gradient_pa_per_m"]
-        p["pressure_gradient_pa_per_m"] *= f
-        p["apparent_permeability_m2"] = args.viscosity * u / p["pressure_gradient_pa_per_m"]
-        px["pressure_gradient_pa_per_m"] *= f
-        p["porosity_shift_factor"], p["porosity_shift_ln_stderr"] = f, sig
-        p["d272_pressure_gradient_pa_per_m"] = (
-            None if c.a_pa_s2_m3 is None else
-            float(asabe_d272_gradient(u, a=c.a_pa_s2_m3, b=c.b_s_m)))
-        p["ergun_pressure_gradient_pa_per_m"] = float(ergun_gradient(
-            u, porosity=e, diameter_m=d32, viscosity_pa_s=args.viscosity,
-            density_kg_m3=args.density))
-        p["pressure_gradient_horizontal_pa_per_m"] = px["pressure_gradient_pa_per_m"]
-        p["band_slope"] = None if band is None else slope_at(u, band["velocities_m_s"],
-                                                             band["slopes"])
-        p["pressure_gradient_band_pa_per_m"] = (
-            None if band is None else
-            dict(zip([f"{o:+.2f}" for o in BAND_OFFSETS],
-                     band_gradients(p["pressure_gradient_pa_per_m"], p["band_slope"]))))
-    area = floor_area(args.diameter, args.floor_area)
-    flow = pts if args.axis == "z" else pts_x          # the direction the bin's air takes
-    ok = [p for p in flow if p["converged"]]
-    su = [p["velocity_m_s"] for p in ok]
-    sg = [p["pressure_gradient_pa_per_m"] for p in ok]
-    system = system_rows(su, sg, depth_m=args.depth, area_m2=area, bulk_density_kg_m3=rho_b)
-    out = {"grain": opts["grain"], "packing": str(path), "n_spheres": packing.n,
-           "n_grains": packing.n_grains, "porosity": e, "inertial_law": args.inertial_law,
-           "porosity_source": f"{opts['bed']['label']}; {why}", "bed": bed_json(opts["bed"], path),
-           "porosity_packing": e_p, "porosity_packing_std": rz.porosity_std,
-           "porosity_reachable": opts["reachable"],
-           "porosity_move": ("none: the packing's own porosity" if not move else
-                             f"along the band's computed slope from the packing's {e_p:.4f} to "
-                             f"{e:.4f} (g exp(S de); not packed anew)"),
-           "sauter_diameter_m": d32, "viscosity_pa_s": args.viscosity,
-           "air_density_kg_m3": args.density, "particle_density_kg_m3": opts["particle_density"],
-           "particle_density_source": opts["particle_density_source"],
-           "bulk_density_kg_m3": rho_b,
-           "d272": {"a_pa_s2_m3": c.a_pa_s2_m3, "b_s_m": c.b_s_m, "source": c.source,
-                    "note": c.note},
-           "permeability_stokes_m2": {"z": rz.permeability_m2, "x": rx.permeability_m2},
-           "horizontal_to_vertical_stokes": rz.permeability_m2 / rx.permeability_m2,
-           "permeability_stokes_note": "as solved, at the packing's own porosity",
-           "fits": _fits(args, pts, e, d32), "fits_horizontal": _fits(args, pts_x, e, d32),
-           "points": pts, "band": band,
-           "bin": {"depth_m": args.depth, "diameter_m": args.diameter, "floor_area_m2": area,
-                   "flow_axis": args.axis,
-                   "grain_mass_t": rho_b * area * args.depth / 1000.0},
-           "system_curve": system, "airflow": None, "operating_point": None}
-    if u_air is not None:
-        g = next(p["pressure_gradient_pa_per_m"] for p in flow
-                 if abs(p["velocity_m_s"] - u_air) <= 1e-12 * u_air)
-        out["airflow"] = system_rows([u_air], [g], depth_m=args.depth, area_m2=area,
-                                     bulk_density_kg_m3=rho_b)[0]
-    if opts["fan"] is not None:
-        sq, sp = dense_system(su, sg, depth_m=args.depth, area_m2=area)
-        op = operating_point(sq, sp, *opts["fan"])
-        out["fan_curve"] = {"airflow_m3_s": opts["fan"][0].tolist(),
-                            "static_pressure_pa": opts["fan"][1].tolist(), "file": args.fan}
-        if op is None:
-            out["operating_point"] = {"found": False, "message": (
-                "no operating point: " + curve_range("system curve", sq, sp) + "; "
-                + curve_range("fan", *opts["fan"]))}
-        else:
-            row = system_rows([op[0] / area], [op[1] / args.depth], depth_m=args.depth,
-                              area_m2=area, bulk_density_kg_m3=rho_b)[0]
-            out["operating_point"] = {"found": True, **row}
-    out["seconds"] = time.perf_counter() - t0
-    return out
 
 
 def _g(v, fmt="10.4g"):
@@ -414,15 +249,40 @@ def main(argv=None) -> int:
     return run(_main, build_parser(), argv)
 
 
+def report_options(args, checked: dict, path) -> ReportOptions:
+    """The :class:`ReportOptions` of the checked command line (``checked``: :func:`_check`'s,
+    after :func:`prepare_bed`) for the packing at ``path``."""
+    box, margin = sample_box_m(args)
+    fan = checked["fan"]
+    return ReportOptions(
+        grain=checked["grain"], velocities_m_s=tuple(checked["velocities"]),
+        porosity=checked["porosity"], porosity_source=checked["porosity_source"],
+        reachable=checked["reachable"], particle_density_kg_m3=checked["particle_density"],
+        particle_density_source=checked["particle_density_source"], depth_m=args.depth,
+        axis=args.axis, diameter_m=args.diameter, floor_area_m2=args.floor_area,
+        airflow=checked["airflow"],
+        fan_airflow_m3_s=None if fan is None else tuple(fan[0].tolist()),
+        fan_static_pressure_pa=None if fan is None else tuple(fan[1].tolist()),
+        fan_file=args.fan, band=not args.no_band, sphere_band=args.sphere_band,
+        band_seed=args.band_seed, viscosity_pa_s=args.viscosity, density_kg_m3=args.density,
+        inertial_law=args.inertial_law, sample_box_m=None if box is None else tuple(box),
+        margin_m=margin, bed_label=checked["bed"]["label"],
+        bed_record=bed_json(checked["bed"], path))
+
+
 def _main(args) -> int:
     progress_log(args)
     with bad_input():
         opts = _check(args)
-    prepare_bed(args, opts)
+    bed = opts["bed"]
+    args.packing = prepare_bed(bed, quiet=args.quiet)
+    if bed["action"] == "pack":
+        opts["reachable"] = reachable_range(packing_meta(args.packing))
     with bad_input():
         path, packing = load_packing(args)
+        options = report_options(args, opts, path)
     with computing():
-        rep = build_report(args, opts, path, packing)
+        rep = build_report(packing, path, options)
     print_report(rep)
     warn_curve(rep["points"], args.depth, "pressure_gradient_pa_per_m" if args.axis == "z"
                else "pressure_gradient_horizontal_pa_per_m")
@@ -444,7 +304,3 @@ def _main(args) -> int:
     if bad:
         raise CliError(f"the nonlinear solve did not converge at U = {bad} m/s", 1)
     return 0
-
-
-if __name__ == "__main__":
-    finish(main())

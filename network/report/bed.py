@@ -31,12 +31,13 @@ import tempfile
 import time
 from pathlib import Path
 
-from ._cli import EXIT_BAD_INPUT, EXIT_FAILED, CliError, computing
-from ._grains import BED
-from ._report_porosity import bundled_packing, packing_meta, reachable_range
+from .._cli import EXIT_BAD_INPUT, EXIT_FAILED, CliError, computing
+from .._grains import BED
+from .porosity import bundled_packing, packing_meta
 
 __all__ = ["TEMPLATE_GRAINS", "PACK_TOL", "add_bed_options", "plan_bed", "bed_paths", "find_bed",
-           "pack_bed", "pack_command", "prepare_bed", "bed_label", "bed_json"]
+           "pack_bed", "pack_command", "prepare_bed", "bed_label", "bed_json",
+           "user_bed_json"]
 
 #: grains with a multi-sphere template in ``dem.templates.TEMPLATE_GRAINS`` (a copy: network may
 #: not import dem; tests/test_report_bed.py checks that the two agree)
@@ -49,7 +50,7 @@ PACK_TOL = 0.005
 #: (docs/report.md); the cap only bounds a bed that never settles, a settled one stops earlier
 PACK_MAX_STEPS = 240_000
 #: the project root that holds ``dem/`` beside ``network/`` (the subprocess's PYTHONPATH)
-_ROOT = Path(__file__).resolve().parent.parent
+_ROOT = Path(__file__).resolve().parents[2]
 
 
 def add_bed_options(ap) -> None:
@@ -93,7 +94,7 @@ def plan_bed(grain: str, *, porosity, seed, packing, move_along_band: bool, bed_
     ``seed``, ``box`` (lx, ly, h m) and ``bed_dir``. ValueError for input that cannot work.
     """
     plan = {"grain": grain, "action": "user", "packing": packing, "not_packed": None,
-            "seed": seed}
+            "seed": seed, "move_along_band": bool(move_along_band)}
     if packing is not None:
         if seed is not None or porosity is not None:
             plan["not_packed"] = (f"--packing {packing} given: the report uses that bed as it "
@@ -282,24 +283,24 @@ def pack_bed(plan: dict, *, quiet: bool = False) -> tuple[Path, dict]:
                    "command": " ".join(["python"] + cmd[1:])}
 
 
-def prepare_bed(args, opts) -> None:
-    """After the checks: pack the planned bed if there is one (``args.packing`` then names it),
-    and label the bed for ``porosity_source``."""
-    bed = opts["bed"]
-    bed["move_along_band"] = args.move_along_band
-    if bed["action"] == "pack":
-        if not args.quiet:
-            print(f"packing a new bed of {bed['grain']} at porosity {bed['porosity']:g}, seed "
-                  f"{bed['seed']}, box {' x '.join(f'{v:g}' for v in bed['box'])} m with "
+def prepare_bed(plan: dict, *, quiet: bool = False) -> str:
+    """After the checks: pack the planned bed if there is one, label the plan's bed (its
+    ``label``, the first words of ``porosity_source``) and return the path of the packing the
+    report solves (the new bed's, else the plan's)."""
+    packing = plan["packing"]
+    if plan["action"] == "pack":
+        if not quiet:
+            print(f"packing a new bed of {plan['grain']} at porosity {plan['porosity']:g}, seed "
+                  f"{plan['seed']}, box {' x '.join(f'{v:g}' for v in plan['box'])} m with "
                   "dem.pack: this takes minutes (2-6 packings of 0.5-8 min each; an existing "
-                  f"bed in {bed['bed_dir']} is reused)", file=sys.stderr, flush=True)
+                  f"bed in {plan['bed_dir']} is reused)", file=sys.stderr, flush=True)
         with computing():
-            found, info = pack_bed(bed, quiet=args.quiet)
-        bed.update(info)
-        bed["pack_seconds"] = None if info["reused"] else info["seconds"]
-        args.packing = str(found)
-        opts["reachable"] = reachable_range(packing_meta(found))
-    bed["label"] = bed_label(bed, packing_meta(args.packing))
+            found, info = pack_bed(plan, quiet=quiet)
+        plan.update(info)
+        plan["pack_seconds"] = None if info["reused"] else info["seconds"]
+        packing = str(found)
+    plan["label"] = bed_label(plan, packing_meta(packing))
+    return packing
 
 
 def bed_label(bed: dict, meta: dict) -> str:
@@ -318,6 +319,11 @@ def bed_label(bed: dict, meta: dict) -> str:
     if bed["not_packed"]:
         label += f" (not packed anew: {bed['not_packed']})"
     return label
+
+
+def user_bed_json(path) -> dict:
+    """The ``bed`` entry of a report on a user's packing at ``path`` (no plan)."""
+    return bed_json({"action": "user", "not_packed": None}, path)
 
 
 def bed_json(b: dict, path) -> dict:
