@@ -9,7 +9,7 @@ import pytest
 
 from network.report.band import band_gradients, fit_log_slope, slope_at
 from network.report.system import (bulk_density, curve_range, operating_point, read_fan,
-                                    system_rows, velocity_from_airflow)
+                                   system_rows, velocity_from_airflow)
 from network.report import main
 
 
