@@ -12,7 +12,7 @@ import importlib
 import pytest
 
 COMMANDS = ["network.solve", "network.curve", "network.paths", "network.report", "network.throats",
-            "network.bench", "cache.precompute", "cache.lookup", "cache.bench", "throats.solve",
+            "network.bench", "network.bin.__main__", "cache.precompute", "cache.lookup", "cache.bench", "throats.solve",
             "throats.bench", "dem.pack", "dem.vibrate", "dem.bench"]
 
 

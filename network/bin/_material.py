@@ -1,0 +1,319 @@
+r"""The grain bulk's resistance, point by point: k_v(ε), k_h(ε), β(ε) and the porosity field.
+
+Network law (``law="network"``). The porosity band's beds of a grain (``network.report``'s
+band on the grain's own DEM beds, ``network/data/band_<grain>.json``: porosity ε_i and the
+network's vertical gradient at three velocities) are fitted bed by bed with
+``network.flow.fit_curve``'s Forchheimer form, g = μU/k + βρU², and ln k, ln β linearly in ε
+over the beds:
+
+.. math:: k_v(\varepsilon) = e^{\kappa_0 + \kappa_1\varepsilon}, \qquad
+          \beta_v(\varepsilon) = e^{b_0 + b_1\varepsilon}
+
+(wheat: eight beds, ε 0.376-0.431). The horizontal permeability is k_h = a k_v with
+a = k_x/k_z of the bundled bed's Forchheimer fits in both directions
+(``network/data/anisotropy_<grain>.json``); β_h follows from the tensor law
+(:mod:`network.bin._law`). A grain without band data has no bin law here (``network.report``
+packs sphere beds for its band, minutes per run): the bin then needs ``law="d272"``.
+
+D272 law (``law="d272"``): the standard's Shedd constants (``network._grains.D272``) for loose
+fill, isotropic, scaled by the network's porosity effect where the grain has band data,
+f(ε) = k_v(ε_0)/k_v(ε) with ε_0 the grain's loose-fill porosity (the standard's condition);
+without band data the porosity field must be uniform.
+
+Porosity field ε(h), h the depth below the local grain surface (m): uniform, a table (linear
+between its rows, held beyond them) or Janssen's vertical stress with a porosity-stress curve
+(:func:`janssen_stress`).
+"""
+
+from __future__ import annotations
+
+import csv
+import json
+import math
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+
+from .._grains import BED, D272
+from .._report_porosity import requested_porosity
+from ._law import ForchheimerLaw, SheddLaw
+
+__all__ = ["ANGLE_OF_REPOSE", "Material", "network_material", "d272_material",
+           "read_profile", "janssen_stress", "PorosityProfile", "G_M_S2"]
+
+DATA = Path(__file__).resolve().parent.parent / "data"
+G_M_S2 = 9.80665
+
+_MWPS = ("secondary: a table of filling angles of repose by crop quoted in a farm forum thread "
+         "(https://community.agriculture.com/t5/Crops/Angle-of-repose/td-p/18193: barley 28, "
+         "shelled corn 23, oats 28, soybeans 25, sunflowers 27, wheat 25 degrees; 'the figures "
+         "given were for standard moisture'); the primary table was not seen")
+#: filling angle of repose, degrees, and its source (the peaked top's default cone)
+ANGLE_OF_REPOSE = {
+    "wheat": (25.0, _MWPS + "; a fan-sizing program's table (network._grains, search-index id "
+              "70324629401) gives 30 for wheat"),
+    "soybean": (25.0, _MWPS),
+    "shelled_corn": (23.0, _MWPS),
+    "barley": (28.0, _MWPS),
+}
+
+
+@dataclass(frozen=True)
+class PorosityProfile:
+    """ε(h) of depth h below the grain surface (m): linear between (depth, porosity) rows,
+    held beyond them; ``source`` says where it came from."""
+
+    depth_m: np.ndarray
+    porosity: np.ndarray
+    source: str
+
+    def __call__(self, depth_m):
+        return np.interp(np.maximum(np.asarray(depth_m, dtype=float), 0.0), self.depth_m,
+                         self.porosity)
+
+    @classmethod
+    def uniform(cls, porosity: float, source: str) -> "PorosityProfile":
+        return cls(np.array([0.0, 1.0]), np.array([porosity, porosity]), source)
+
+    @property
+    def is_uniform(self) -> bool:
+        return bool(np.ptp(self.porosity) == 0)
+
+
+def read_profile(path, option: str = "--porosity-profile") -> tuple[np.ndarray, np.ndarray]:
+    """Two columns of a CSV with a header (depth_m,porosity or stress_pa,porosity): x ascending
+    from >= 0, y in (0, 1); ValueError naming the file and row."""
+    xs, ys = [], []
+    with open(path, newline="") as f:
+        rows = list(csv.reader(f))
+    if not rows:
+        raise ValueError(f"{option} {path}: empty file")
+    want = ("depth_m", "porosity") if option == "--porosity-profile" else ("stress_pa",
+                                                                          "porosity")
+    head = [c.strip() for c in rows[0]]
+    if head != list(want):
+        raise ValueError(f"{option} {path}: header must be {','.join(want)}, got "
+                         f"{','.join(head)}")
+    for i, row in enumerate(rows[1:], start=2):
+        if not row or all(not c.strip() for c in row):
+            continue
+        if len(row) != 2:
+            raise ValueError(f"{option} {path} row {i}: {len(row)} values, the header has 2")
+        try:
+            x, y = float(row[0]), float(row[1])
+        except ValueError:
+            raise ValueError(f"{option} {path} row {i}: {row!r} is not two numbers") from None
+        if not (math.isfinite(x) and x >= 0):
+            raise ValueError(f"{option} {path} row {i}: {want[0]} must be finite and >= 0, "
+                             f"got {row[0].strip()}")
+        if not (0 < y < 1):
+            raise ValueError(f"{option} {path} row {i}: porosity must be in (0, 1), got "
+                             f"{row[1].strip()}")
+        if xs and x <= xs[-1]:
+            raise ValueError(f"{option} {path} row {i}: {want[0]} {x:g} does not increase")
+        xs.append(x)
+        ys.append(y)
+    if len(xs) < 1:
+        raise ValueError(f"{option} {path}: no rows")
+    if len(xs) == 1:
+        xs, ys = [xs[0], xs[0] + 1.0], [ys[0], ys[0]]
+    return np.array(xs), np.array(ys)
+
+
+def janssen_stress(depth_m, *, bulk_density_kg_m3, diameter_m, wall_friction, lateral_ratio):
+    r"""Janssen's vertical stress, Pa, at depth h below the surface of a round bin:
+
+    .. math:: \sigma_v(h) = \frac{\rho_b g R_h}{\mu_w K}\big(1 - e^{-\mu_w K h/R_h}\big),
+              \qquad R_h = B/4,
+
+    μ_w the grain-wall friction coefficient, K the lateral-to-vertical stress ratio.
+
+    >>> s = janssen_stress(1e-6, bulk_density_kg_m3=750.0, diameter_m=8.0, wall_friction=0.4,
+    ...                    lateral_ratio=0.5)
+    >>> round(float(s / (750.0 * G_M_S2 * 1e-6)), 6)   # hydrostatic near the surface
+    1.0
+    """
+    rh = diameter_m / 4.0
+    c = wall_friction * lateral_ratio / rh
+    h = np.asarray(depth_m, dtype=float)
+    return bulk_density_kg_m3 * G_M_S2 / c * -np.expm1(-c * h)
+
+
+@dataclass(frozen=True)
+class Material:
+    """The bin's law: a builder of the per-element law from per-element porosity, the kernel
+    density (kg/m³), the porosity profile and what to say about them."""
+
+    law: str
+    grain: str
+    viscosity_pa_s: float
+    density_kg_m3: float
+    particle_density_kg_m3: float
+    anisotropy: float
+    profile: PorosityProfile
+    k_coef: tuple | None          # (κ0, κ1) of ln k_v(ε)
+    beta_coef: tuple | None       # (b0, b1) of ln β_v(ε)
+    d272: tuple | None            # (a, b) Shedd constants
+    loose_porosity: float | None
+    band_range: tuple | None
+    note: str
+
+    def k_v(self, eps):
+        """k_v(ε), m²."""
+        return np.exp(self.k_coef[0] + self.k_coef[1] * np.asarray(eps, dtype=float))
+
+    def beta_v(self, eps):
+        """β_v(ε), 1/m."""
+        return np.exp(self.beta_coef[0] + self.beta_coef[1] * np.asarray(eps, dtype=float))
+
+    def element_law(self, eps):
+        """The law for per-element porosities ``eps`` (Ne,)."""
+        eps = np.asarray(eps, dtype=float)
+        if self.law == "network":
+            return ForchheimerLaw(self.viscosity_pa_s / self.k_v(eps),
+                                  self.beta_v(eps) * self.density_kg_m3, self.anisotropy)
+        f = np.ones_like(eps)
+        if self.k_coef is not None:
+            f = self.k_v(self.loose_porosity) / self.k_v(eps)
+        return SheddLaw(f, self.d272[0], self.d272[1], self.anisotropy)
+
+    def gradient_1d(self, velocity_m_s, eps, *, axis="z"):
+        """The 1-D law g(U), Pa/m, at porosity ε along z (vertical) or x (horizontal)."""
+        law = self.element_law(np.atleast_1d(eps))
+        u = np.asarray(velocity_m_s, dtype=float)
+        if axis == "z":
+            return law.resistance(u)
+        a = self.anisotropy                 # horizontal: W = U/√a, G = F(W) = √a g
+        return law.resistance(u / np.sqrt(a)) / np.sqrt(a)
+
+    def as_json(self) -> dict:
+        out = {"law": self.law, "grain": self.grain, "viscosity_pa_s": self.viscosity_pa_s,
+               "air_density_kg_m3": self.density_kg_m3,
+               "particle_density_kg_m3": self.particle_density_kg_m3,
+               "anisotropy_kh_over_kv": self.anisotropy,
+               "porosity_profile": {"depth_m": self.profile.depth_m.tolist(),
+                                    "porosity": self.profile.porosity.tolist(),
+                                    "source": self.profile.source},
+               "note": self.note}
+        if self.k_coef is not None:
+            out["ln_k_v"] = {"intercept": self.k_coef[0], "slope_per_porosity": self.k_coef[1]}
+            out["ln_beta_v"] = {"intercept": self.beta_coef[0],
+                                "slope_per_porosity": self.beta_coef[1]}
+            out["band_porosity_range"] = list(self.band_range)
+        if self.d272 is not None:
+            out["d272_a_pa_s2_m3"], out["d272_b_s_m"] = self.d272
+        return out
+
+
+def _forchheimer(u, g, mu, rho):
+    m = np.column_stack([mu * u, rho * u**2]) / g[:, None]
+    (ik, beta), *_ = np.linalg.lstsq(m, np.ones_like(u), rcond=None)
+    return 1.0 / ik, beta
+
+
+def _band_fit(grain: str):
+    """((κ0, κ1), (b0, b1), (ε min, ε max), anisotropy, note) from the bundled band and
+    anisotropy files, or None without a band file."""
+    path = DATA / f"band_{grain}.json"
+    if not path.is_file():
+        return None
+    band = json.loads(path.read_text())
+    mu, rho = 1.932e-5, 1.20          # the air of the band's solves (its 'source')
+    u = np.array(band["velocities_m_s"], dtype=float)
+    eps, lk, lb = [], [], []
+    for bed in band["beds"]:
+        k, beta = _forchheimer(u, np.array(bed["pressure_gradient_pa_per_m"], float), mu, rho)
+        eps.append(bed["porosity"])
+        lk.append(math.log(k))
+        lb.append(math.log(beta))
+    k1, k0 = np.polyfit(eps, lk, 1)
+    b1, b0 = np.polyfit(eps, lb, 1)
+    a, note_a = 1.0, "no horizontal curve bundled: isotropic"
+    apath = DATA / f"anisotropy_{grain}.json"
+    if apath.is_file():
+        an = json.loads(apath.read_text())
+        ua = np.array(an["velocities_m_s"], float)
+        kz, bz = _forchheimer(ua, np.array(an["vertical_pa_per_m"], float),
+                              an["viscosity_pa_s"], an["density_kg_m3"])
+        kx, bx = _forchheimer(ua, np.array(an["horizontal_pa_per_m"], float),
+                              an["viscosity_pa_s"], an["density_kg_m3"])
+        a = kx / kz
+        note_a = (f"k_h/k_v = {a:.4f} from the bundled bed's fits in x and z "
+                  f"(network/data/{apath.name}); the tensor law's beta_h/beta_v = "
+                  f"{a**-1.5:.4f}, the network's own {bx / bz:.4f}")
+    note = (f"network law: ln k_v and ln beta_v linear in porosity over the {len(eps)} beds of "
+            f"network/data/{path.name} (Forchheimer fit per bed); {note_a}")
+    return (float(k0), float(k1)), (float(b0), float(b1)), (min(eps), max(eps)), a, note
+
+
+def _profile(grain, porosity, profile, compaction, janssen):
+    if profile is not None:
+        d, e = profile
+        return PorosityProfile(d, e, "--porosity-profile (the user's table)")
+    if compaction is not None:
+        (s, e), (rho_b, diam, mu_w, k_lat) = compaction, janssen
+        depth = np.linspace(0.0, 60.0, 601)
+        sig = janssen_stress(depth, bulk_density_kg_m3=rho_b, diameter_m=diam,
+                             wall_friction=mu_w, lateral_ratio=k_lat)
+        return PorosityProfile(depth, np.interp(sig, s, e),
+                               f"Janssen (wall friction {mu_w:g}, K {k_lat:g}, bulk density "
+                               f"{rho_b:.1f} kg/m^3) with the --compaction curve")
+    eps, why = requested_porosity(grain, porosity)
+    if eps is None:
+        raise ValueError(f"no measured loose-fill porosity for {grain}: give --porosity")
+    return PorosityProfile.uniform(eps, "uniform: " + why)
+
+
+def _density(grain, particle_density):
+    if particle_density is not None:
+        return float(particle_density)
+    rho_p = BED[grain].particle_density_kg_m3
+    if rho_p is None:
+        raise ValueError(f"no sourced kernel density for {grain}: give --particle-density")
+    return float(rho_p)
+
+
+def network_material(grain: str, *, viscosity_pa_s: float, density_kg_m3: float,
+                     porosity=None, profile=None, compaction=None, janssen=None,
+                     particle_density=None) -> Material:
+    """The network's law for ``grain`` (band data needed, ValueError naming the file without)."""
+    fit = _band_fit(grain)
+    if fit is None:
+        raise ValueError(f"no porosity band of {grain}'s own beds is bundled "
+                         f"(network/data/band_{grain}.json; bundled: wheat), so the network law "
+                         "has no k(porosity) for it: use --law d272")
+    kc, bc, rng, a, note = fit
+    prof = _profile(grain, porosity, profile, compaction, janssen)
+    loose = requested_porosity(grain, None)[0]
+    return Material("network", grain, viscosity_pa_s, density_kg_m3,
+                    _density(grain, particle_density), a, prof, kc, bc, None, loose, rng, note)
+
+
+def d272_material(grain: str, *, viscosity_pa_s: float, density_kg_m3: float, porosity=None,
+                  profile=None, compaction=None, janssen=None,
+                  particle_density=None) -> Material:
+    """D272's Shedd law for ``grain``, isotropic, scaled by the band's porosity effect."""
+    c = D272[grain]
+    if c.a_pa_s2_m3 is None:
+        raise ValueError(f"no sourced ASABE D272 constants for {grain} (network/_grains.py): "
+                         "--law d272 cannot be used")
+    prof = _profile(grain, porosity, profile, compaction, janssen)
+    fit = _band_fit(grain)
+    loose = requested_porosity(grain, None)[0]
+    if fit is None or loose is None:
+        if not prof.is_uniform:
+            raise ValueError(f"--law d272 with a porosity field needs {grain}'s porosity band "
+                             f"(network/data/band_{grain}.json, not bundled): give a uniform "
+                             "porosity")
+        return Material("d272", grain, viscosity_pa_s, density_kg_m3,
+                        _density(grain, particle_density), 1.0, prof, None, None,
+                        (c.a_pa_s2_m3, c.b_s_m), loose, None,
+                        "D272 Shedd constants for loose fill, isotropic, at every porosity")
+    kc, bc, rng, _, _ = fit
+    note = (f"D272 Shedd constants for loose fill (porosity {loose:g}), isotropic, times "
+            f"k_v({loose:g})/k_v(porosity) of the network's band (network/data/band_{grain}"
+            ".json)")
+    return Material("d272", grain, viscosity_pa_s, density_kg_m3,
+                    _density(grain, particle_density), 1.0, prof, kc, bc,
+                    (c.a_pa_s2_m3, c.b_s_m), loose, rng, note)
