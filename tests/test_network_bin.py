@@ -8,7 +8,7 @@ import json
 import numpy as np
 import pytest
 
-from network._report_system import system_rows
+from network.report.system import system_rows
 from network.bin import (BinGeometry, BinProblem, ForchheimerLaw, SheddLaw,
                          closed_form_radial_airflow, d272_material, mesh_bin, mesh_rz_polygon,
                          network_material)
@@ -83,7 +83,7 @@ def test_the_newton_matrix_is_the_derivative_of_the_residual(wheat):
 @pytest.mark.parametrize("law", ["network", "d272"])
 def test_a_flat_bed_on_a_full_floor_is_the_reports_system_curve(law):
     """(a): the bin's airflow at each fan pressure is the report's 1-D system curve
-    (network._report_system.system_rows at the same law and porosity), to the solver's
+    (network.report.system.system_rows at the same law and porosity), to the solver's
     tolerance."""
     make = network_material if law == "network" else d272_material
     mat = make("wheat", viscosity_pa_s=MU, density_kg_m3=RHO)

@@ -26,7 +26,7 @@ import numpy as np
 from .._cli import (CliError, CliParser, add_air, bad_input, check_common, check_outputs,
                     check_plot, computing, finish, progress_log, run)
 from .._grains import BED, D272, GRAIN_ALIASES
-from .._report_system import AIRFLOW_UNITS, read_fan
+from ..report.system import AIRFLOW_UNITS, read_fan
 from ._geometry import BinGeometry, Duct, default_size, mesh_bin
 from ._material import (ANGLE_OF_REPOSE, d272_material, network_material, read_profile)
 from ._outputs import aeration, write_figure, write_vtk

@@ -36,7 +36,7 @@ from pathlib import Path
 import numpy as np
 
 from .._grains import BED, D272
-from .._report_porosity import requested_porosity
+from ..report.porosity import requested_porosity
 from ._law import ForchheimerLaw, SheddLaw
 
 __all__ = ["ANGLE_OF_REPOSE", "Material", "network_material", "d272_material",

@@ -5,7 +5,7 @@ the same mesh. The airflow Q(P) of the plenum rises monotonically with the fan's
 pressure P (the law's resistance grows with speed), as Q ∝ P between P^{1/2} (inertial) and
 P (Darcy): :func:`pressure_for_airflow` finds P by the secant method on ln Q against ln P.
 The fan's operating point is where the fan curve crosses the computed system curve
-(``network.report``'s :func:`~network._report_system.operating_point` on the curve's points,
+(``network.report``'s :func:`~network.report.system.operating_point` on the curve's points,
 log-log interpolated), then solved exactly by the secant method on P - P_fan(Q(P)).
 """
 
@@ -68,7 +68,7 @@ def _dense(q, p, n=400):
 
 def fan_operating_point(problem, curve, fan_q, fan_p, *, rtol=1e-9, maxiter=40):
     """(solution at the operating point, None) or (None, message with both ranges)."""
-    from .._report_system import curve_range, operating_point
+    from ..report.system import curve_range, operating_point
 
     q = np.array([s.inflow_m3_s for s in curve])
     p = np.array([s.pressure_pa for s in curve])
