@@ -1,22 +1,23 @@
-"""What the dem command lines share: process setup, exit codes, progress lines, the container.
+"""What the dem command lines share: process setup, progress lines, the container; the
+command-line base (exit codes, one-line parser, run wrapper, output check) is the project's one
+(:mod:`network.core`).
 
-``python -m dem.pack`` and ``python -m dem.vibrate`` (and the vibration study) run their body
-through :func:`run_main`: malloc tuning (:mod:`dem._perf`), argument parsing, and one mapping
-of failures to exit codes, the project's convention: 2 for bad input (``ValueError``,
-``OSError``), 1 for a computation that failed (a simulation that went unstable,
-:class:`~dem._integrate.DemInstabilityError`, an unconverged packing) or was interrupted
-(Ctrl-C). No physics here.
+``python -m dem.pack``, ``dem.vibrate``, ``dem.study`` and ``dem.bench`` run their body through
+:func:`run_main`: malloc tuning (:mod:`dem._perf`), argument parsing, and the project's mapping
+of failures to exit codes: 2 for bad input (``ValueError``, ``OSError``), 1 for a computation
+that failed (a simulation that went unstable, :class:`~dem._integrate.DemInstabilityError`, an
+unconverged packing) or was interrupted (Ctrl-C). No physics here.
 """
 
 from __future__ import annotations
 
 import argparse
 import math
-import os
 import sys
-import tempfile
 import time
-from pathlib import Path
+
+from network.core import (EXIT_BAD_INPUT, EXIT_FAILED, CliError, CliParser, bad_input,
+                          check_output_list, run)
 
 from ._container import SCENES, Container
 from ._integrate import DemInstabilityError
@@ -25,44 +26,42 @@ from ._perf import tune_malloc
 __all__ = ["EXIT_BAD_INPUT", "EXIT_FAILED", "EXIT_UNSTABLE", "run_main", "progress_printer",
            "resolve_container", "check_output", "check_seed", "OneLineParser"]
 
-EXIT_BAD_INPUT = 2
-#: A computation that failed: unstable, not converged, interrupted (the same code as network's).
-EXIT_FAILED = 1
+#: A simulation that went unstable: a failed computation (exit 1).
 EXIT_UNSTABLE = EXIT_FAILED
+#: What an interrupted dem command says was kept.
+INTERRUPTED = ("nothing more written (a packing is written whole at the end; a vibration "
+               "study resumes from its last checkpoint)")
 
 
-class OneLineParser(argparse.ArgumentParser):
-    """``ArgumentParser`` whose usage errors are one ``error:`` line and exit 2."""
+class OneLineParser(CliParser):
+    """The project's one-line parser (:class:`network.core.CliParser`) with argparse's plain
+    help layout."""
 
-    def error(self, message):
-        print(f"error: {message} (see {self.prog} --help)", file=sys.stderr)
-        raise SystemExit(EXIT_BAD_INPUT)
+    def __init__(self, *a, **kw):
+        kw.setdefault("formatter_class", argparse.HelpFormatter)
+        super().__init__(*a, **kw)
 
 
 def run_main(parser, body, argv=None, *, interrupted=None) -> int:
     """Parse ``argv`` with ``parser`` and return ``body(args)``, mapping failures to exit codes.
 
     A ``ValueError`` or ``OSError`` prints ``error: ...`` and returns 2; a
-    ``DemInstabilityError`` prints ``unstable: ...`` and Ctrl-C ``interrupted: ...``, both
-    returning 1 (what was written before stays: packings are written whole at the end, the
-    vibration study keeps its checkpoints; ``interrupted`` replaces that line's text).
-    argparse's own errors exit 2 as usual.
+    ``DemInstabilityError`` prints ``unstable, not written: ...`` and Ctrl-C
+    ``interrupted: ...``, both returning 1 (what was written before stays: packings are
+    written whole at the end, the vibration study keeps its checkpoints; ``interrupted``
+    replaces that line's text). Any other exception is one ``error:`` line and exit 1
+    (:func:`network.core.run`).
     """
     tune_malloc()
-    args = parser.parse_args(argv)
-    try:
-        return body(args)
-    except (ValueError, OSError) as e:
-        print(f"error: {e}", file=sys.stderr)
-        return EXIT_BAD_INPUT
-    except DemInstabilityError as e:
-        print(f"unstable, not written: {e}", file=sys.stderr)
-        return EXIT_UNSTABLE
-    except KeyboardInterrupt:
-        print("interrupted: " + (interrupted or "nothing more written (a packing is written "
-              "whole at the end; a vibration study resumes from its last checkpoint)"),
-              file=sys.stderr)
-        return EXIT_FAILED
+
+    def guarded(args):
+        try:
+            with bad_input():
+                return body(args)
+        except DemInstabilityError as e:
+            raise CliError(str(e), EXIT_UNSTABLE, label="unstable, not written") from e
+
+    return run(guarded, parser, argv, interrupted=interrupted or INTERRUPTED)
 
 
 def progress_printer(label="", *, quiet=False, every_steps=2000):
@@ -104,26 +103,11 @@ def resolve_container(scene, *, size_m=None, height_m=None, summary=None):
     raise ValueError("no container: give --scene or keep the packing's JSON summary beside it")
 
 
-def check_output(path, option="--out") -> None:
-    """ValueError naming ``option`` when the file ``path`` cannot be written: it is a folder,
-    an existing file not writable, or its folder (the nearest existing one: missing folders
-    are created when written) takes no new file, probed by making and removing a temporary
-    file there (``os.access`` says yes to root, even on ``/proc``)."""
-    path = Path(path)
-    if path.is_dir():
-        raise ValueError(f"{option} {path}: is a folder, give a file name")
-    folder = path.parent
-    while not folder.is_dir():
-        if folder.exists() or folder == folder.parent:
-            raise ValueError(f"{option} {path}: {folder} is not a folder")
-        folder = folder.parent
-    try:
-        tempfile.TemporaryFile(dir=folder, prefix=".grainflow-").close()
-    except OSError as exc:
-        raise ValueError(f"{option} {path}: folder {folder} is not writable "
-                         f"({exc.strerror or exc})") from None
-    if path.exists() and not os.access(path, os.W_OK):
-        raise ValueError(f"{option} {path}: file exists and is not writable")
+def check_output(path, option="--out", inputs=()) -> None:
+    """ValueError naming ``option`` when the file ``path`` cannot be written, or is one of
+    ``inputs`` (``(what, path)`` pairs): :func:`network.core.check_output_list`, missing
+    folders made on writing."""
+    check_output_list([(option, path)], inputs, make_folders=True)
 
 
 def check_seed(seed, option="--seed") -> None:

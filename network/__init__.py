@@ -2,7 +2,8 @@
 
 Each layer imports only the layers above it in this list (``tests/test_layers.py``):
 
-``_air``, ``packing``  air properties; Packing, readers/writers, random and lattice packings
+``_air``, ``core``,    air properties; Packing, its file format and the command-line base
+``packing``            (``core``, shared with ``dem``); random and lattice packings
 ``pores``              Delaunay tessellation, merged pore bodies, sample region, porosity
 ``conductance``        Q* by policy (the only importer of ``cache``), thesis and conduit models
 ``flow``               assemble → constrain → solve → verify; :func:`solve_network`, the one
@@ -14,34 +15,76 @@ CLIs                   ``python -m network.solve`` (permeability and pressure dr
                        ``network.curve`` (the resistance curve with inertia), ``network.bench``:
                        parse, call the pipeline, print
 
-The names below (``__all__``) are the public API; the subpackages export more.
+The names below (``__all__``) are the public API, each imported from its subpackage on first
+use; the subpackages export more.
 """
 
+import importlib as _importlib
+import importlib.util as _importlib_util
 import sys as _sys
 
-if _sys.argv[:1] == ["-m"]:     # python -m network.<command>: a command process (network._lean)
+
+def _network_command() -> bool:
+    """Whether this process is a command on the network pipeline: started as ``python -m
+    <module>`` (``sys.argv[0]`` is ``'-m'`` while the package is imported) with a module not
+    of ``dem``, which imports only :mod:`network.core`."""
+    if _sys.argv[:1] != ["-m"]:
+        return False
+    orig = list(getattr(_sys, "orig_argv", ()))
+    for k, arg in enumerate(orig[1:], 1):
+        if arg.startswith("-m"):
+            module = arg[2:] or (orig[k + 1] if k + 1 < len(orig) else "")
+            return module.split(".")[0] != "dem"
+    return True
+
+
+if _network_command():          # a command process (network._lean): the pipeline imported now
     from ._lean import lean_imports as _lean_imports
     _lean_imports()
+    from . import conductance, flow, packing, paths, pores, validation  # noqa: F401
+    from ._lean import imports_done as _imports_done
+    _imports_done()             # the collector back on, what was imported frozen
 
-from ._air import MU_AIR_PA_S, RHO_AIR_KG_M3
-from .conductance import (MODELS, POLICIES, ConductanceResult, QstarResult, thesis_conductance,
-                          throat_conductance, throat_qstar)
-from .flow import (AMGSolver, FlowResult, InertialPoint, SolveInfo, apply_pressure_bc,
-                   asabe_d272_gradient, fit_curve, solve_inertial,
-                   assemble_laplacian, darcy_permeability, ergun_gradient, kozeny_carman_gradient,
-                   solve_fixed_pressure, solve_network, solve_pressure, verify_solution,
-                   write_network_vtu)
-from .packing import (Packing, default_packing_path, lattice_packing, lattice_radius,
-                      random_packing, read_container, read_packing, write_packing_csv)
-from .paths import AirflowPath, BranchedResult, branched_pressure_drop, trace_paths
-from .pores import (QHULL_OPTIONS, Region, SampleNetwork, Tessellation, default_region,
-                    prune_disconnected, region_porosity, sample_throats, select_sample,
-                    tessellate, tie_groups)
-from .validation import beetstra_permeability, kozeny_carman_permeability, lattice_permeability
+#: public name -> the subpackage that defines it; imported on first use (PEP 562), so that
+#: ``import network.core`` (what ``dem`` imports) loads the core alone
+_HOME = {}
+for _module, _names in {
+    "._air": ("MU_AIR_PA_S", "RHO_AIR_KG_M3"),
+    ".paths": ("AirflowPath", "BranchedResult", "branched_pressure_drop", "trace_paths"),
+    ".conductance": ("MODELS", "POLICIES", "ConductanceResult", "QstarResult",
+                     "thesis_conductance", "throat_conductance", "throat_qstar"),
+    ".flow": ("AMGSolver", "FlowResult", "InertialPoint", "SolveInfo", "apply_pressure_bc",
+              "asabe_d272_gradient", "fit_curve", "solve_inertial", "assemble_laplacian",
+              "darcy_permeability", "ergun_gradient", "kozeny_carman_gradient",
+              "solve_fixed_pressure", "solve_network", "solve_pressure", "verify_solution",
+              "write_network_vtu"),
+    ".packing": ("Packing", "default_packing_path", "lattice_packing", "lattice_radius",
+                 "random_packing", "read_container", "read_packing", "write_packing_csv"),
+    ".pores": ("QHULL_OPTIONS", "Region", "SampleNetwork", "Tessellation", "default_region",
+               "prune_disconnected", "region_porosity", "sample_throats", "select_sample",
+               "tessellate", "tie_groups"),
+    ".validation": ("beetstra_permeability", "kozeny_carman_permeability",
+                    "lattice_permeability"),
+}.items():
+    _HOME.update(dict.fromkeys(_names, _module))
+del _module, _names
 
-from ._lean import imports_done as _imports_done
 
-_imports_done()                 # a command process's collector back on (no-op otherwise)
+def __getattr__(name: str):
+    """A public name (or a subpackage) of the package, imported on first use."""
+    if name in _HOME:
+        value = getattr(_importlib.import_module(_HOME[name], __name__), name)
+    elif not name.startswith("__") and _importlib_util.find_spec(f"{__name__}.{name}"):
+        value = _importlib.import_module(f"{__name__}.{name}")
+    else:
+        raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
+    globals()[name] = value
+    return value
+
+
+def __dir__():
+    return sorted(set(globals()) | set(__all__))
+
 
 __all__ = [
     "Packing", "read_packing", "write_packing_csv", "default_packing_path", "read_container",

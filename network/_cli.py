@@ -1,12 +1,7 @@
 """Shared pieces of the network command-line tools (``network.solve``, ``.curve``, ``.throats``,
-``.paths``): the packing/sample/units/air arguments, output-path checks, warning capture and the
-exit-code convention (docs/cli.md).
-
-Exit codes: 0 done, 1 the computation failed, 2 bad input. A failure prints one line
-``error: ...`` on stderr naming the value, row or file, never a traceback (set
-``GRAINFLOW_DEBUG=1`` to get one). Input, output paths included, is checked before anything is
-computed or written. Numbers such as ``--viscosity -1.8e-5`` are read as values (and refused
-with the option's own message), not as options.
+``.paths``, ``.report``): the packing/sample/units/air arguments, the packing's input files and
+the model's validity warnings, on top of the command-line base every grainflow command shares
+(:mod:`network.core`: exit codes, parser, run wrapper, output check; docs/cli.md).
 
 Lengths that place something in the packing (``--sample``, ``--margin``, ``--entry``) are in
 the packing file's unit (``--units``, default m); physical quantities (``--depth``,
@@ -15,100 +10,28 @@ the packing file's unit (``--units``, default m); physical quantities (``--depth
 
 from __future__ import annotations
 
-import argparse
-import atexit
-import contextlib
-import logging
 import os
-import re
-import sys
-import tempfile
-import warnings
 from pathlib import Path
 
 from ._air import MU_AIR_PA_S, P_ATM_PA, RHO_AIR_KG_M3, check_positive
 from ._lean import keep_heap
+from .core import (EXIT_BAD_INPUT, EXIT_FAILED, EXIT_OK, CliError, CliParser, bad_input,
+                   check_output_list, check_outputs, check_writable_folder, computing, finish,
+                   progress_log, run, warn)
 from .packing import (UNITS, check_three_dimensional, default_packing_path, read_container,
                       read_packing, scale_warning)
 from .flow import DEFAULT_INERTIAL_LAW, INERTIAL_LAWS
 
 __all__ = ["EXIT_OK", "EXIT_FAILED", "EXIT_BAD_INPUT", "CliError", "CliParser", "bad_input",
-           "computing", "run", "add_packing", "add_sample", "add_air", "check_outputs",
-           "check_plot", "load_packing", "sample_box_m", "warn"]
+           "computing", "run", "finish", "progress_log", "add_packing", "add_sample", "add_air",
+           "check_outputs", "check_output_list", "check_writable_folder", "check_plot",
+           "load_packing", "sample_box_m", "warn"]
 
-EXIT_OK, EXIT_FAILED, EXIT_BAD_INPUT = 0, 1, 2
 #: Smallest ``--viscosity`` taken, Pa s: about a hundredth of hydrogen's (8.8e-6 Pa s at 20 °C),
 #: the least viscous gas. Far below it the viscous term is lost beside the inertial one in the
 #: Newton solve (Re_p 1e16 at 1e-20 Pa s: a gradient 8 times low, exit 0; at 1e-30 no
 #: convergence after two minutes).
 MIN_VISCOSITY_PA_S = 1e-7
-#: a number, negative ones and exponents included: argparse's own pattern misses ``-1.8e-5``
-_NUMBER = re.compile(r"^-(\d+\.?\d*|\.\d+)([eE][-+]?\d+)?$|^-(inf|infinity|nan)$", re.I)
-
-
-class CliError(Exception):
-    """One line for the user and the exit code (1 or 2) that goes with it."""
-
-    def __init__(self, message: str, code: int = EXIT_BAD_INPUT):
-        super().__init__(message)
-        self.code = code
-
-
-class _Help(argparse.HelpFormatter):
-    """Appends ``(default: X)`` to an option's help unless it says its default already or the
-    default is None/False (an output not written, a switch off)."""
-
-    def _get_help_string(self, action):
-        text = action.help or ""
-        if (action.default not in (None, False, argparse.SUPPRESS) and action.option_strings
-                and "default" not in text):
-            text += " (default: %(default)s)"
-        return text
-
-
-class CliParser(argparse.ArgumentParser):
-    """``ArgumentParser`` that reads ``-1.8e-5`` as a value and reports a bad option in one
-    line (exit 2) instead of the usage block."""
-
-    def __init__(self, *a, **kw):
-        kw.setdefault("formatter_class", _Help)
-        super().__init__(*a, **kw)
-        self._negative_number_matcher = _NUMBER
-
-    def error(self, message):
-        raise CliError(f"{message} (see {self.prog} --help)")
-
-
-def _message(exc: BaseException) -> str:
-    if isinstance(exc, OSError) and exc.filename is not None and exc.strerror:
-        return f"{exc.strerror}: {exc.filename}"
-    return str(exc) or type(exc).__name__
-
-
-@contextlib.contextmanager
-def bad_input():
-    """ValueError/OSError inside become exit 2 (the user's input is wrong)."""
-    try:
-        yield
-    except (ValueError, OSError) as exc:
-        raise CliError(_message(exc), EXIT_BAD_INPUT) from exc
-
-
-@contextlib.contextmanager
-def computing():
-    """ValueError/RuntimeError/ArithmeticError/OSError inside become exit 1 (the computation
-    or writing its output failed); exit 2 for an error that marks itself ``bad_input`` (found
-    only by computing, e.g. a packing too small for its sample: ``EmptySampleError``)."""
-    try:
-        yield
-    except (ValueError, RuntimeError, ArithmeticError, NotImplementedError, OSError) as exc:
-        code = EXIT_BAD_INPUT if getattr(exc, "bad_input", False) else EXIT_FAILED
-        raise CliError(_message(exc), code) from exc
-
-
-def warn(message: str) -> None:
-    """One ``warning:`` line on stderr."""
-    print(f"warning: {' '.join(str(message).split())}", file=sys.stderr)
 
 
 #: Largest particle Reynolds number the inertial law is checked at (against the Beetstra law
@@ -137,122 +60,6 @@ def warn_curve(points, depth_m: float, key: str = "pressure_gradient_pa_per_m") 
     if ok:
         warn_validity(max(p["reynolds_particle"] for p in ok),
                       max(p[key] for p in ok) * depth_m)
-
-
-class _WarningLines(logging.Handler):
-    """Log records of level WARNING and above as one ``warning:`` line each, a message
-    repeated within the run (once per axis, a file read twice) printed once."""
-
-    def __init__(self):
-        super().__init__(logging.WARNING)
-        self.seen: set[str] = set()
-
-    def emit(self, record):
-        text = " ".join(record.getMessage().split())
-        if text not in self.seen:
-            self.seen.add(text)
-            warn(text)
-
-
-def _below_warning(record) -> bool:
-    return record.levelno < logging.WARNING
-
-
-#: handlers :func:`run` installed on the root logger, removed when the command ends
-_INSTALLED: list = []
-
-
-def progress_log(args, fmt: str = "[%(relativeCreated)7.0f ms] %(message)s") -> None:
-    """Stage progress on stderr (INFO log lines) unless ``--quiet`` or logging is configured
-    already (a test's or an embedding program's handlers); warnings go to :func:`run`'s
-    ``warning:`` lines, not here."""
-    root = logging.getLogger()
-    if getattr(args, "quiet", False) or any(h not in _INSTALLED for h in root.handlers):
-        return
-    handler = logging.StreamHandler(sys.stderr)
-    handler.setFormatter(logging.Formatter(fmt))
-    handler.addFilter(_below_warning)
-    root.addHandler(handler)
-    _INSTALLED.append(handler)
-    root.setLevel(min(root.level or logging.WARNING, logging.INFO))
-
-
-def run(body, parser: argparse.ArgumentParser, argv=None, *,
-        interrupted: str | None = None) -> int:
-    """Parse ``argv``, call ``body(args)`` with numpy/scipy warnings captured, return its exit
-    code; a :class:`CliError` (or any other exception: exit 1) becomes one ``error:`` line.
-    Ctrl-C is exit 1 with one ``error: interrupted`` line, or ``interrupted: <interrupted>``
-    where that text is given.
-
-    Captured warnings do not reach the terminal; when there were any, one line says how many
-    and quotes the first (the checks of the result decide whether it is good). The library's
-    logged warnings (``logging``) become ``warning:`` lines, each distinct one once.
-    """
-    debug = os.environ.get("GRAINFLOW_DEBUG")
-    root = logging.getLogger()
-    level, mark = root.level, len(_INSTALLED)      # a run inside a run keeps the outer's
-    lines = _WarningLines()
-    root.addHandler(lines)
-    _INSTALLED.append(lines)
-    try:
-        return _run(body, parser, argv, debug, interrupted)
-    finally:
-        while len(_INSTALLED) > mark:
-            root.removeHandler(_INSTALLED.pop())
-        root.setLevel(level)
-
-
-def _run(body, parser, argv, debug, interrupted=None) -> int:
-    with warnings.catch_warnings(record=True) as caught:
-        warnings.simplefilter("always")
-        try:
-            code = body(parser.parse_args(argv))
-        except CliError as exc:
-            print(f"error: {' '.join(str(exc).split())}", file=sys.stderr)
-            code = exc.code
-        except KeyboardInterrupt:
-            print(f"interrupted: {interrupted}" if interrupted else
-                  "error: interrupted; no output written after the interruption", file=sys.stderr)
-            code = EXIT_FAILED
-        except Exception as exc:  # noqa: BLE001 - the convention: one line, no traceback
-            if debug:
-                raise
-            print(f"error: {type(exc).__name__}: {_message(exc)} (an internal error; "
-                  "GRAINFLOW_DEBUG=1 shows the traceback)", file=sys.stderr)
-            code = EXIT_FAILED
-    distinct = list(dict.fromkeys(f"{w.category.__name__}: {w.message}" for w in caught))
-    if distinct:
-        warn(f"{len(caught)} numerical warning(s) from numpy/scipy suppressed "
-             f"({len(distinct)} distinct; first: {distinct[0][:160]})")
-    return code
-
-
-def finish(code: int):
-    """End the command process with exit status ``code`` without tearing the interpreter down.
-
-    An ordinary exit frees every module, array and solver hierarchy one by one: 0.05-0.1 s
-    after a 5 000-sphere solve (``docs/network-bench.md``). By the time a command
-    returns its outputs are written and closed (its ``with`` blocks) and every future of its
-    worker threads awaited, so ``finish`` flushes stdout and stderr, runs the ``atexit``
-    handlers (logging's flush, multiprocessing's clean-up), flushes again (what a handler
-    printed) and ends with :func:`os._exit`. A stream that cannot be flushed (a reader that
-    closed the pipe) loses what it could not take, as it would at an ordinary exit; an
-    interpreter without ``atexit._run_exitfuncs`` exits the ordinary way.
-    """
-    run_handlers = getattr(atexit, "_run_exitfuncs", None)
-    if run_handlers is None:
-        sys.exit(code)
-    _flush()
-    run_handlers()
-    _flush()
-    os._exit(code)
-
-
-def _flush() -> None:
-    """Flush stdout and stderr, ignoring a stream that is closed or whose reader has gone."""
-    for stream in (sys.stdout, sys.stderr):
-        with contextlib.suppress(OSError, ValueError, AttributeError):
-            stream.flush()
 
 
 # ------------------------------------------------------------------ arguments
@@ -314,46 +121,6 @@ def add_air(ap, *, density: bool = True) -> None:
 
 
 # ------------------------------------------------------------------ checks
-def check_outputs(*, inputs=(), **paths) -> None:
-    """ValueError unless every given output path (``option=path``; None skipped) can be
-    written: its folder exists and takes a new file (tried: a temporary file made and removed,
-    which ``os.access`` cannot tell for root or a read-only mount), it is not a folder, and no
-    two outputs, nor an output and one of ``inputs`` (``(what, path)`` pairs, e.g.
-    :func:`packing_inputs`), name the same file."""
-    check_output_list([("--" + k.replace("_", "-"), p) for k, p in paths.items()], inputs)
-
-
-def check_output_list(pairs, inputs=()) -> None:
-    """:func:`check_outputs` for ``(option, path)`` pairs (an option may come more than once)."""
-    seen = {Path(p).resolve(): what for what, p in inputs if p is not None}
-    for opt, p in pairs:
-        if p is None:
-            continue
-        path = Path(p)
-        folder = path.parent if str(path.parent) else Path(".")
-        if path.is_dir():
-            raise ValueError(f"{opt} {p}: is a folder, give a file name")
-        if not folder.is_dir():
-            raise ValueError(f"{opt} {p}: folder {folder} does not exist")
-        key = path.resolve()
-        if key in seen:
-            raise ValueError(f"{opt} {p}: the same file as {seen[key]}; give another name")
-        seen[key] = f"{opt} {p}"
-        check_writable_folder(folder, f"{opt} {p}")
-        if path.exists() and not os.access(path, os.W_OK):
-            raise ValueError(f"{opt} {p}: file exists and is not writable")
-
-
-def check_writable_folder(folder, what: str) -> None:
-    """ValueError naming ``what`` unless a file can be made in ``folder``: tried with a temporary
-    file, removed at once (``os.access`` says yes to root even on ``/proc``)."""
-    try:
-        tempfile.TemporaryFile(dir=folder, prefix=".grainflow-").close()
-    except OSError as exc:
-        raise ValueError(f"{what}: folder {folder} is not writable "
-                         f"({exc.strerror or exc})") from None
-
-
 def packing_inputs(args) -> list:
     """``(what, path)`` of the files a network command reads: the packing file (``args.packing``)
     and its companion JSON when that holds the DEM's container (:func:`read_container`)."""

@@ -15,7 +15,7 @@ from __future__ import annotations
 import importlib
 from concurrent.futures import Future, ThreadPoolExecutor
 
-__all__ = ["Deferred", "beside", "csgraph", "import_now", "sparse_linalg", "spatial"]
+__all__ = ["Deferred", "beside", "csgraph", "import_now", "sparse", "sparse_linalg", "spatial"]
 
 
 class Deferred:
@@ -44,6 +44,7 @@ def _load(deferred: Deferred):
 
 
 csgraph = Deferred("scipy.sparse.csgraph")
+sparse = Deferred("scipy.sparse")
 sparse_linalg = Deferred("scipy.sparse.linalg")
 spatial = Deferred("scipy.spatial")
 

@@ -2,8 +2,9 @@
 
 Rules:
 
-* packages: ``throats`` <- ``cache`` <- ``network``; ``dem`` stands apart (it imports no other
-  project package and none imports it). A benchmark (``<package>/bench.py``) is a tool on top of
+* packages: ``throats`` <- ``cache`` <- ``network``; ``dem`` imports one module of another
+  package, ``network.core`` (the packing format and the command-line base, NumPy only at
+  import), and no package imports ``dem``. A benchmark (``<package>/bench.py``) is a tool on top of
   the pipeline and may import the public API (the package itself, never a private module) of the
   packages below or beside it;
 * inside a package, subpackages form layers (``LAYERS``): a module imports only its own layer
@@ -26,7 +27,13 @@ ROOT = Path(__file__).resolve().parents[1]
 PACKAGES = ("throats", "cache", "network", "dem")
 #: which project packages each package may import (bench modules: see ``BENCH_MAY_IMPORT``)
 MAY_IMPORT = {"throats": set(), "cache": {"throats"}, "network": {"throats", "cache"},
-              "dem": set()}
+              "dem": {"network"}}
+#: of another package, a package may import only these modules where listed (dem shares the
+#: light core of network, nothing else of it)
+ONLY_MODULES = {"dem": {"network": "network.core"}}
+#: what the shared core may import of its own package: itself and the deferred SciPy modules
+CORE = "network.core"
+CORE_MAY_IMPORT = ("network.core", "network._deferred")
 BENCH_MAY_IMPORT = {"throats": {"network"}, "cache": {"throats", "network"},
                     "network": {"throats", "cache"}, "dem": set()}
 #: inside network, only the conductance layer talks to the Q* table (cache)
@@ -35,7 +42,7 @@ ONLY_FROM = {"cache": "network.conductance"}
 #: below the package (a subpackage name, or the module name for top-level modules)
 LAYERS = {
     "network": [
-        {"_lean", "_deferred", "_air", "_json", "_grains", "packing"},
+        {"_lean", "_deferred", "_air", "_json", "_grains", "core", "packing"},
         {"pores"},
         {"conductance"},
         {"flow"},
@@ -107,13 +114,51 @@ def test_packages_import_only_what_they_may(package):
             continue
         is_bench = module == f"{package}.bench"
         allowed = BENCH_MAY_IMPORT[package] if is_bench else MAY_IMPORT[package]
-        if top not in allowed or (is_bench and target != top):
+        only = ONLY_MODULES.get(package, {}).get(top)
+        if top not in allowed or (is_bench and target != top) or (
+                only and not is_bench and target != only):
             bad.append(f"{path.relative_to(ROOT)}:{line} imports {target}")
         elif top in ONLY_FROM and package == ONLY_FROM[top].split(".")[0] \
                 and not module.startswith(ONLY_FROM[top]):
             bad.append(f"{path.relative_to(ROOT)}:{line} imports {target}: only "
                        f"{ONLY_FROM[top]} may")
     assert not bad, "\n".join(bad)
+
+
+def test_the_shared_core_imports_only_itself():
+    """network.core, which dem imports, imports nothing of network but itself and the deferred
+    SciPy modules, so that importing it never loads the pipeline."""
+    bad = [f"{p.relative_to(ROOT)}:{line} imports {t}"
+           for m, p, line, t, _, _ in _project_imports("network")
+           if m.startswith(CORE) and not t.startswith(CORE_MAY_IMPORT)]
+    assert not bad, "\n".join(bad)
+
+
+_LIGHT_PROBE = """
+import json, sys
+import {module}
+print(json.dumps(sorted(m for m in sys.modules if m.split('.')[0] in
+                        ('network', 'numba', 'scipy', 'pyamg', 'matplotlib'))))
+"""
+
+
+def test_the_shared_core_loads_numpy_alone():
+    """``import network.core`` loads NumPy and the core, no SciPy, numba or pipeline layer;
+    ``import dem`` loads no module of network beyond it."""
+    import json
+    import subprocess
+    import sys
+
+    def loaded(module):
+        out = subprocess.run([sys.executable, "-c", _LIGHT_PROBE.format(module=module)],
+                             capture_output=True, text=True, cwd=ROOT, check=True)
+        return json.loads(out.stdout)
+
+    core = loaded("network.core")
+    assert set(core) == {"network", "network._deferred", "network.core", "network.core._cli",
+                         "network.core._io", "network.core._packing"}, core
+    net = {m for m in loaded("dem") if m.split(".")[0] == "network"}
+    assert net == set(core), net
 
 
 @pytest.mark.parametrize("package", PACKAGES)

@@ -21,7 +21,7 @@ import numpy as np
 
 from ..flow import solve_network
 from .._lean import keep_heap
-from ..packing import Packing, periodic_copies, random_packing, read_packing, write_packing_csv
+from ..packing import periodic_copies, random_packing, read_packing, write_packing_csv
 from .._cli import available_cores
 from ._common import qstar_sources
 
@@ -44,8 +44,7 @@ def _tiled(base_n: int, n: int, workdir: Path, seed: int):
     big = periodic_copies(base, box, k)
     side = k * box * (n / big.n) ** (1.0 / 3.0)
     keep = np.all(big.centers < side, axis=1)
-    return Packing(big.centers[keep], big.radii[keep],
-                   source=f"{k}^3 tiling of {base_n} periodic spheres")
+    return big.subset(keep, source=f"{k}^3 tiling of {base_n} periodic spheres")
 
 
 def packing_file(n: int, workdir: Path, seed: int) -> Path:

@@ -1,4 +1,5 @@
-"""Packings: the :class:`Packing` table, its readers and writers, and generated packings.
+"""Packings: the :class:`Packing` table, its readers and writers (both from :mod:`network.core`,
+the light module ``dem`` shares), and generated packings.
 
 Readers take CSV ``x,y,z,r`` (m), ``.npz`` and LAMMPS/LIGGGHTS dumps; :func:`random_packing` is the
 project's one random sphere packer (grow and push, no gravity); :func:`lattice_packing` builds
@@ -6,11 +7,10 @@ the regular arrays whose exact permeability is known.
 """
 
 from ._generate import SOYBEAN_DEFAULT, periodic_copies, random_packing, soybean_default_scene
-from ._io import (FORMATS, UNITS, default_packing_path, read_container, read_packing,
-                  write_packing_csv)
-from ._packing import (MIN_SPHERES, PLAUSIBLE_DIAMETER_M, DegeneratePackingError, Packing,
-                       check_grains, check_three_dimensional, grain_volumes, scale_warning,
-                       validate_spheres)
+from ..core import (FORMATS, MIN_SPHERES, PLAUSIBLE_DIAMETER_M, UNITS, DegeneratePackingError,
+                    Packing, check_grains, check_three_dimensional, default_packing_path,
+                    grain_volumes, read_container, read_packing, scale_warning,
+                    validate_spheres, write_packing_csv)
 from ._lattices import (LATTICES, SPHERES_PER_CELL, TOUCHING_FRACTION, lattice_basis,
                         lattice_packing, lattice_radius)
 

@@ -24,7 +24,7 @@ import math
 import numpy as np
 
 from .._deferred import spatial
-from ._packing import Packing
+from ..core import Packing
 
 __all__ = ["random_packing", "periodic_copies", "soybean_default_scene", "SOYBEAN_DEFAULT"]
 
@@ -180,7 +180,11 @@ def periodic_copies(packing: Packing, side: float, copies: int) -> Packing:
         raise ValueError(f"copies must be >= 1, got {copies!r}")
     shifts = np.stack(np.meshgrid(*[np.arange(n)] * 3, indexing="ij"), -1).reshape(-1, 3)
     c = (np.mod(packing.centers, side)[None] + side * shifts[:, None]).reshape(-1, 3)
-    return Packing(c, np.tile(packing.radii, len(shifts)),
+    grain = None
+    if packing.grain_id is not None:            # each copy's grains numbered apart
+        span = int(packing.grain_id.max()) - int(packing.grain_id.min()) + 1
+        grain = (packing.grain_id[None] + span * np.arange(len(shifts))[:, None]).ravel()
+    return Packing(c, np.tile(packing.radii, len(shifts)), grain_id=grain,
                    source=f"{n}^3 periodic copies of {packing.source}")
 
 

@@ -1,4 +1,5 @@
-"""Reading sphere packings: delimited text ``x,y,z,r``, ``.npz`` and LAMMPS/LIGGGHTS dumps.
+"""Packing files: reading delimited text ``x,y,z,r``, ``.npz`` and LAMMPS/LIGGGHTS dumps, writing
+CSV and the JSON summary beside it.
 
 A packing is a table of sphere centres (N, 3) and radii (N,), in metres: a file in mm or cm
 is read with ``units``. Every reader validates at the door and names the
@@ -9,6 +10,7 @@ the 1-based array index of a ``.npz``).
 from __future__ import annotations
 
 import io
+import json
 import logging
 import os
 import zipfile
@@ -16,10 +18,10 @@ from pathlib import Path
 
 import numpy as np
 
-from ._packing import Packing, check_grains, validate_spheres
+from ._packing import MIN_SPHERES, Packing, check_grains, validate_spheres
 
 __all__ = ["read_packing", "write_packing_csv", "default_packing_path", "read_container",
-           "UNITS", "FORMATS"]
+           "read_summary", "summary_path", "write_summary", "UNITS", "FORMATS"]
 
 log = logging.getLogger(__name__)
 
@@ -60,7 +62,7 @@ def _split(line: str, delim):
     return [f.strip() for f in (line.split(delim) if delim else line.split())]
 
 
-def _read_csv(path: Path) -> Packing:
+def _read_csv(path: Path, rules) -> Packing:
     """Delimited text: comma, semicolon, or spaces/tabs (YADE's ``export.text``: ``#`` comment
     lines, then ``x y z r`` rows); an optional header names x, y, z and r/radius/diameter."""
     src = str(path)
@@ -111,7 +113,7 @@ def _read_csv(path: Path) -> Packing:
                                [i for i, _ in body], src)
         lineno = np.array([i for i, _ in body])
     data = fast[:, cols]
-    validate_spheres(data[:, :3], data[:, 3] * scale, lineno, src)
+    validate_spheres(data[:, :3], data[:, 3] * scale, lineno, src, min_spheres=rules[0])
     grain = None
     if data.shape[1] == 5:
         grain = data[:, 4]
@@ -119,8 +121,21 @@ def _read_csv(path: Path) -> Packing:
         if bad.size:
             raise ValueError(f"{src}: row {lineno[bad[0]]}: grain_id must be a whole number, "
                              f"got {float(grain[bad[0]])!r}")
-        check_grains(data[:, :3], data[:, 3] * scale, grain, lineno, src)
+        _grains(data[:, :3], data[:, 3] * scale, grain, lineno, src, rules[1])
     return Packing(data[:, :3], data[:, 3] * scale, source=src, grain_id=grain)
+
+
+def _grains(centers, radii, grain, rows, source, one_sphere: str | None) -> None:
+    """The grain check of every reader: each grain one body (:func:`check_grains`), or, with
+    ``one_sphere`` (a reason), no grain of several spheres."""
+    if one_sphere is None:
+        check_grains(centers, radii, grain, rows, source)
+        return
+    ids, first, counts = np.unique(grain, return_index=True, return_counts=True)
+    if np.any(counts > 1):
+        k = int(np.argmax(counts > 1))
+        raise ValueError(f"{source}: row {rows[first[k]]}: grain_id {ids[k]:g} is on {counts[k]} "
+                         f"spheres: {one_sphere}")
 
 
 def _isfloat(s: str) -> bool:
@@ -131,7 +146,7 @@ def _isfloat(s: str) -> bool:
     return True
 
 
-def _read_npz(path: Path) -> Packing:
+def _read_npz(path: Path, rules) -> Packing:
     src = str(path)
     with np.load(path) as z:
         missing = [k for k in ("centers", "radii") if k not in z.files]
@@ -143,15 +158,15 @@ def _read_npz(path: Path) -> Packing:
     if c.ndim != 2 or c.shape[1] != 3 or c.shape[0] != r.shape[0]:
         raise ValueError(f"{src}: centers {c.shape} and radii {r.shape} must be (N, 3) and (N,)")
     rows = np.arange(1, len(r) + 1)
-    validate_spheres(c, r, rows, src)
+    validate_spheres(c, r, rows, src, min_spheres=rules[0])
     if grain is not None:
         if grain.shape != r.shape:
             raise ValueError(f"{src}: grain_id {grain.shape} must be ({r.size},)")
-        check_grains(c, r, grain, rows, src)
+        _grains(c, r, grain, rows, src, rules[1])
     return Packing(c, r, source=src, grain_id=grain)
 
 
-def _read_dump(path: Path) -> Packing:
+def _read_dump(path: Path, rules) -> Packing:
     """LAMMPS/LIGGGHTS ``dump custom`` text; the last snapshot in the file is read."""
     src = str(path)
     text = path.read_text(encoding="utf-8-sig").splitlines()
@@ -194,11 +209,12 @@ def _read_dump(path: Path) -> Packing:
         raise ValueError(f"{src}: row {s + 1}: scaled coordinates (xs ys zs) are not supported; "
                          "dump x y z or xu yu zu")
     lineno = np.array([i for i, _ in body])
-    validate_spheres(c, r, lineno, src)
+    validate_spheres(c, r, lineno, src, min_spheres=rules[0])
     return Packing(c, r, source=src)
 
 
-def read_packing(path: str | os.PathLike, *, units: str = "m") -> Packing:
+def read_packing(path: str | os.PathLike, *, units: str = "m", min_spheres: int = MIN_SPHERES,
+                 one_sphere_grains: str | None = None) -> Packing:
     """Read a sphere packing from a file, in metres.
 
     Parameters
@@ -211,7 +227,13 @@ def read_packing(path: str | os.PathLike, *, units: str = "m") -> Packing:
         ``radii`` (N,); LAMMPS/LIGGGHTS ``dump custom`` text (``x y z radius`` columns, the
         last snapshot).
     units : {'m', 'mm', 'cm'}, keyword-only
-        Unit of the file's lengths (default metres); the packing is returned in metres.
+        Unit of the file's lengths (default metres); the packing is returned in metres, every
+        column (``grain_id``) kept.
+    min_spheres : int, keyword-only
+        Fewest spheres taken (default :data:`MIN_SPHERES`, what a tessellation needs).
+    one_sphere_grains : str, optional, keyword-only
+        When given, a ``grain_id`` on several spheres is refused with this reason appended
+        (a reader whose engine moves single spheres only).
 
     Returns
     -------
@@ -228,6 +250,7 @@ def read_packing(path: str | os.PathLike, *, units: str = "m") -> Packing:
     """
     if units not in UNITS:
         raise ValueError(f"unknown length unit {units!r}; choose one of {', '.join(UNITS)}")
+    rules = (int(min_spheres), one_sphere_grains)
     p = Path(path)
     if p.is_dir():
         raise IsADirectoryError(f"packing {p} is a folder, not a file: give the packing file")
@@ -238,7 +261,7 @@ def read_packing(path: str | os.PathLike, *, units: str = "m") -> Packing:
         if not zipfile.is_zipfile(p):
             raise ValueError(f"{p}: not a .npz (zip) archive; formats read: {'; '.join(FORMATS)}")
         try:
-            pk = _read_npz(p)
+            pk = _read_npz(p, rules)
         except (OSError, EOFError, zipfile.BadZipFile) as e:
             raise ValueError(f"{p}: not a readable .npz file ({e}); formats read: "
                              f"{'; '.join(FORMATS)}") from e
@@ -249,12 +272,11 @@ def read_packing(path: str | os.PathLike, *, units: str = "m") -> Packing:
             raise ValueError(f"{p}: a binary file, not a packing; formats read: "
                              f"{'; '.join(FORMATS)}")
         if b"ITEM: ATOMS" in head or b"ITEM: TIMESTEP" in head:
-            pk = _read_dump(p)
+            pk = _read_dump(p, rules)
         else:
-            pk = _read_csv(p)
+            pk = _read_csv(p, rules)
     if units != "m":
-        f = UNITS[units]
-        pk = Packing(pk.centers * f, pk.radii * f, source=f"{pk.source} ({units})")
+        pk = pk.scaled(UNITS[units], source=f"{pk.source} ({units})")
     log.info("read %d spheres from %s", pk.n, p)
     return pk
 
@@ -288,8 +310,6 @@ def read_container(path: str | os.PathLike) -> dict | None:
         ``size_m`` is not the kind's positive, finite sizes (a box: length_x, width_y; a
         cylinder: diameter); the message names the file.
     """
-    import json
-
     p = Path(path).with_suffix(".json")
     if not p.is_file():
         return None
@@ -321,12 +341,68 @@ def read_container(path: str | os.PathLike) -> dict | None:
     return out
 
 
-def write_packing_csv(packing: Packing, path: str | os.PathLike, *, digits: int = 7) -> None:
-    """Write a packing as CSV ``x,y,z,r`` (``x,y,z,r,grain_id`` for grains of several spheres)
-    with ``digits`` significant digits."""
+def write_packing_csv(packing: Packing, path: str | os.PathLike, *, digits: int = 7,
+                      notation: str = "g", summary: dict | None = None) -> None:
+    """Write a packing as CSV ``x,y,z,r`` (``x,y,z,r,grain_id`` when it has grain ids) with
+    ``digits`` significant digits (``notation`` 'g' or 'e': ``%.{digits}g`` or
+    ``%.{digits - 1}e``) and, when given, ``summary`` as the JSON beside it
+    (:func:`write_summary`).
+
+    The file is written under a temporary name in its folder and renamed, so a failure never
+    leaves a half-written packing (nor the temporary file); missing folders are made.
+    """
+    if notation not in ("g", "e"):
+        raise ValueError(f"notation must be 'g' or 'e', got {notation!r}")
     data = np.column_stack([packing.centers, packing.radii])
-    fmt, head = [f"%.{digits}g"] * 4, "x,y,z,r"
+    fmt = [f"%.{digits}g" if notation == "g" else f"%.{digits - 1}e"] * 4
+    head = "x,y,z,r"
     if packing.grain_id is not None:
         data = np.column_stack([data, packing.grain_id])
         fmt, head = fmt + ["%d"], head + ",grain_id"
-    np.savetxt(path, data, delimiter=",", header=head, comments="", fmt=fmt)
+    path = Path(path)
+    path.parent.mkdir(parents=True, exist_ok=True)
+    tmp = path.with_name(path.name + ".tmp")
+    try:
+        np.savetxt(tmp, data, delimiter=",", header=head, comments="", fmt=fmt)
+        os.replace(tmp, path)
+    finally:                                   # a failed write leaves no .tmp behind
+        tmp.unlink(missing_ok=True)
+    if summary is not None:
+        write_summary(path, summary)
+
+
+def summary_path(csv_path) -> Path:
+    """The JSON companion of a packing file: the same path with suffix ``.json``."""
+    return Path(csv_path).with_suffix(".json")
+
+
+def write_summary(csv_path, summary: dict) -> None:
+    """Write (replace) the JSON summary beside a packing file, atomically (NumPy scalars and
+    arrays written as numbers and lists)."""
+    jp = summary_path(csv_path)
+    tmp = jp.with_name(jp.name + ".tmp")
+    try:
+        tmp.write_text(json.dumps(summary, indent=1, default=_json_default))
+        os.replace(tmp, jp)
+    finally:
+        tmp.unlink(missing_ok=True)
+
+
+def read_summary(path) -> dict | None:
+    """The JSON summary beside packing file ``path`` (:func:`summary_path`), None when there is
+    none; ValueError naming it when it is not readable JSON."""
+    jp = summary_path(path)
+    if not jp.exists():
+        return None
+    try:
+        return json.loads(jp.read_text(encoding="utf-8-sig"))
+    except (ValueError, UnicodeDecodeError) as e:
+        raise ValueError(f"{jp}: the packing's JSON summary is not readable JSON ({e})") from e
+
+
+def _json_default(o):
+    if isinstance(o, np.generic):
+        return o.item()
+    if isinstance(o, np.ndarray):
+        return o.tolist()
+    raise TypeError(f"not JSON serialisable: {type(o).__name__}")

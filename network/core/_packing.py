@@ -11,9 +11,8 @@ import dataclasses
 import functools
 
 import numpy as np
-import scipy.sparse as sp
 
-from .._deferred import csgraph, spatial
+from .._deferred import csgraph, sparse, spatial
 
 __all__ = ["MIN_SPHERES", "PLAUSIBLE_DIAMETER_M", "DegeneratePackingError", "Packing",
            "check_grains", "check_three_dimensional", "grain_volumes", "scale_warning",
@@ -67,6 +66,30 @@ class Packing:
             g = g.astype(np.int64)
             g.setflags(write=False)
             object.__setattr__(self, "grain_id", g)
+
+    def scaled(self, factor: float, source: str | None = None) -> "Packing":
+        """This packing with every length times ``factor`` (a unit change), every other column
+        (``grain_id``) kept; ``source`` replaces the description when given.
+
+        >>> p = Packing(np.eye(3), [1, 1, 1], grain_id=[4, 5, 6]).scaled(0.01)
+        >>> p.radii.tolist(), p.grain_id.tolist()
+        ([0.01, 0.01, 0.01], [4, 5, 6])
+        """
+        return dataclasses.replace(self, centers=self.centers * factor,
+                                   radii=self.radii * factor,
+                                   source=self.source if source is None else source)
+
+    def shifted(self, offset) -> "Packing":
+        """This packing moved by ``offset`` (3,) (its unit), every other column kept."""
+        return dataclasses.replace(self, centers=self.centers + np.asarray(offset, float))
+
+    def subset(self, members, source: str | None = None) -> "Packing":
+        """The spheres ``members`` (a bool mask or indices) of this packing, every column kept
+        (a grain keeps its id; a grain cut by the subset keeps the spheres selected)."""
+        return dataclasses.replace(
+            self, centers=self.centers[members], radii=self.radii[members],
+            grain_id=None if self.grain_id is None else self.grain_id[members],
+            source=self.source if source is None else source)
 
     @functools.cached_property
     def n_grains(self) -> int:
@@ -158,15 +181,16 @@ class Packing:
         return float(np.sum(d**3) / np.sum(d**2))
 
 
-def validate_spheres(centers, radii, lines, source, *, check_duplicates=True):
-    """Check finite values, positive radii, distinct centres and enough spheres.
+def validate_spheres(centers, radii, lines, source, *, check_duplicates=True,
+                     min_spheres: int = MIN_SPHERES):
+    """Check finite values, positive radii, distinct centres and at least ``min_spheres``.
 
     ``lines[i]`` is the row sphere i came from, counted as a spreadsheet does: the file line
     (header = row 1) of a text file, the 1-based array index of a .npz.
     """
     n = len(radii)
-    if n < MIN_SPHERES:
-        raise ValueError(f"{source}: too few spheres ({n}); a packing needs at least {MIN_SPHERES}")
+    if n < min_spheres:
+        raise ValueError(f"{source}: too few spheres ({n}); a packing needs at least {min_spheres}")
     bad = ~np.isfinite(centers).all(axis=1) | ~np.isfinite(radii)
     if bad.any():
         i = int(np.flatnonzero(bad)[0])
@@ -238,7 +262,7 @@ def check_grains(centers, radii, grain_id, lines, source) -> None:
     else:
         i = j = np.zeros(0, dtype=np.int64)
     n = r.size
-    adj = sp.coo_array((np.ones(i.size), (i, j)), shape=(n, n))
+    adj = sparse.coo_array((np.ones(i.size), (i, j)), shape=(n, n))
     _, comp = csgraph.connected_components(adj, directed=False)
     pairs_gc = np.unique(np.column_stack([g, comp]), axis=0)
     ids, counts = np.unique(pairs_gc[:, 0], return_counts=True)
