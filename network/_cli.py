@@ -177,12 +177,18 @@ def check_common(args) -> None:
 
 def load_packing(args):
     """(path, packing in metres) of ``args.packing`` (bundled scene if None) in ``args.units``;
-    the scale warning, if any, as one stderr line. A companion JSON whose container is of an
+    the scale warning, if any, as one stderr line. A ``--depth`` thinner than the largest
+    sphere is refused (ValueError). A companion JSON whose container is of an
     unknown kind or malformed is refused here, before any work (:func:`read_container`)."""
     path = Path(args.packing) if args.packing else default_packing_path()
     packing = read_packing(path, units=args.units)
     check_three_dimensional(packing.centers, str(path))
     read_container(path)
+    depth = getattr(args, "depth", None)
+    if isinstance(depth, float) and packing.n and depth < 2.0 * float(packing.radii.max()):
+        raise ValueError(f"--depth {depth:g} m is thinner than one grain of {path} (its largest "
+                         f"sphere alone is {2e3 * float(packing.radii.max()):.3g} mm across): "
+                         "give the bed depth in metres")
     keep_heap(packing.n)
     msg = scale_warning(packing)
     if msg:

@@ -20,10 +20,20 @@ constants were not found has ``a = b = None`` and a note. Grain names are those 
 
 from __future__ import annotations
 
+import json
+import logging
 from dataclasses import dataclass
+from pathlib import Path
 
-__all__ = ["D272Constants", "D272", "GRAIN_ALIASES", "d272_constants", "grains_with_d272",
+__all__ = ["D272Constants", "D272", "GRAIN_ALIASES", "HUKILL_IVES_RANGE_M_S", "d272_constants",
+           "d272_velocity_range", "grain_key", "packing_grain", "template_grain",
+           "grains_with_d272",
            "BedProperties", "BED"]
+
+
+log = logging.getLogger(__name__)
+#: the bundled packings, ``<grain>_default.csv`` (spheres) and ``<grain>_grains.csv``
+_DATA_DIR = Path(__file__).resolve().parent / "data"
 
 
 @dataclass(frozen=True)
@@ -108,9 +118,44 @@ GRAIN_ALIASES = {"soybeans": "soybean", "corn": "shelled_corn", "maize": "shelle
                  "milo": "sorghum"}
 
 
+#: The velocity range, m/s, over which the Hukill-Ives form of D272 is stated to hold: "a
+#: larger range of velocities (0.01-2.0 m s-1)" (thesis section 2.3.2, on Hukill & Ives 1955).
+#: The standard's own per-grain ranges are not in any source here (``velocity_range_m_s`` of
+#: every grain is None), so this range bounds where a D272 curve is drawn.
+HUKILL_IVES_RANGE_M_S = (0.01, 2.0)
+
+
+def d272_velocity_range(name: str) -> tuple[tuple[float, float], str]:
+    """((low, high) m/s, where it comes from) over which a grain's D272 curve is drawn: the
+    grain's own range where a source gives one, else :data:`HUKILL_IVES_RANGE_M_S`.
+
+    >>> d272_velocity_range("wheat")[0]
+    (0.01, 2.0)
+    """
+    c = D272[grain_key(name)]
+    if c.velocity_range_m_s is not None:
+        return tuple(c.velocity_range_m_s), f"{c.edition}'s range for {grain_key(name)}"
+    return HUKILL_IVES_RANGE_M_S, ("the Hukill-Ives form's stated range (thesis 2.3.2); the "
+                                   "standard's own range for this grain is not sourced here")
+
+
 def grains_with_d272() -> list[str]:
     """The grains whose D272 constants have a source here."""
     return [k for k, v in D272.items() if v.a_pa_s2_m3 is not None]
+
+
+def grain_key(name: str) -> str:
+    """Library name of a grain: any case, spaces or hyphens for underscores, aliases
+    (:data:`GRAIN_ALIASES`) accepted; ValueError listing the known grains.
+
+    >>> grain_key("Shelled corn"), grain_key("soybeans"), grain_key(" rough-rice ")
+    ('shelled_corn', 'soybean', 'rough_rice')
+    """
+    text = "_".join(str(name).strip().lower().replace("-", " ").split())
+    key = GRAIN_ALIASES.get(text, text)
+    if key not in D272:
+        raise ValueError(f"unknown grain {name!r}; known grains: {', '.join(D272)}")
+    return key
 
 
 def d272_constants(name: str) -> tuple[float, float]:
@@ -122,10 +167,11 @@ def d272_constants(name: str) -> tuple[float, float]:
     >>> d272_constants("soybeans")
     (10200.0, 16.0)
     """
-    key = GRAIN_ALIASES.get(str(name).lower(), str(name).lower())
-    if key not in D272:
+    try:
+        key = grain_key(name)
+    except ValueError:
         raise ValueError(f"unknown grain {name!r}; known grains: {', '.join(D272)} (with D272 "
-                         f"constants: {', '.join(grains_with_d272())})")
+                         f"constants: {', '.join(grains_with_d272())})") from None
     c = D272[key]
     if c.a_pa_s2_m3 is None:
         raise ValueError(f"no sourced ASABE D272 constants for {key} (docs/grain-library.md); "
@@ -182,3 +228,54 @@ BED: dict[str, BedProperties] = {
     "canola": BedProperties(None, _NONE, None, _NONE),
     "sorghum": BedProperties(1257.33, _SORGHUM, (0.3515, 0.3675), _SORGHUM),
 }
+
+
+def template_grain(path) -> tuple[str | None, str | None]:
+    """(grain, record) of the packing at ``path``: ``record`` is the ``template`` its companion
+    JSON (same stem, ``.json``) names, None when there is none; ``grain`` is that record as a
+    grain of the library (:func:`network._grains.grain_key`), else the grain a bundled bed is
+    of (``network/data/<grain>_default.csv``, ``<grain>_grains.csv``), else None."""
+    path = Path(path)
+    record = None
+    try:
+        meta = json.loads(path.with_suffix(".json").read_text())
+    except (OSError, ValueError):
+        meta = None
+    if isinstance(meta, dict) and isinstance(meta.get("template"), str):
+        record = meta["template"]
+        try:
+            return grain_key(record), record
+        except ValueError:
+            return None, record
+    data = _DATA_DIR.resolve()
+    stem = path.resolve().stem
+    for tail in ("_default", "_grains"):
+        if path.resolve().parent == data and stem.endswith(tail) and stem[:-len(tail)] in D272:
+            return stem[: -len(tail)], None
+    return None, None
+
+
+def packing_grain(path, given=None, *, default=None, option: str = "--grain") -> str | None:
+    """The grain a packing is of, for the comparisons with D272 and the grain's data.
+
+    ``given`` (the ``--grain`` option, None when not given) must agree with the bed's own
+    grain (:func:`template_grain`): ValueError naming both when it does not. A bed without a
+    template record is taken to be ``given`` (or ``default``) with one logged warning (a
+    command's ``warning:`` line); with
+    neither, None (the grain is unknown: no D272 line).
+    """
+    own, record = template_grain(path)
+    key = None if given is None else grain_key(given)
+    if key is not None and own is not None and key != own:
+        raise ValueError(f"{option} {given}: {path} is a bed of {own} (its companion JSON's "
+                         f"grain template); give {option} {own}, or a packing of {key}")
+    if own is not None:
+        return own
+    key = key if key is not None else default
+    if key is not None:
+        what = (f"names the template {record!r}, not a grain of the library" if record
+                else "has no grain template record")
+        src = f"as {option} says" if given is not None else f"the default {option}"
+        log.warning("%s %s: taken to be %s (%s); its D272 line and grain data are %s's", path,
+                    what, key, src, key)
+    return key

@@ -27,10 +27,10 @@ from ._cli import (CliError, CliParser, add_air, add_packing, add_sample, add_ta
                    finish, load_packing, packing_inputs, progress_log, run, sample_box_m, warn,
                    warn_curve)
 from .conductance import POLICIES
-from ._grains import GRAIN_ALIASES, d272_constants
+from ._grains import d272_constants, d272_velocity_range, grains_with_d272, packing_grain
 from .flow import (DEFAULT_DEPTH_M, GRAINS, asabe_d272_gradient, ergun_gradient,
                    solve_network)
-from .packing import read_container
+from .packing import default_packing_path, read_container
 from .pores import sample_region
 
 #: Default: 12 velocities spaced logarithmically over aeration and drying, m/s.
@@ -91,9 +91,12 @@ def build_parser() -> CliParser:
                          "(n log-spaced points)")
     ap.add_argument("--depth", type=float, default=DEFAULT_DEPTH_M,
                     help="bed depth, m, > 0 (reported; the gradient does not depend on it)")
-    ap.add_argument("--grain", default="soybeans",
-                    help=f"D272 line to compare with (grains with sourced constants: "
-                         f"{', '.join(GRAINS)})")
+    ap.add_argument("--grain", default=None,
+                    help=f"the crop the bed is of, for the D272 line of --plot (grains with "
+                         f"sourced constants: {', '.join(GRAINS)}); default: the grain "
+                         "template its companion JSON names (the bundled scene: soybean); a bed "
+                         "of unknown grain gets no D272 line. A --grain that contradicts the "
+                         "JSON is refused")
     ap.add_argument("--policy", default="table-only", choices=POLICIES,
                     help="Q* source (see python -m network.solve --help)")
     add_table(ap)
@@ -124,14 +127,19 @@ def plot_curve(path, points, *, grain, porosity, diameter_m, viscosity_pa_s, den
     uu = np.geomspace(u.min() / 1.5, u.max() * 1.5, 100)
     fig, ax = plt.subplots(figsize=(5.5, 4.2))
     ax.loglog(u, gr, "o-", label="network (inertial)")
-    a, b = d272_constants(grain)
-    ax.loglog(uu, [asabe_d272_gradient(v, a=a, b=b) for v in uu], "--", label=f"ASABE D272 {grain}")
+    if grain in grains_with_d272():       # only over the velocities D272 is stated for
+        a, b = d272_constants(grain)
+        (lo, hi), _ = d272_velocity_range(grain)
+        ud = uu[(uu >= lo) & (uu <= hi)]
+        if ud.size:
+            ax.loglog(ud, [asabe_d272_gradient(v, a=a, b=b) for v in ud], "--",
+                      label=f"ASABE D272 {grain} ({lo:g}-{hi:g} m/s)")
     if 0 < porosity < 1:
         ax.loglog(uu, [ergun_gradient(v, porosity=porosity, diameter_m=diameter_m,
                                       viscosity_pa_s=viscosity_pa_s,
                                       density_kg_m3=density_kg_m3) for v in uu], ":",
                   label="Ergun")
-    if GRAIN_ALIASES.get(grain, grain) == "soybean":
+    if grain == "soybean":
         tu, tg = zip(*THESIS_POINTS)
         ax.loglog(tu, tg, "ks", label="thesis measured")
     ax.set_xlabel("airflow U (m/s)")
@@ -145,7 +153,8 @@ def plot_curve(path, points, *, grain, porosity, diameter_m, viscosity_pa_s, den
 
 def _check_options(args) -> list[float]:
     check_common(args)
-    d272_constants(args.grain)          # an unknown or unsourced grain: ValueError naming them
+    if args.grain is not None:
+        d272_constants(args.grain)      # an unknown or unsourced grain: ValueError naming them
     check_outputs(json=args.json_out, csv=args.csv_out, plot=args.plot,
                   inputs=packing_inputs(args))
     if args.plot:
@@ -162,7 +171,7 @@ def _warn_fits(n_distinct: int, what: str) -> None:
              f"distinct velocities; {what} {n_distinct}: they are reported as None")
 
 
-def _write_outputs(args, out, pts, ok, res) -> None:
+def _write_outputs(args, out, pts, ok, res, grain) -> None:
     """--json, --csv and --plot (paths checked before the solve)."""
     if args.json_out:
         with open(args.json_out, "w") as f:
@@ -176,7 +185,7 @@ def _write_outputs(args, out, pts, ok, res) -> None:
                 w.writerow({k: p[k] for k in KEYS})
         print(f"wrote {args.csv_out}")
     if args.plot and ok:
-        plot_curve(args.plot, ok, grain=args.grain, porosity=res.porosity,
+        plot_curve(args.plot, ok, grain=grain, porosity=res.porosity,
                    diameter_m=res.sauter_diameter_m, viscosity_pa_s=args.viscosity,
                    density_kg_m3=args.density)
         print(f"wrote {args.plot}")
@@ -192,6 +201,7 @@ def _main(args) -> int:
     t0 = time.perf_counter()
     with bad_input():
         us = _check_options(args)
+        grain = packing_grain(args.packing or default_packing_path(), args.grain)
         path, packing = load_packing(args)
         box, margin = sample_box_m(args)
         container = None if box else read_container(path)
@@ -228,7 +238,7 @@ def _main(args) -> int:
     total = time.perf_counter() - t0
     print(f"total {total:.2f} s")
     out = {"packing": str(path), "units": args.units, "n_spheres": packing.n, "axis": args.axis,
-           "grain": args.grain, "workers": args.workers, "density_kg_m3": args.density,
+           "grain": grain, "workers": args.workers, "density_kg_m3": args.density,
            "inertial_law": args.inertial_law,
            "viscosity_pa_s": args.viscosity,
            "porosity": res.porosity, "sauter_diameter_m": res.sauter_diameter_m,
@@ -236,7 +246,7 @@ def _main(args) -> int:
            "fits_note": FITS_NOTE,
            "seconds": dict(res.timings_s, wall=total)}
     with computing():
-        _write_outputs(args, out, pts, ok, res)
+        _write_outputs(args, out, pts, ok, res, grain)
     bad = [p["velocity_m_s"] for p in pts if not p["converged"]]
     if bad:
         raise CliError(f"the nonlinear solve did not converge at U = {bad} m/s (marked "

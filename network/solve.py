@@ -15,6 +15,7 @@ done, 1 the computation failed, 2 bad input: one ``error:`` line (docs/cli.md).
 
 from __future__ import annotations
 
+import dataclasses
 import json
 import sys
 import time
@@ -24,12 +25,13 @@ import numpy as np
 
 from ._cli import (CliError, CliParser, add_air, add_packing, add_sample, add_table,
                    available_cores, bad_input, check_common, check_output_list, computing,
-                   finish, load_packing, packing_inputs, progress_log, run, sample_box_m,
-                   warn_validity)
+                   finish, load_packing, packing_inputs, progress_log, run,
+                   sample_box_m, warn_validity)
+from ._grains import D272, grain_key, packing_grain
 from .conductance import MODELS, POLICIES, throat_qstar
 from .flow import (DEFAULT_DEPTH_M, DEFAULT_VELOCITY_M_S, combined_summary, solve_axes,
                    write_network_vtu)
-from .packing import read_container
+from .packing import default_packing_path, read_container
 from .pores import sample_region, tessellate
 
 # Thesis section 4.2.3 and Table 4.5: pressure drop over 0.25 m at 0.013 m/s (Pa)
@@ -88,6 +90,12 @@ def build_parser() -> CliParser:
                          "area of the throat triangle; Q* of its window in mean-radius units; "
                          "flow > 0 from pore1 to pore2, Stokes field); suffixed with --axis "
                          "all (default: not written)")
+    ap.add_argument("--grain", default=None,
+                    help="the crop the bed is of, for the ASABE D272 line (any case, spaces "
+                         f"or underscores: {', '.join(D272)}); default: the grain template its "
+                         "companion JSON names (the bundled scene: soybean); a bed of unknown "
+                         "grain gets no D272 line. A --grain that contradicts the JSON is "
+                         "refused")
     ap.add_argument("--quiet", "-q", action="store_true", help="no stage progress on stderr")
     return ap
 
@@ -97,9 +105,21 @@ def _per_axis(base, axis: str, multi: bool, suffix: str) -> Path:
     return p.with_name(f"{p.stem}_{axis}{p.suffix or suffix}") if multi else p
 
 
+def _empirical_line(s: dict, grain) -> str:
+    """Ergun, Kozeny-Carman and the grain's D272 drop (or why there is none)."""
+    c = s["comparisons"]
+    text = (f"    Ergun {c['ergun']['pressure_drop_pa']:.4g} Pa, Kozeny-Carman "
+            f"{c['kozeny_carman']['pressure_drop_pa']:.4g} Pa, ")
+    if c.get("asabe_d272") is not None:
+        name = "soybeans" if grain == "soybean" else grain.replace("_", " ")
+        return text + f"ASABE D272 ({name}) {c['asabe_d272']['pressure_drop_pa']:.4g} Pa"
+    if grain is None:
+        return text + "no ASABE D272 line: the bed's grain is unknown (give --grain)"
+    return text + f"no ASABE D272 line: no sourced constants for {grain}"
+
+
 def _print_result(res, out):
     s = res.summary()
-    c = s["comparisons"]
     print(f"axis {res.axis}: {s['n_pores']} pores, {s['n_throats']} throats "
           f"({s['n_inlet_pores']} inlet, {s['n_outlet_pores']} outlet, "
           f"{s['n_dropped_pores']} disconnected dropped)", file=out)
@@ -121,9 +141,7 @@ def _print_result(res, out):
               f"{s['pressure_gradient_stokes_pa_per_m']:.4g} Pa/m, "
               f"{s['pressure_drop_stokes_pa']:.4g} Pa; "
               f"{s['inertial_solver']['newton_iterations']} Newton iterations)", file=out)
-    print(f"    Ergun {c['ergun']['pressure_drop_pa']:.4g} Pa, Kozeny-Carman "
-          f"{c['kozeny_carman']['pressure_drop_pa']:.4g} Pa, ASABE D272 (soybeans) "
-          f"{c['asabe_d272']['pressure_drop_pa']:.4g} Pa", file=out)
+    print(_empirical_line(s, res.grain), file=out)
     src = s.get("qstar", {}).get("sources")
     if src:
         print("  Q* sources: " + ", ".join(f"{k} {v}" for k, v in src.items())
@@ -139,6 +157,8 @@ def _print_result(res, out):
 def _check_inputs(args, axes) -> None:
     """Every option and output path, before any work (ValueError names the option)."""
     check_common(args)
+    if args.grain is not None:
+        grain_key(args.grain)
     if args.vtk and Path(args.vtk).suffix.lower() not in ("", ".vtu"):
         raise ValueError(f"--vtk {args.vtk}: the writer makes VTK XML (.vtu, read by ParaView "
                          f"and meshio), not legacy VTK; name the file "
@@ -217,6 +237,7 @@ def _main(args) -> int:
     axes = ["x", "y", "z"] if args.axis == "all" else [args.axis]
     with bad_input():
         _check_inputs(args, axes)
+        grain = packing_grain(args.packing or default_packing_path(), args.grain)
         path, packing = load_packing(args)
         box, margin = sample_box_m(args)
         container = None if box else read_container(path)
@@ -235,6 +256,7 @@ def _main(args) -> int:
             inertia=not args.stokes and args.conductance_model == "conduit",
             density_kg_m3=args.density, inertial_law=args.inertial_law, tessellation=tess,
             threads=args.threads)
+        results = [dataclasses.replace(r, grain=grain) for r in results]
         written = [p for res in results for p in (_write_tables(res, tess, args, len(axes) > 1)
                                                   if tables else [])]
     for p in written:
@@ -248,7 +270,9 @@ def _main(args) -> int:
     out["packing"] = str(path)
     out["units"] = args.units
     out["n_spheres"] = packing.n
-    out["thesis_lsv_reference_pa"] = THESIS_LSV
+    out["grain"] = grain
+    if grain == "soybean":
+        out["thesis_lsv_reference_pa"] = THESIS_LSV
     if len(results) > 1:
         k = out["by_axis"]
         print("anisotropy: k_x : k_y : k_z = " + " : ".join(
@@ -262,7 +286,7 @@ def _main(args) -> int:
     if out.get("orientation_order") is not None:
         print(f"grains: {packing.n_grains}, long-axis order S against the vertical "
               f"{out['orientation_order']:.3f} (1 vertical, -0.5 horizontal, 0 random)")
-    if np.isclose(args.velocity, 0.013) and np.isclose(args.depth, 0.25):
+    if grain == "soybean" and np.isclose(args.velocity, 0.013) and np.isclose(args.depth, 0.25):
         t = THESIS_LSV
         print(f"thesis (soybeans, 0.25 m at 0.013 m/s; section 4.2.3, Table 4.5): measured "
               f"{t['measured']} ± {t['measured_sd']} Pa, ASABE {t['asabe_d272']} Pa, thesis network "

@@ -196,7 +196,7 @@ def test_the_command_reports_pressure_uniformity_and_the_check(tmp_path, capsys)
       "--pressure", "100"], "outside the floor"),
     (["--diameter", "8", "--depth", "5", "--floor", "duct", "--duct", "0.6", "9", "0",
       "--pressure", "100"], "longer than the bin"),
-    (["--diameter", "8", "--depth", "5", "--airflow", "0.1", "cfm/bu"], "--airflow unit"),
+    (["--diameter", "8", "--depth", "5", "--airflow", "0.1", "cfs"], "--airflow unit"),
 ])
 def test_bad_input_is_one_error_line_and_exit_2(argv, words, capsys, tmp_path):
     code = main(argv + ["--no-figure", "-q"])

@@ -368,3 +368,44 @@ def test_report_options_are_keyword_only_frozen_and_checked():
             ReportOptions(**{"grain": "wheat", **kw})
     with pytest.raises(ValueError, match="no sourced kernel density for canola"):
         ReportOptions(grain="canola")
+
+
+def test_airflow_units_any_case_per_m3_and_cfm_per_bushel(tmp_path, monkeypatch, capsys):
+    """--airflow takes M/S, m3/min/m3 (U = q H / 60) and cfm/bu (1 ft^3/min per US bushel of
+    0.03523907 m^3 = 0.3048^3 / 0.03523907 = 0.8035640 m^3/(min m^3)); an unknown unit names
+    the accepted ones. The command gets past the unit to the next check (--fan without a bin)."""
+    from network.report.system import M3_MIN_M3_PER_CFM_BU, airflow_unit
+    assert airflow_unit("M/S") == "m/s" and airflow_unit("M3/MIN/M3") == "m3/min/m3"
+    assert M3_MIN_M3_PER_CFM_BU == pytest.approx(0.028316846592 / 0.03523907, rel=1e-12)
+    assert velocity_from_airflow(1.2, "m3/min/m3", depth_m=2.5, bulk_density_kg_m3=700.0) \
+        == pytest.approx(1.2 * 2.5 / 60.0, rel=1e-12)
+    u = velocity_from_airflow(0.1, "CFM/bu", depth_m=3.0, bulk_density_kg_m3=700.0)
+    assert u == pytest.approx(0.1 * 0.8035639587537 * 3.0 / 60.0, rel=1e-12)
+    # the round trip through the report's per-m^3 column: 60 U / H
+    (row,) = system_rows([u], [10.0], depth_m=3.0, area_m2=2.0, bulk_density_kg_m3=700.0)
+    assert row["airflow_m3_min_m3"] == pytest.approx(0.1 * M3_MIN_M3_PER_CFM_BU, rel=1e-12)
+    monkeypatch.chdir(tmp_path)
+    for unit in ("M/S", "m3/min/m3", "cfm/bu"):
+        assert main(["--airflow", "0.1", unit, "--fan", "fan.csv", "-q"]) == 2
+        assert "--fan needs the bin" in capsys.readouterr().err
+    assert main(["--airflow", "0.1", "cfs", "-q"]) == 2
+    assert "--airflow unit 'cfs': use one of m/s, m3/min/t, m3/min/m3, cfm/bu" \
+        in capsys.readouterr().err
+    assert list(tmp_path.iterdir()) == []
+
+
+@pytest.mark.slow
+def test_no_band_run_removes_the_earlier_band_figure(tmp_path, capsys):
+    """A --no-band run into a folder with an earlier run's report_band.png removes that file
+    (the report names it) and nothing else; the curve figure draws D272 only over its stated
+    0.01-2 m/s, which the printed report says."""
+    (tmp_path / "report_band.png").write_bytes(b"old")
+    (tmp_path / "notes.txt").write_text("mine")
+    assert main(["--grain", "soybean", "--velocities", "0.005,0.05", "--no-band", "--plot-dir",
+                 str(tmp_path), "-q"]) == 0
+    out = capsys.readouterr().out
+    assert sorted(p.name for p in tmp_path.iterdir()) == [
+        "notes.txt", "report_curve.png", "report_system.png"]
+    assert (tmp_path / "notes.txt").read_text() == "mine"
+    assert f"removed {tmp_path / 'report_band.png'}" in out
+    assert "D272 holds for 0.01-2 m/s (the Hukill-Ives form's stated range" in out

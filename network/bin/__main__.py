@@ -25,8 +25,8 @@ import numpy as np
 
 from .._cli import (CliError, CliParser, add_air, bad_input, check_common, check_outputs,
                     check_plot, computing, finish, progress_log, run)
-from .._grains import BED, D272, GRAIN_ALIASES
-from ..report.system import AIRFLOW_UNITS, read_fan
+from .._grains import BED, D272, grain_key
+from ..report.system import AIRFLOW_UNITS, M3_MIN_M3_PER_CFM_BU, airflow_unit, read_fan
 from ._geometry import BinGeometry, Duct, default_size, mesh_bin
 from ._material import (ANGLE_OF_REPOSE, d272_material, network_material, read_profile)
 from ._outputs import aeration, write_figure, write_vtk
@@ -123,9 +123,11 @@ def _positive(name, v, upper=None):
 def _check(args) -> dict:
     """Every option checked before any mesh or solve."""
     check_common(args)
-    key = GRAIN_ALIASES.get(args.grain.lower(), args.grain.lower())
-    if key not in D272:
-        raise ValueError(f"--grain {args.grain!r}: unknown; known grains: {', '.join(D272)}")
+    try:
+        key = grain_key(args.grain)
+    except ValueError:
+        raise ValueError(f"--grain {args.grain!r}: unknown; known grains: "
+                         f"{', '.join(D272)}") from None
     for name in ("pressure", "particle_density", "wall_friction", "mesh_size",
                  "grain_heat_capacity"):
         _positive(name.replace("_", "-"), getattr(args, name))
@@ -164,8 +166,7 @@ def _check(args) -> dict:
     airflow = None
     if args.airflow is not None:
         value, unit = args.airflow
-        if unit not in AIRFLOW_UNITS:
-            raise ValueError(f"--airflow unit {unit!r}: use one of {', '.join(AIRFLOW_UNITS)}")
+        unit = airflow_unit(unit)
         try:
             airflow = (float(value), unit)
         except ValueError:
@@ -235,7 +236,9 @@ def build(args, opts) -> dict:
         curve = system_curve(prob, args.pressure * np.geomspace(0.25, 2.0, n), start=sol)
     elif opts["airflow"] is not None:
         v, unit = opts["airflow"]
-        q = v * mass_t / 60.0 if unit == "m3/min/t" else v * floor
+        q = {"m3/min/t": v * mass_t / 60.0, "m3/min/m3": v * geom.grain_volume_m3 / 60.0,
+             "cfm/bu": v * M3_MIN_M3_PER_CFM_BU * geom.grain_volume_m3 / 60.0,
+             "m/s": v * floor}[unit]
         eps0 = float(np.sum(prob.porosity * prob.volumes) / np.sum(prob.volumes))
         guess = float(material.gradient_1d(q / floor, eps0)[0]) * geom.grain_volume_m3 / floor
         sol = pressure_for_airflow(prob, q, guess)

@@ -7,6 +7,7 @@ import dataclasses
 import numpy as np
 
 from .._air import RHO_AIR_KG_M3
+from .._grains import D272
 from ._empirical import asabe_d272_gradient, ergun_gradient, kozeny_carman_gradient
 from ._fits import fit_curve
 
@@ -74,6 +75,9 @@ class FlowResult:
     #: ``inertia=True``): ``density_kg_m3``, ``velocities_m_s`` (the first is
     #: ``velocity_m_s``) and their :class:`network.flow.InertialPoint` ``points``.
     inertial: dict | None = dataclasses.field(default=None, repr=False)
+    #: The grain the bed is of (a key of :data:`network._grains.D272`), for the D272
+    #: comparison; None: unknown, no D272 line.
+    grain: str | None = None
 
     def reynolds_particle(self, velocity_m_s: float, density_kg_m3: float) -> float:
         """Re_p = ρ U d32 / μ (DESIGN.md), dimensionless."""
@@ -123,7 +127,9 @@ class FlowResult:
         return self.pressure_gradient_pa_per_m * self.depth_m
 
     def comparisons(self) -> dict:
-        """Empirical pressure gradients (Pa/m) and drops over ``depth_m`` (Pa) at the same v."""
+        """Empirical pressure gradients (Pa/m) and drops over ``depth_m`` (Pa) at the same v:
+        Ergun, Kozeny-Carman and, where ``grain`` has sourced constants, ASABE D272 (else
+        ``asabe_d272`` is None)."""
         v, e, d = self.velocity_m_s, self.porosity, self.sauter_diameter_m
         out = {}
         for name, grad in (
@@ -131,10 +137,15 @@ class FlowResult:
                                      density_kg_m3=RHO_AIR_KG_M3)),
             ("kozeny_carman", kozeny_carman_gradient(v, porosity=e, diameter_m=d,
                                                      viscosity_pa_s=self.viscosity_pa_s)),
-            ("asabe_d272", asabe_d272_gradient(v)),
         ):
             out[name] = {"pressure_gradient_pa_per_m": float(grad),
                          "pressure_drop_pa": float(grad * self.depth_m)}
+        c = D272.get(self.grain) if self.grain is not None else None
+        out["asabe_d272"] = None
+        if c is not None and c.a_pa_s2_m3 is not None:
+            grad = asabe_d272_gradient(v, a=c.a_pa_s2_m3, b=c.b_s_m)
+            out["asabe_d272"] = {"grain": self.grain, "pressure_gradient_pa_per_m": float(grad),
+                                 "pressure_drop_pa": float(grad * self.depth_m)}
         return out
 
     def summary(self) -> dict:

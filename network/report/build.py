@@ -13,7 +13,7 @@ import time
 import numpy as np
 
 from .._cli import available_cores
-from .._grains import D272
+from .._grains import D272, d272_velocity_range
 from ..flow import asabe_d272_gradient, ergun_gradient, fit_curve, solve_network
 from ..packing import read_container
 from ..pores import region_porosity, sample_region
@@ -111,6 +111,7 @@ def build_report(packing, path, options: ReportOptions) -> dict:
                          viscosity_pa_s=o.viscosity_pa_s,
                          density_kg_m3=o.density_kg_m3, inertial_law=o.inertial_law)
     c = D272[o.grain]
+    d272_range, d272_range_source = d272_velocity_range(o.grain)
     for p, px in zip(pts, pts_x):
         u = p["velocity_m_s"]
         f, sig = 1.0, 0.0
@@ -157,7 +158,8 @@ def build_report(packing, path, options: ReportOptions) -> dict:
            "particle_density_source": o.particle_density_source,
            "bulk_density_kg_m3": rho_b,
            "d272": {"a_pa_s2_m3": c.a_pa_s2_m3, "b_s_m": c.b_s_m, "source": c.source,
-                    "note": c.note},
+                    "note": c.note, "velocity_range_m_s": list(d272_range),
+                    "velocity_range_source": d272_range_source},
            "permeability_stokes_m2": {"z": rz.permeability_m2, "x": rx.permeability_m2},
            "horizontal_to_vertical_stokes": rz.permeability_m2 / rx.permeability_m2,
            "permeability_stokes_note": "as solved, at the packing's own porosity",

@@ -17,7 +17,7 @@ import numpy as np
 from .._cli import (CliError, CliParser, add_air, add_sample, bad_input, check_common,
                     check_outputs, check_plot, computing, load_packing, packing_inputs,
                     progress_log, run, sample_box_m, warn_curve)
-from .._grains import BED, D272, grains_with_d272
+from .._grains import BED, D272, grains_with_d272, packing_grain
 from ..curve import DEFAULT_VELOCITIES, parse_velocities
 from ..flow import DEFAULT_DEPTH_M
 from ..packing import UNITS
@@ -28,7 +28,7 @@ from .figures import write_figures, write_html
 from .options import ReportOptions, grain_key
 from .porosity import (bundled_grains, bundled_packing, check_reachable, packing_meta,
                        reachable_range, requested_porosity)
-from .system import AIRFLOW_UNITS, read_fan
+from .system import AIRFLOW_UNITS, airflow_unit, read_fan
 
 __all__ = ["build_parser", "main", "print_report", "report_options"]
 
@@ -39,9 +39,12 @@ def build_parser() -> CliParser:
                                "(vertical and horizontal) beside D272 and Ergun, porosity band, "
                                "system curve of a bin and a fan's operating point. Exit status "
                                "0 done, 1 a solve failed, 2 bad input.")
-    ap.add_argument("--grain", default="soybean",
-                    help=f"crop: {', '.join(D272)} (D272 constants sourced for "
-                         f"{', '.join(grains_with_d272())})")
+    ap.add_argument("--grain", default=None,
+                    help=f"crop: {', '.join(D272)} (any case, spaces or underscores; D272 "
+                         f"constants sourced for {', '.join(grains_with_d272())}); default: "
+                         "the grain template the --packing's companion JSON names, else "
+                         "soybean. A --grain that contradicts that JSON is refused; a packing "
+                         "without one is taken to be the --grain with a warning")
     ap.add_argument("--packing", default=None, metavar="FILE",
                     help="packing of that grain (any format the readers take), used as it is; "
                          f"default: the bundled one ({', '.join(bundled_grains())}), or a new "
@@ -74,7 +77,9 @@ def build_parser() -> CliParser:
     area.add_argument("--floor-area", type=float, default=None,
                       help="floor area, m^2 (default without --diameter: 1 m^2)")
     ap.add_argument("--airflow", nargs=2, default=None, metavar=("VALUE", "UNIT"),
-                    help=f"an airflow to report, UNIT one of {', '.join(AIRFLOW_UNITS)}")
+                    help=f"an airflow to report, UNIT one of {', '.join(AIRFLOW_UNITS)} (any "
+                         "case; per tonne, per m^3 of grain, and ft^3/min per US bushel, 1 "
+                         "cfm/bu = 0.8036 m^3/(min m^3))")
     ap.add_argument("--fan", default=None, metavar="FILE",
                     help="fan curve CSV airflow_m3_s,static_pressure_pa: operating point")
     add_bed_options(ap)
@@ -97,7 +102,10 @@ def build_parser() -> CliParser:
 def _check(args) -> dict:
     """Every option checked before any solve; returns the parsed pieces."""
     check_common(args)
-    key = grain_key(args.grain)
+    if args.packing is not None:
+        key = packing_grain(args.packing, args.grain, default="soybean")
+    else:
+        key = grain_key(args.grain or "soybean")
     for opt in ("particle_density", "diameter", "floor_area"):
         v = getattr(args, opt)
         if v is not None and not (np.isfinite(v) and v > 0):
@@ -135,8 +143,7 @@ def _check(args) -> dict:
     airflow = None
     if args.airflow is not None:
         value, unit = args.airflow
-        if unit not in AIRFLOW_UNITS:
-            raise ValueError(f"--airflow unit {unit!r}: use one of {', '.join(AIRFLOW_UNITS)}")
+        unit = airflow_unit(unit)
         try:
             airflow = (float(value), unit)
         except ValueError:
@@ -196,6 +203,11 @@ def print_report(r) -> None:
           f"{r['horizontal_to_vertical_stokes']:.3f})")
     if r["d272"]["a_pa_s2_m3"] is None:
         print(f"D272: no sourced constants for {r['grain']} (column '-')")
+    else:
+        lo, hi = r["d272"]["velocity_range_m_s"]
+        print(f"D272 holds for {lo:g}-{hi:g} m/s ({r['d272']['velocity_range_source']}); "
+              "the figure draws it only there, the column outside it is the formula "
+              "extrapolated")
     print(f"{'U m/s':>8} {'Re_p':>6} {'dP/L z':>10} {'dP/L x':>10} {'D272':>10} {'Ergun':>10} "
           f"{'e-0.02':>10} {'e-0.01':>10} {'e+0.01':>10} {'e+0.02':>10}   (Pa/m)")
     for p in r["points"]:
@@ -297,6 +309,8 @@ def _main(args) -> int:
         figs = write_figures(rep, plot_dir) if (args.html or plot_dir) else {}
         for name in figs.get("files", []):
             print(f"wrote {name}")
+        for name in figs.get("removed", []):
+            print(f"removed {name} (an earlier run's; this report draws none)")
         if args.html:
             write_html(args.html, rep, figs.get("png", {}))
             print(f"wrote {args.html}")

@@ -15,7 +15,10 @@ from pathlib import Path
 
 import numpy as np
 
-__all__ = ["write_figures", "write_html"]
+__all__ = ["FIGURES", "write_figures", "write_html"]
+
+#: the figures a report draws, ``report_<name>.png`` (the band's only with a band)
+FIGURES = ("curve", "system", "band")
 
 
 def _png(fig) -> bytes:
@@ -35,9 +38,13 @@ def _curve(plt, r):
     ax.loglog(u, [p["pressure_gradient_pa_per_m"] for p in pts], "o-", label="network vertical")
     ax.loglog(u, [p["pressure_gradient_horizontal_pa_per_m"] for p in pts], "s-",
               label="network horizontal", ms=4)
-    if pts and pts[0]["d272_pressure_gradient_pa_per_m"] is not None:
-        ax.loglog(u, [p["d272_pressure_gradient_pa_per_m"] for p in pts], "--",
-                  label=f"ASABE D272 {r['grain']}")
+    lo, hi = r["d272"].get("velocity_range_m_s") or (0.0, np.inf)
+    inside = [p for p in pts if lo <= p["velocity_m_s"] <= hi
+              and p["d272_pressure_gradient_pa_per_m"] is not None]
+    if inside:                  # D272 only over the velocities it is stated for
+        ax.loglog([p["velocity_m_s"] for p in inside],
+                  [p["d272_pressure_gradient_pa_per_m"] for p in inside], "--",
+                  label=f"ASABE D272 {r['grain']} ({lo:g}-{hi:g} m/s)")
     ax.loglog(u, [p["ergun_pressure_gradient_pa_per_m"] for p in pts], ":", label="Ergun")
     ax.set_xlabel("superficial velocity U (m/s)")
     ax.set_ylabel("pressure gradient (Pa/m)")
@@ -88,15 +95,22 @@ def _band(plt, r):
 
 
 def write_figures(r: dict, plot_dir=None) -> dict:
-    """PNG bytes of the report's figures, ``{"png": {name: bytes}, "files": [paths]}``; with
-    ``plot_dir`` also written there as ``report_<name>.png``."""
+    """PNG bytes of the report's figures, ``{"png": {name: bytes}, "files": [paths],
+    "removed": [paths]}``; with ``plot_dir`` also written there as ``report_<name>.png``, and a
+    ``report_<name>.png`` of :data:`FIGURES` this report does not draw (the band's, without a
+    band) removed from it, so the folder holds this run's figures only."""
     import matplotlib
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
     makers = {"curve": _curve, "system": _system}
     if r.get("band"):
         makers["band"] = _band
-    png, files = {}, []
+    png, files, removed = {}, [], []
+    for name in FIGURES:
+        stale = None if plot_dir is None else Path(plot_dir) / f"report_{name}.png"
+        if name not in makers and stale is not None and stale.is_file():
+            stale.unlink()              # an earlier run's figure this run does not draw
+            removed.append(str(stale))
     for name, make in makers.items():
         fig = make(plt, r)
         png[name] = _png(fig)
@@ -105,7 +119,7 @@ def write_figures(r: dict, plot_dir=None) -> dict:
             path = Path(plot_dir) / f"report_{name}.png"
             path.write_bytes(png[name])
             files.append(str(path))
-    return {"png": png, "files": files}
+    return {"png": png, "files": files, "removed": removed}
 
 
 def _table(head, rows) -> str:

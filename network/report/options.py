@@ -11,24 +11,12 @@ import math
 from dataclasses import dataclass, field
 
 from .._air import MU_AIR_PA_S, RHO_AIR_KG_M3
-from .._grains import BED, D272, GRAIN_ALIASES
+from .._grains import BED, grain_key
 from ..curve import DEFAULT_VELOCITIES, parse_velocities
 from ..flow import DEFAULT_DEPTH_M, DEFAULT_INERTIAL_LAW, INERTIAL_LAWS
 from .system import AIRFLOW_UNITS
 
 __all__ = ["ReportOptions", "grain_key"]
-
-
-def grain_key(name: str) -> str:
-    """Library name of a grain (aliases accepted); ValueError listing the known ones.
-
-    >>> grain_key("Corn")
-    'shelled_corn'
-    """
-    key = GRAIN_ALIASES.get(str(name).lower(), str(name).lower())
-    if key not in D272:
-        raise ValueError(f"unknown grain {name!r}; known grains: {', '.join(D272)}")
-    return key
 
 
 def _positive(name: str, value, *, optional: bool = True) -> None:
@@ -159,8 +147,9 @@ class ReportOptions:
             raise ValueError("give diameter_m (round bin) or floor_area_m2, not both")
         if self.airflow is not None:
             value, unit = self.airflow
-            if unit not in AIRFLOW_UNITS:
+            if str(unit).lower() not in AIRFLOW_UNITS:
                 raise ValueError(f"airflow unit {unit!r}: use one of {', '.join(AIRFLOW_UNITS)}")
+            unit = str(unit).lower()
             _positive("airflow", value, optional=False)
             set_(self, "airflow", (float(value), unit))
         self._check_fan()

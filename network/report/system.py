@@ -22,11 +22,33 @@ import math
 
 import numpy as np
 
-__all__ = ["AIRFLOW_UNITS", "FAN_COLUMNS", "bulk_density", "floor_area", "velocity_from_airflow",
+__all__ = ["AIRFLOW_UNITS", "FAN_COLUMNS", "M3_MIN_M3_PER_CFM_BU", "airflow_unit", "bulk_density",
+           "floor_area", "velocity_from_airflow",
            "system_rows", "dense_system", "read_fan", "operating_point", "curve_range"]
 
-#: units accepted by ``--airflow VALUE UNIT``
-AIRFLOW_UNITS = ("m3/min/t", "m/s")
+#: units accepted by ``--airflow VALUE UNIT`` (any case): superficial velocity, airflow per
+#: tonne of grain, per cubic metre of grain, and the US cubic feet per minute per bushel
+AIRFLOW_UNITS = ("m/s", "m3/min/t", "m3/min/m3", "cfm/bu")
+#: 1 ft^3 (0.3048^3 m^3) per US bushel (2150.42 in^3 = 0.03523907 m^3): 1 cfm/bu is
+#: 0.8035640 m^3/(min m^3) of grain
+M3_MIN_M3_PER_CFM_BU = 0.3048**3 / 0.03523907
+_UNIT_SPELLINGS = {"m3/(mint)": "m3/min/t", "m3/(minm3)": "m3/min/m3", "cfm/bushel": "cfm/bu",
+                   "ft3/min/bu": "cfm/bu"}
+
+
+def airflow_unit(text: str) -> str:
+    """The unit of ``--airflow`` as :data:`AIRFLOW_UNITS` spells it: any case, spaces and
+    ``^`` ignored (``M/S``, ``m^3/(min t)``); ValueError naming the accepted ones.
+
+    >>> airflow_unit("M/S"), airflow_unit("m^3/(min t)"), airflow_unit("CFM/bu")
+    ('m/s', 'm3/min/t', 'cfm/bu')
+    """
+    key = "".join(str(text).lower().split()).replace("^", "")
+    key = _UNIT_SPELLINGS.get(key, key)
+    if key not in AIRFLOW_UNITS:
+        raise ValueError(f"--airflow unit {text!r}: use one of {', '.join(AIRFLOW_UNITS)} "
+                         "(any case)")
+    return key
 FAN_COLUMNS = ("airflow_m3_s", "static_pressure_pa")
 
 
@@ -50,16 +72,24 @@ def floor_area(diameter_m=None, area_m2=None) -> float:
 
 def velocity_from_airflow(value: float, unit: str, *, depth_m: float,
                           bulk_density_kg_m3: float) -> float:
-    """Superficial velocity, m/s, of an airflow in m/s or m³/(min t).
+    r"""Superficial velocity U, m/s, of an airflow in one of :data:`AIRFLOW_UNITS`.
+
+    Per tonne, :math:`U = q_t \rho_b H / 60\,000`; per cubic metre of grain,
+    :math:`U = q_v H / 60`; ``cfm/bu`` is :math:`q_v` / 0.8035640 (1 ft³/min per US bushel of
+    0.03523907 m³). H is the depth (m), ρ_b the bulk density (kg/m³).
 
     >>> round(velocity_from_airflow(0.1, "m3/min/t", depth_m=3.0, bulk_density_kg_m3=771.0), 8)
     0.003855
+    >>> round(velocity_from_airflow(1.0, "cfm/bu", depth_m=3.0, bulk_density_kg_m3=771.0), 8)
+    0.0401782
     """
+    unit = airflow_unit(unit)
     if unit == "m/s":
         return float(value)
     if unit == "m3/min/t":
         return float(value) * bulk_density_kg_m3 * depth_m / 60_000.0
-    raise ValueError(f"--airflow unit {unit!r}: use one of {', '.join(AIRFLOW_UNITS)}")
+    per_m3 = float(value) * (M3_MIN_M3_PER_CFM_BU if unit == "cfm/bu" else 1.0)
+    return per_m3 * depth_m / 60.0
 
 
 def system_rows(velocity_m_s, gradient_pa_per_m, *, depth_m, area_m2,
