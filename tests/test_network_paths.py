@@ -9,12 +9,12 @@ import pytest
 from network import Packing, tessellate
 from network.paths import (
     EXIT_FACES,
+    BuildRules,
     bed_depth,
     branched_path_pressure_drop,
     build_paths,
     entry_faces,
-    eq323_negative,
-    face_areas,
+    eq323_area,
     face_graph,
     interior_angles,
     maximin_paths,
@@ -117,8 +117,8 @@ def test_maximin_follows_the_only_wide_channel(lattice):
 
 @pytest.mark.parametrize("kind", ["widest", "narrowest"])
 def test_built_paths_obey_the_step_rule(lattice, kind):
-    # every exit is higher than its base, and (without backtracking) is the widest/narrowest
-    # face allowed: upward, open by Eq. 3.23
+    # every exit is higher than its base, and (where no exit was reselected) is the
+    # widest/narrowest face allowed: upward, open by Eq. 3.23, which also gives the width
     c, r, _, _ = lattice
     xy = np.array([[9.75e-3, 9.75e-3], [13e-3, 6.5e-3]])
     paths = build_paths(c, r, xy, kind=kind)
@@ -129,8 +129,7 @@ def test_built_paths_obey_the_step_rule(lattice, kind):
         assert np.all(np.diff(h) > 0)
         assert h[-1] >= c[:, 2].max() - r.mean()
         tri = p.tetra_vertices[:, EXIT_FACES]  # (n, 3, 3)
-        _, op = face_areas(c, r, tri)
-        op = np.where(eq323_negative(c, r, tri), 0.0, op)
+        op = eq323_area(c, r, tri)
         base_h = c[p.tetra_vertices[:, :3]].mean(axis=1)[:, 2]
         allowed = (op > 0) & (c[tri].mean(axis=2)[:, :, 2] > base_h[:, None])
         chosen = op[np.arange(p.n_tetrahedra), p.exit_local]
@@ -139,6 +138,94 @@ def test_built_paths_obey_the_step_rule(lattice, kind):
         if p.n_backtracks == 0:
             np.testing.assert_allclose(chosen, best)
         np.testing.assert_allclose(p.widths_m, 2 * np.sqrt(chosen / np.pi))
+
+
+# A hand-made packing, mm, all radii 1: floor triangle A B C (legs 4.5 and 3), D above its
+# centroid, E beyond face BCD (away from A), F beyond face ACD (away from B), D E F at the
+# top height 2.7. With equal radii the three sectors of Eq. 3.23 sum to pi r^2 / 2 on any
+# triangle, so S_f = (triangle area) - pi / 2 mm^2 and the exits rank as the triangles do.
+_HAND_A, _HAND_B, _HAND_C, _HAND_D = (0, 0, 0), (4.5, 0, 0), (0, 3, 0), (1.5, 1, 2.7)
+_BC_OUT = np.array([3.0, 4.5]) / np.hypot(3.0, 4.5)  # unit normal of BC in the floor, away from A
+_HAND_E = (2.0 + 1.5 * _BC_OUT[0], 4 / 3 + 1.5 * _BC_OUT[1], 2.7)
+_HAND_F = (-1.0, 4 / 3, 2.7)
+
+
+def _tri_area_mm2(*p):
+    p = np.array(p, dtype=float)
+    return 0.5 * np.linalg.norm(np.cross(p[1] - p[0], p[2] - p[0]))
+
+
+def _width_mm(*p):  # Eq. 3.24 with S_f = triangle - pi / 2 (unit radii)
+    return 2.0 * np.sqrt((_tri_area_mm2(*p) - np.pi / 2) / np.pi)
+
+
+@pytest.mark.parametrize("rules", [BuildRules(), BuildRules(overlap="ball"),
+                                   BuildRules(overlap="none"), BuildRules(closed="second"),
+                                   BuildRules(area="exact"), BuildRules(insphere=False)])
+def test_hand_made_widest_and_narrowest_paths(rules):
+    A, B, C, D, E, F = range(6)
+    c = np.array([_HAND_A, _HAND_B, _HAND_C, _HAND_D, _HAND_E, _HAND_F]) * 1e-3
+    r = np.full(6, 1e-3)
+    # the AEP (1.5, 1) on the floor z = -1: A, C, B are nearest (2.06, 2.69, 3.32 mm), D is
+    # 3.70 mm away; D is the nearest sphere above the floor triangle's centroid. Step 1's
+    # exits ABD, ACD, BCD have triangles 6.48, 4.63, 7.64 mm^2: widest BCD, narrowest ACD.
+    assert [_tri_area_mm2(*q) for q in ((_HAND_A, _HAND_B, _HAND_D), (_HAND_A, _HAND_C, _HAND_D),
+                                        (_HAND_B, _HAND_C, _HAND_D))] == \
+        pytest.approx([6.4783, 4.6330, 7.6401], abs=1e-4)
+    # step 2: E (F) is nearest above BCD's (ACD's) centroid, on the far side from A (B); the
+    # exits keeping D and E (F) lie above the base centroid (z 1.8 > 0.9), the one keeping
+    # the two floor spheres does not (z 0.9). Widest: BDE (triangle 4.13 mm^2) over CDE (3.76);
+    # narrowest: ADF (3.72) under CDF (4.08). Their centroids (z 1.8) reach the top band
+    # (highest centre 2.7 less the mean radius 1), so each path has two tetrahedra.
+    wide, = build_paths(c, r, [[1.5e-3, 1e-3]], kind="widest", rules=rules)
+    narrow, = build_paths(c, r, [[1.5e-3, 1e-3]], kind="narrowest", rules=rules)
+    assert wide.status == narrow.status == "ok"
+    assert [set(t) for t in wide.tetra_vertices] == [{A, B, C, D}, {B, C, D, E}]
+    assert [set(t) for t in narrow.tetra_vertices] == [{A, B, C, D}, {A, C, D, F}]
+    exits = [set(t[EXIT_FACES[j]]) for t, j in zip(wide.tetra_vertices, wide.exit_local)]
+    assert exits == [{B, C, D}, {B, D, E}]
+    exits = [set(t[EXIT_FACES[j]]) for t, j in zip(narrow.tetra_vertices, narrow.exit_local)]
+    assert exits == [{A, C, D}, {A, D, F}]
+    P = {k: np.array(v, dtype=float) for k, v in zip("ABCDEF", (_HAND_A, _HAND_B, _HAND_C,
+                                                                 _HAND_D, _HAND_E, _HAND_F))}
+    np.testing.assert_allclose(wide.widths_m * 1e3, [_width_mm(P["B"], P["C"], P["D"]),
+                                                     _width_mm(P["B"], P["D"], P["E"])],
+                               rtol=1e-12)
+    np.testing.assert_allclose(wide.widths_m * 1e3, [2.7799, 1.8036], atol=1e-4)
+    np.testing.assert_allclose(narrow.widths_m * 1e3, [1.9746, 1.6545], atol=1e-4)
+    g = [(P["A"] + P["B"] + P["C"]) / 3, (P["B"] + P["C"] + P["D"]) / 3,
+         (P["B"] + P["D"] + P["E"]) / 3]
+    np.testing.assert_allclose(wide.points * 1e3, g, atol=1e-12)
+    length = np.linalg.norm(g[1] - g[0]) + np.linalg.norm(g[2] - g[1])
+    assert wide.length_m * 1e3 == pytest.approx(length, rel=1e-12)
+    assert wide.depth_m * 1e3 == pytest.approx(2.7 + 2.0, rel=1e-12)  # centre span + diameter
+
+
+def test_rule_one_reselects_the_exit():
+    # G at (3, -0.25, 2) mm, outside ABCD beyond its edge AB, is the sphere nearest above
+    # BCD's centroid but lies on A's side of the plane BCD: the tetrahedron BCDG would
+    # overlap ABCD (Fig. 3.7). 'exit' takes ABCD's next-best exit ABD (triangle 6.48 mm^2)
+    # and builds ABDG on it; 'ball' keeps BCD and passes over G to E; 'none' builds BCDG.
+    A, B, C, D, E, F, G = range(7)
+    c = np.array([_HAND_A, _HAND_B, _HAND_C, _HAND_D, _HAND_E, _HAND_F, (3.0, -0.25, 2.0)])
+    c, r = c * 1e-3, np.full(7, 1e-3)
+    side = np.cross(c[C] - c[B], c[D] - c[B])
+    assert np.dot(c[G] - c[B], side) * np.dot(c[A] - c[B], side) > 0  # G on A's side
+    got = {}
+    for overlap in ("exit", "ball", "none"):
+        p, = build_paths(c, r, [[1.5e-3, 1e-3]], kind="widest",
+                         rules=BuildRules(overlap=overlap))
+        got[overlap] = (set(p.tetra_vertices[0][EXIT_FACES[p.exit_local[0]]]),
+                        set(p.tetra_vertices[1]))
+    assert got == {"exit": ({A, B, D}, {A, B, D, G}), "ball": ({B, C, D}, {B, C, D, E}),
+                   "none": ({B, C, D}, {B, C, D, G})}
+
+
+def test_build_rules_are_checked():
+    with pytest.raises(ValueError, match="BuildRules.exits"):
+        BuildRules(exits="down")
+    with pytest.raises(TypeError, match="BuildRules"):
+        build_paths(np.zeros((4, 3)), np.ones(4), [[0.0, 0.0]], rules={"exits": "all"})
 
 
 def test_walked_paths_and_network_pressure(lattice):

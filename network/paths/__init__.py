@@ -6,7 +6,8 @@ centroids of the faces it crosses (thesis Fig. 3.9). Kinds and methods:
 
 ``'widest'`` / ``'narrowest'``, method ``'build'`` (:func:`build_paths`, the thesis's own
     construction, 3.4.1): tetrahedra built sphere by sphere upward, leaving each through the
-    open exit face of largest (smallest) open area :math:`S_f` (Eq. 3.23).
+    open exit face of largest (smallest) open area :math:`S_f` (Eq. 3.23); :class:`BuildRules`
+    names the readings of its ambiguous steps (docs/airpaths.md).
 ``'widest'`` / ``'narrowest'``, method ``'delaunay'`` (:func:`walk_paths`): the same exit rule
     walked on the Delaunay tessellation, whose tetrahedra are fixed.
 ``'maximin'`` (:func:`maximin_paths`): the optimal widest path on the tessellation, whose
@@ -29,7 +30,7 @@ from ._along import (branched_path_pressure_drop, branched_table, pore_pressure_
                      pressure_along_path)
 from ._branched import (MULTIPLIERS, WIDTHS, BranchedResult, branched_pressure_drop,
                         branching_multiplier, equivalent_diameter, laminar_pipe_dp, local_width)
-from ._build import build_paths, eq323_negative
+from ._build import BuildRules, build_paths, eq323_area, eq323_negative
 from ._faces import (END_BAND_DIAMETERS, MIN_QUALITY, FaceGraph, entry_faces, face_graph,
                      passable_pores, pore_quality, random_entry_points)
 from ._geometry import (EXIT_FACES, OMEGA_A, OMEGA_B_DEG, bed_depth, face_areas,
@@ -40,10 +41,11 @@ from ._record import AirflowPath
 from ._walks import PATH_KINDS, maximin_paths, shortest_paths, trace_paths, walk_paths
 
 __all__ = ["END_BAND_DIAMETERS", "EXIT_FACES", "MIN_QUALITY", "MULTIPLIERS", "OMEGA_A",
-           "OMEGA_B_DEG", "PATH_KINDS", "WIDTHS", "AirflowPath", "BranchedResult", "FaceGraph",
+           "OMEGA_B_DEG", "PATH_KINDS", "WIDTHS", "AirflowPath", "BranchedResult", "BuildRules",
+           "FaceGraph",
            "bed_depth", "branched_path_pressure_drop", "branched_pressure_drop",
            "branched_table", "branching_multiplier", "build_paths", "entry_faces",
-           "eq323_negative", "equivalent_diameter", "face_areas", "face_graph",
+           "eq323_area", "eq323_negative", "equivalent_diameter", "face_areas", "face_graph",
            "interior_angles", "laminar_pipe_dp", "local_width", "maximin_paths",
            "passable_pores", "path_length", "plot_paths", "pore_pressure_array", "pore_quality",
            "pressure_along_path", "random_entry_points", "shortest_paths", "smoothed_length",
