@@ -10,6 +10,7 @@ the packing file's unit (``--units``, default m); physical quantities (``--depth
 
 from __future__ import annotations
 
+import math
 import os
 from pathlib import Path
 
@@ -54,12 +55,13 @@ def warn_validity(reynolds_particle=None, pressure_drop_pa=None) -> None:
 
 
 def warn_curve(points, depth_m: float, key: str = "pressure_gradient_pa_per_m") -> None:
-    """:func:`warn_validity` for the converged points of a curve: the largest Re_p, and the
-    largest drop over ``depth_m`` (Pa) = gradient ``key`` (Pa/m) x depth."""
-    ok = [p for p in points if p["converged"]]
-    if ok:
-        warn_validity(max(p["reynolds_particle"] for p in ok),
-                      max(p[key] for p in ok) * depth_m)
+    """:func:`warn_validity` for every point of a curve, converged or not (a velocity beyond
+    the checked range is so whether or not its solve finished): the largest Re_p, and the
+    largest finite drop over ``depth_m`` (Pa) = gradient ``key`` (Pa/m) x depth."""
+    if not points:
+        return
+    drops = [p[key] * depth_m for p in points if math.isfinite(p[key])]
+    warn_validity(max(p["reynolds_particle"] for p in points), max(drops) if drops else None)
 
 
 # ------------------------------------------------------------------ arguments

@@ -136,6 +136,9 @@ def _print_result(res, out):
                   s["pressure_drop_pa"])
     print(f"  at v = {s['velocity_m_s']:g} m/s: gradient {s['pressure_gradient_pa_per_m']:.4g} "
           f"Pa/m, drop over {s['depth_m']:g} m = {s['pressure_drop_pa']:.4g} Pa", file=out)
+    if "inertial_solver" in s and not s["inertial_solver"]["converged"]:
+        print("    NOT CONVERGED: the nonlinear solve stopped short; the gradient and drop "
+              "above (and Ergun beside them) are not a result", file=out)
     if "pressure_drop_stokes_pa" in s:
         print(f"    with inertia (Re_p {s['reynolds_particle']:.3g}; Stokes "
               f"{s['pressure_gradient_stokes_pa_per_m']:.4g} Pa/m, "
@@ -271,6 +274,8 @@ def _main(args) -> int:
     out["units"] = args.units
     out["n_spheres"] = packing.n
     out["grain"] = grain
+    out["converged"] = all(r.summary().get("inertial_solver", {}).get("converged", True)
+                           for r in results)
     if grain == "soybean":
         out["thesis_lsv_reference_pa"] = THESIS_LSV
     if len(results) > 1:
@@ -297,6 +302,11 @@ def _main(args) -> int:
         with open(args.json_out, "w") as f:
             json.dump(out, f, indent=2)
         print(f"wrote {args.json_out}")
+    stopped = [r.axis for r in results
+               if not r.summary().get("inertial_solver", {}).get("converged", True)]
+    if stopped:
+        raise CliError(f"the nonlinear solve did not converge along {', '.join(stopped)} at "
+                       f"{args.velocity:g} m/s (the JSON says converged: false)", 1)
     bad = [r.axis for r in results if not r.check["ok"]]
     if bad:
         raise CliError(f"mass balance check failed along {', '.join(bad)} (see mass_balance)",

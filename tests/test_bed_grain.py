@@ -136,3 +136,29 @@ def test_a_depth_thinner_than_a_grain_is_refused(tmp_path, monkeypatch, capsys):
         assert err[-1].startswith("error: --depth 1e-06 m is thinner than one grain") \
             and "mm across" in err[-1] and cap.out == ""
     assert list(tmp_path.iterdir()) == []
+
+
+@pytest.mark.slow
+def test_solve_marks_an_unconverged_inertial_answer(tmp_path, capsys, monkeypatch):
+    """network.solve whose nonlinear solve stops short (forced): the line says so, the JSON
+    says converged: false, exit 1 after the JSON is written."""
+    import dataclasses
+
+    import network.solve as solve_module
+    real = solve_module.solve_axes
+
+    def stops_short(*args, **kwargs):
+        out = []
+        for res in real(*args, **kwargs):
+            pts = [dataclasses.replace(pt, converged=False) for pt in res.inertial["points"]]
+            out.append(dataclasses.replace(res, inertial=dict(res.inertial, points=pts)))
+        return out
+
+    monkeypatch.setattr(solve_module, "solve_axes", stops_short)
+    out = tmp_path / "s.json"
+    assert solve_main(["--json", str(out), "-q"]) == 1
+    cap = capsys.readouterr()
+    r = json.loads(out.read_text())
+    assert r["converged"] is False and r["inertial_solver"]["converged"] is False
+    assert "NOT CONVERGED: the nonlinear solve stopped short" in cap.out
+    assert "error: the nonlinear solve did not converge along z at 0.013 m/s" in cap.err

@@ -409,3 +409,85 @@ def test_no_band_run_removes_the_earlier_band_figure(tmp_path, capsys):
     assert (tmp_path / "notes.txt").read_text() == "mine"
     assert f"removed {tmp_path / 'report_band.png'}" in out
     assert "D272 holds for 0.01-2 m/s (the Hukill-Ives form's stated range" in out
+
+
+@pytest.mark.parametrize("rows", [
+    "0,0\n0.1,50\n0.2,200\n",               # a system curve given as the fan
+    "0,0\n50,0.1\n200,0.2\n",               # the same with its columns swapped
+])
+def test_a_fan_whose_pressure_rises_with_airflow_is_refused(rows, tmp_path, monkeypatch,
+                                                            capsys):
+    monkeypatch.chdir(tmp_path)
+    fan = tmp_path / "fan.csv"
+    fan.write_text("airflow_m3_s,static_pressure_pa\n" + rows)
+    before = fan.read_bytes()
+    out = tmp_path / "r.json"
+    assert main(["--fan", str(fan), "--floor-area", "1", "--json", str(out), "-q"]) == 2
+    cap = capsys.readouterr()
+    err = cap.err.strip().splitlines()
+    assert cap.out == "" and len(err) == 1 and err[0].startswith(f"error: --fan {fan}: ")
+    assert "rises with airflow" in err[0] and "never falls" in err[0] and "system curve" in err[0]
+    assert fan.read_bytes() == before and sorted(p.name for p in tmp_path.iterdir()) == ["fan.csv"]
+
+
+def test_a_fan_with_a_stall_hump_or_swapped_looking_columns_is_warned(caplog):
+    from network.report.system import check_fan_shape
+    with caplog.at_level("WARNING"):
+        check_fan_shape([0.0, 0.5, 1.0, 2.0], [400.0, 450.0, 300.0, 0.0])      # a stall hump
+    assert len(caplog.records) == 1
+    assert "rises with airflow between 0 and 0.5 m^3/s (a stall region?)" in caplog.text
+    caplog.clear()
+    with caplog.at_level("WARNING"):
+        check_fan_shape([50.0, 60.0], [2.0, 1.0])
+    assert len(caplog.records) == 1 and "are the columns swapped?" in caplog.text
+    caplog.clear()
+    with caplog.at_level("WARNING"):
+        check_fan_shape([0.0, 0.1, 0.2], [600.0, 350.0, 0.0])                 # a fan: quiet
+    assert caplog.records == []
+
+
+@pytest.mark.slow
+def test_unconverged_numbers_are_marked_and_left_out_of_the_fits(tmp_path, capsys,
+                                                                  monkeypatch):
+    """A solve that stops short at 3 m/s (forced here: the vertical and horizontal points at
+    3 m/s report converged False): its row and the airflow line carry a visible mark, the JSON
+    says converged: false, the system curve and the fits use the converged points only, the
+    Re_p and atmosphere warnings still look at it, and the run exits 1."""
+    import dataclasses
+
+    from network.flow import fit_curve
+    from network.report import build as report_build
+    real = report_build.solve_network
+
+    def stops_short_at_3(*args, **kwargs):
+        res = real(*args, **kwargs)
+        pts = [dataclasses.replace(pt, converged=False) if u == 3.0 else pt
+               for u, pt in zip(res.inertial["velocities_m_s"], res.inertial["points"])]
+        return dataclasses.replace(res, inertial=dict(res.inertial, points=pts))
+
+    monkeypatch.setattr(report_build, "solve_network", stops_short_at_3)
+    monkeypatch.chdir(tmp_path)
+    out = tmp_path / "r.json"
+    assert main(["--velocities", "0.01,0.03,0.1", "--airflow", "3", "M/S", "--depth", "40",
+                 "--no-band", "--no-figures", "--json", str(out), "-q"]) == 1
+    cap = capsys.readouterr()
+    r = json.loads(out.read_text())
+    bad = [p for p in r["points"] if p["velocity_m_s"] == 3.0]
+    assert len(bad) == 1 and bad[0]["converged"] is False
+    assert bad[0]["converged_horizontal"] is False
+    assert r["airflow"]["converged"] is False
+    assert [s["velocity_m_s"] for s in r["system_curve"]] == [0.01, 0.03, 0.1]
+    ok = [p for p in r["points"] if p["converged"]]
+    want = fit_curve([p["velocity_m_s"] for p in ok],
+                     [p["pressure_gradient_pa_per_m"] for p in ok],
+                     viscosity_pa_s=r["viscosity_pa_s"], density_kg_m3=r["air_density_kg_m3"],
+                     porosity=r["porosity"], diameter_m=r["sauter_diameter_m"])
+    assert r["fits"]["permeability_m2"] == pytest.approx(want["permeability_m2"], rel=1e-12)
+    rows = [line for line in cap.out.splitlines() if "NOT CONVERGED" in line]
+    assert len(rows) == 2 and rows[0].strip().startswith("3 ") \
+        and "NOT CONVERGED (z, x): not a result" in rows[0]
+    assert rows[1].startswith("airflow ") and "static pressure" in rows[1]
+    re_p = bad[0]["reynolds_particle"]
+    assert f"warning: Re_p {re_p:.3g} is beyond the 200" in cap.err
+    assert "of the atmosphere's" in cap.err
+    assert "error: the nonlinear solve did not converge at U = [3.0] m/s" in cap.err

@@ -131,6 +131,7 @@ def build_report(packing, path, options: ReportOptions) -> dict:
             u, porosity=e, diameter_m=d32, viscosity_pa_s=o.viscosity_pa_s,
             density_kg_m3=o.density_kg_m3))
         p["pressure_gradient_horizontal_pa_per_m"] = px["pressure_gradient_pa_per_m"]
+        p["converged_horizontal"] = px["converged"]
         p["band_slope"] = None if band is None else slope_at(u, band["velocities_m_s"],
                                                              band["slopes"])
         p["pressure_gradient_band_pa_per_m"] = (
@@ -170,10 +171,11 @@ def build_report(packing, path, options: ReportOptions) -> dict:
                    "grain_mass_t": rho_b * area * o.depth_m / 1000.0},
            "system_curve": system, "airflow": None, "operating_point": None}
     if u_air is not None:
-        g = next(p["pressure_gradient_pa_per_m"] for p in flow
-                 if abs(p["velocity_m_s"] - u_air) <= 1e-12 * u_air)
-        out["airflow"] = system_rows([u_air], [g], depth_m=o.depth_m, area_m2=area,
+        at = next(p for p in flow if abs(p["velocity_m_s"] - u_air) <= 1e-12 * u_air)
+        out["airflow"] = system_rows([u_air], [at["pressure_gradient_pa_per_m"]],
+                                     depth_m=o.depth_m, area_m2=area,
                                      bulk_density_kg_m3=rho_b)[0]
+        out["airflow"]["converged"] = bool(at["converged"])
     if o.fan is not None:
         sq, sp = dense_system(su, sg, depth_m=o.depth_m, area_m2=area)
         op = operating_point(sq, sp, *o.fan)

@@ -177,6 +177,13 @@ def _g(v, fmt="10.4g"):
     return f"{'-':>{fmt.split('.')[0]}}" if v is None else format(v, fmt)
 
 
+def _not_converged(p) -> str:
+    """The mark of a row whose nonlinear solve stopped short: which direction(s)."""
+    bad = [ax for ax, ok in (("z", p["converged"]), ("x", p.get("converged_horizontal", True)))
+           if not ok]
+    return f"  NOT CONVERGED ({', '.join(bad)}): not a result" if bad else ""
+
+
 def print_report(r) -> None:
     """The text report on stdout."""
     print(f"grain {r['grain']}: packing {r['packing']} ({r['n_grains']} grains, {r['n_spheres']} "
@@ -218,7 +225,7 @@ def print_report(r) -> None:
               f"{_g(p['d272_pressure_gradient_pa_per_m'])} "
               f"{p['ergun_pressure_gradient_pa_per_m']:10.4g} "
               + " ".join(_g(b.get(f"{o:+.2f}")) for o in BAND_OFFSETS)
-              + ("" if p["converged"] else "  NOT CONVERGED"))
+              + _not_converged(p))
     band = r["band"]
     if band:
         print("porosity band: d ln(dP/L)/d(porosity) = "
@@ -245,7 +252,9 @@ def print_report(r) -> None:
     if r["airflow"]:
         a = r["airflow"]
         print(f"airflow {a['airflow_m3_min_t']:.4g} m^3/(min t) = {a['velocity_m_s']:.4g} m/s: "
-              f"{a['airflow_m3_s']:.4g} m^3/s, static pressure {a['static_pressure_pa']:.4g} Pa")
+              f"{a['airflow_m3_s']:.4g} m^3/s, static pressure {a['static_pressure_pa']:.4g} Pa"
+              + ("" if a.get("converged", True) else
+                 "  NOT CONVERGED: the nonlinear solve stopped short, not a result"))
     op = r["operating_point"]
     if op and op["found"]:
         print(f"operating point: {op['airflow_m3_s']:.4g} m^3/s, {op['airflow_m3_min_t']:.4g} "
@@ -314,7 +323,8 @@ def _main(args) -> int:
         if args.html:
             write_html(args.html, rep, figs.get("png", {}))
             print(f"wrote {args.html}")
-    bad = [p["velocity_m_s"] for p in rep["points"] if not p["converged"]]
+    bad = [p["velocity_m_s"] for p in rep["points"]
+           if not (p["converged"] and p["converged_horizontal"])]
     if bad:
         raise CliError(f"the nonlinear solve did not converge at U = {bad} m/s", 1)
     return 0

@@ -133,19 +133,26 @@ def _f(v, fmt=".4g") -> str:
     return "-" if v is None else format(v, fmt)
 
 
+def _converged(p) -> str:
+    bad = [ax for ax, ok in (("z", p["converged"]), ("x", p.get("converged_horizontal", True)))
+           if not ok]
+    return f"NO ({', '.join(bad)}): not a result" if bad else "yes"
+
+
 def write_html(path, r: dict, png: dict) -> None:
     """One self-contained HTML file: summary, curve table, system table, embedded plots."""
     band = r.get("band")
     offs = ["-0.02", "-0.01", "+0.01", "+0.02"]
     curve = _table(["U m/s", "Re_p", "dP/L vertical Pa/m", "dP/L horizontal Pa/m",
-                    "D272 Pa/m", "Ergun Pa/m"] + [f"porosity {o} Pa/m" for o in offs],
+                    "D272 Pa/m", "Ergun Pa/m"] + [f"porosity {o} Pa/m" for o in offs]
+                   + ["converged"],
                    [[_f(p["velocity_m_s"]), _f(p["reynolds_particle"], ".3g"),
                      _f(p["pressure_gradient_pa_per_m"]),
                      _f(p["pressure_gradient_horizontal_pa_per_m"]),
                      _f(p["d272_pressure_gradient_pa_per_m"]),
                      _f(p["ergun_pressure_gradient_pa_per_m"])]
                     + [_f((p["pressure_gradient_band_pa_per_m"] or {}).get(o)) for o in offs]
-                    for p in r["points"]])
+                    + [_converged(p)] for p in r["points"]])
     system = _table(["U m/s", "airflow m^3/s", "airflow m^3/(min t)", "airflow m^3/(min m^3)",
                      "static pressure Pa"],
                     [[_f(s["velocity_m_s"]), _f(s["airflow_m3_s"]), _f(s["airflow_m3_min_t"]),
@@ -177,7 +184,10 @@ def write_html(path, r: dict, png: dict) -> None:
     if a:
         op_text = (f"Airflow asked: {a['airflow_m3_min_t']:.4g} m^3/(min t) = "
                    f"{a['velocity_m_s']:.4g} m/s, {a['airflow_m3_s']:.4g} m^3/s, static pressure "
-                   f"{a['static_pressure_pa']:.4g} Pa. " + op_text)
+                   f"{a['static_pressure_pa']:.4g} Pa"
+                   + ("" if a.get("converged", True) else
+                      " (NOT CONVERGED: the nonlinear solve stopped short, not a result)")
+                   + ". " + op_text)
     imgs = "".join(f'<p><img alt="{n}" src="data:image/png;base64,'
                    f'{base64.b64encode(b).decode("ascii")}"></p>' for n, b in png.items())
     doc = f"""<!DOCTYPE html>

@@ -14,7 +14,7 @@ from .._air import MU_AIR_PA_S, RHO_AIR_KG_M3
 from .._grains import BED, grain_key
 from ..curve import DEFAULT_VELOCITIES, parse_velocities
 from ..flow import DEFAULT_DEPTH_M, DEFAULT_INERTIAL_LAW, INERTIAL_LAWS
-from .system import AIRFLOW_UNITS
+from .system import AIRFLOW_UNITS, check_fan_shape
 
 __all__ = ["ReportOptions", "grain_key"]
 
@@ -186,6 +186,7 @@ class ReportOptions:
             raise ValueError("the fan curve's airflow must ascend")
         if self.diameter_m is None and self.floor_area_m2 is None:
             raise ValueError("a fan curve needs the bin: diameter_m (round) or floor_area_m2")
+        check_fan_shape(q, p)
         object.__setattr__(self, "fan_airflow_m3_s", q)
         object.__setattr__(self, "fan_static_pressure_pa", p)
 

@@ -18,17 +18,18 @@ log-log interpolated between the solved velocities).
 from __future__ import annotations
 
 import csv
+import logging
 import math
 
 import numpy as np
 
 __all__ = ["AIRFLOW_UNITS", "FAN_COLUMNS", "M3_MIN_M3_PER_CFM_BU", "airflow_unit", "bulk_density",
-           "floor_area", "velocity_from_airflow",
-           "system_rows", "dense_system", "read_fan", "operating_point", "curve_range"]
+           "check_fan_shape", "floor_area", "velocity_from_airflow", "system_rows", "dense_system", "read_fan", "operating_point", "curve_range"]
 
 #: units accepted by ``--airflow VALUE UNIT`` (any case): superficial velocity, airflow per
 #: tonne of grain, per cubic metre of grain, and the US cubic feet per minute per bushel
 AIRFLOW_UNITS = ("m/s", "m3/min/t", "m3/min/m3", "cfm/bu")
+log = logging.getLogger(__name__)
 #: 1 ft^3 (0.3048^3 m^3) per US bushel (2150.42 in^3 = 0.03523907 m^3): 1 cfm/bu is
 #: 0.8035640 m^3/(min m^3) of grain
 M3_MIN_M3_PER_CFM_BU = 0.3048**3 / 0.03523907
@@ -149,7 +150,38 @@ def read_fan(path) -> tuple[np.ndarray, np.ndarray]:
     twice = np.flatnonzero(np.diff(a[:, 0]) == 0)
     if twice.size:
         raise ValueError(f"--fan {path}: airflow {a[twice[0], 0]:g} m^3/s appears twice")
+    check_fan_shape(a[:, 0], a[:, 1], f"--fan {path}")
     return a[:, 0], a[:, 1]
+
+
+def check_fan_shape(airflow_m3_s, pressure_pa, where: str = "the fan curve") -> None:
+    """A fan's static pressure falls as its airflow rises. ValueError where it never falls
+    (a system curve, or a curve whose columns are swapped); one logged warning where it rises
+    over part of the range (a stall hump: the operating point is sought where it falls) or
+    where the airflows exceed the pressures (m^3/s above Pa: swapped columns?).
+
+    >>> check_fan_shape([0.0, 1.0, 2.0], [0.0, 100.0, 400.0])  # doctest: +ELLIPSIS
+    Traceback (most recent call last):
+    ...
+    ValueError: the fan curve: static pressure rises with airflow (0 Pa at 0 m^3/s to 400 ...
+    """
+    q, p = np.asarray(airflow_m3_s, float), np.asarray(pressure_pa, float)
+    dp = np.diff(p)
+    if not np.any(dp < 0):
+        raise ValueError(f"{where}: static pressure rises with airflow ({p[0]:g} Pa at "
+                         f"{q[0]:g} m^3/s to {p[-1]:g} Pa at {q[-1]:g} m^3/s) and never falls: "
+                         "that is a system curve, not a fan's (columns "
+                         f"{','.join(FAN_COLUMNS)}; a fan delivers less air against more "
+                         "pressure)")
+    up = np.flatnonzero(dp > 0)
+    if up.size:
+        log.warning("%s: static pressure rises with airflow between %g and %g m^3/s (a stall "
+                    "region?); the operating point is sought where it falls", where,
+                    q[up[0]], q[up[-1] + 1])
+    if q.max() > p.max():
+        log.warning("%s: airflows up to %g m^3/s exceed the pressures (at most %g Pa): are "
+                    "the columns swapped? (%s)", where, q.max(), p.max(),
+                    ",".join(FAN_COLUMNS))
 
 
 def operating_point(system_q, system_p, fan_q, fan_p):
