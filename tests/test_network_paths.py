@@ -221,6 +221,18 @@ def test_rule_one_reselects_the_exit():
                    "none": ({B, C, D}, {B, C, D, G})}
 
 
+def test_the_entry_point_lies_on_the_floor():
+    # from (1.5, 1) on the floor z = -1 mm the nearest spheres are A, C, B (2.06, 2.69,
+    # 3.32 mm; D 3.70); from the lowest centre height z = 0 they are A, C, D (1.80, 2.50,
+    # 2.70 mm; B 3.16), so the path starts from the triangle ACD
+    c = np.array([_HAND_A, _HAND_B, _HAND_C, _HAND_D, _HAND_E, _HAND_F]) * 1e-3
+    r = np.full(6, 1e-3)
+    floor, = build_paths(c, r, [[1.5e-3, 1e-3]])
+    centre, = build_paths(c, r, [[1.5e-3, 1e-3]], rules=BuildRules(start="lowest-centre"))
+    assert set(floor.tetra_vertices[0, :3]) == {0, 1, 2}
+    assert set(centre.tetra_vertices[0, :3]) == {0, 2, 3}
+
+
 def test_build_rules_are_checked():
     with pytest.raises(ValueError, match="BuildRules.exits"):
         BuildRules(exits="down")

@@ -47,6 +47,7 @@ READINGS = {
     "rule 2 second": BuildRules(closed="second"),
     "area exact": BuildRules(area="exact"),
     "no insphere": BuildRules(insphere=False),
+    "start lowest centre": BuildRules(start="lowest-centre"),
 }
 
 

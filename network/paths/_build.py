@@ -91,6 +91,9 @@ class BuildRules:
         Condition (2) of 3.4.1 on the fourth sphere, the inscribed sphere of the tetrahedron
         of centres smaller than a mean grain radius (default True; Appendix D has no such
         test).
+    start : {'floor', 'lowest-centre'}
+        Height of the AEP: the floor, the lowest sphere bottom (default; the thesis's AEPs lie
+        at z = 0, the bin floor), or the lowest sphere centre.
     """
 
     exits: str = "upward"
@@ -98,10 +101,12 @@ class BuildRules:
     closed: str = "next"
     area: str = "eq3.23"
     insphere: bool = True
+    start: str = "floor"
 
     def __post_init__(self):
         for name, allowed in (("exits", ("upward", "all")), ("overlap", ("exit", "ball", "none")),
-                              ("closed", ("next", "second")), ("area", ("eq3.23", "exact"))):
+                              ("closed", ("next", "second")), ("area", ("eq3.23", "exact")),
+                              ("start", ("floor", "lowest-centre"))):
             if getattr(self, name) not in allowed:
                 raise ValueError(f"BuildRules.{name} must be one of {allowed}, "
                                  f"got {getattr(self, name)!r}")
@@ -113,8 +118,8 @@ def build_paths(points, radii, entry_xy, *, kind="widest", axis="z", rules=Build
 
     All entries advance together, one tetrahedron per step.
 
-    1. Start: the air entry point (AEP) lies on the floor, the lowest sphere bottom; the three
-       spheres nearest to it are the first base triangle.
+    1. Start: the air entry point (AEP) lies on the floor, the lowest sphere bottom
+       (``rules.start``); the three spheres nearest to it are the first base triangle.
     2. Fourth sphere: the nearest to the base centroid that (a) is higher than the centroid
        along ``axis``, (b) is on no earlier base triangle of the path (Appendix D), (c) makes
        a tetrahedron of centres whose inscribed sphere is smaller than a mean grain radius
@@ -190,7 +195,7 @@ def build_paths(points, radii, entry_xy, *, kind="widest", axis="z", rules=Build
 
     aep = np.zeros((n, 3))
     aep[:, plane_axes(ax)] = xy
-    aep[:, ax] = (h - r).min()
+    aep[:, ax] = (h - r).min() if rules.start == "floor" else h.min()
     _, base = tree.query(aep, k=3)
     base = np.asarray(base, dtype=np.intp).reshape(n, 3)
     used = np.zeros((n, ns), dtype=bool)
