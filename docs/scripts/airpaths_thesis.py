@@ -18,7 +18,6 @@ every number and ``--plot`` draws the turning-angle distribution.
 from __future__ import annotations
 
 import argparse
-import dataclasses
 import json
 
 import numpy as np
@@ -180,8 +179,8 @@ def _print(res):
         for name, d in res["readings"].items():
             cells = []
             for kind in ("widest", "narrowest"):
-                cells += [f"{d[kind]['tortuosity']['mean']:.2f} ± {d[kind]['tortuosity']['sd']:.2f}",
-                          f"{d[kind]['width_mm']['mean']:.2f} ± {d[kind]['width_mm']['sd']:.2f}",
+                t, w = d[kind]["tortuosity"], d[kind]["width_mm"]
+                cells += [f"{t['mean']:.2f} ± {t['sd']:.2f}", f"{w['mean']:.2f} ± {w['sd']:.2f}",
                           f"{d[kind]['tetrahedra']['mean']:.0f}"]
             print(f"| {name} | " + " | ".join(cells) + " |")
 
@@ -205,8 +204,8 @@ def _plot(angles, path):
         axp.set_xticks(np.arange(0, 181, 30))
         axp.legend(fontsize=7, loc="upper right")
     axs[0].set_ylabel("frequency (%)")
-    fig.suptitle("Local turning angles on the rect-bin (thesis Fig. 4.6: more than 50 % below 30°)",
-                 fontsize=9)
+    fig.suptitle("Local turning angles on the rect-bin "
+                 "(thesis Fig. 4.6: more than 50 % below 30°)", fontsize=9)
     fig.tight_layout()
     fig.savefig(path, dpi=110)
 

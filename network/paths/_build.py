@@ -271,9 +271,9 @@ def build_paths(points, radii, entry_xy, *, kind="widest", axis="z", rules=Build
             relaxed[active[pending[neg & good]]] += 1
             slot_of[pending[good]] = slot
             pending = pending[~good]
-        choice = np.where(slot_of >= 0,
-                          cand[np.arange(a), order[np.arange(a), np.maximum(slot_of, 0)]], -1)
-        ov = (choice >= 0) & (rules.overlap == "exit") & same_side[np.arange(a), order[np.arange(a), np.maximum(slot_of, 0)]]
+        pick = order[np.arange(a), np.maximum(slot_of, 0)]
+        choice = np.where(slot_of >= 0, cand[np.arange(a), pick], -1)
+        ov = (choice >= 0) & (rules.overlap == "exit") & same_side[np.arange(a), pick]
         go = (choice >= 0) & ~ov
         ga = active[go]
         tet = np.column_stack([b[go], choice[go]])
