@@ -23,6 +23,10 @@ porosity_in_spheres, porosity_in_region, coordination_numbers, Region, lens_volu
     Measurements; summarize, surface_height, default_measure_spheres (B1–B5) for whole packings.
 generate_spheres, thesis_particle_count, intensity_g
     Random sequential addition, Eq. 3.10, Eq. 3.11's Γ = Aω²/g.
+FillOptions, pour_grains, janssen_stress, load_bed
+    Poured grain beds (rain over the cross-section or a centre spout) with the grains' real
+    masses, and the overburden: Janssen's vertical stress and a servo-controlled lid that
+    applies it (``python -m dem.pack --grain G --fill rain|spout --depth Z --bin-diameter D``).
 write_packing, read_packing
     CSV ``x,y,z,r`` (m) + JSON summary. CLIs: ``python -m dem.pack``, ``python -m dem.vibrate``
     (``--study thesis``: the thesis's vibration study, :mod:`dem.study`), ``python -m dem.bench``.
@@ -52,6 +56,8 @@ from ._summary import summarize, surface_height
 from ._vibrate import VibrationResult, intensity_g, rest_motion, vibrate_bed
 from ._walls import CylinderWall, PlaneWall
 from .clumps import ClumpSimulation
+from ._load import janssen_stress, load_bed
+from ._pour import FillOptions, pour_grains
 from .grains import GRAIN_FIELDS, GRAINS, Grain, Sourced, grain
 from .templates import (LIBRARY_MAX_SPHERES, ROW_SPACING, TEMPLATE_GRAINS, Template, check_template,
                         library_template, read_template, resolve_template, sphere_template,
@@ -73,4 +79,6 @@ __all__ = [
     "ClumpSimulation", "LIBRARY_MAX_SPHERES", "ROW_SPACING", "TEMPLATE_GRAINS", "Template",
     "check_template", "library_template", "read_template", "resolve_template", "sphere_template",
     "template_from_axes",
+    # poured fills and the overburden lid
+    "FillOptions", "pour_grains", "janssen_stress", "load_bed",
 ]

@@ -101,6 +101,33 @@ def union_porosity_in_box(centers, radii, lo, hi, *, log2_points=14, replicates=
     return 1.0 - float(np.mean(sol)), float(np.std(sol, ddof=1) / np.sqrt(replicates))
 
 
+def interior_box(xs, r, template, container):
+    """The interior box of a grain bed, (lo, hi) m: one grain length from the side walls (a
+    cylinder: its inscribed square), the floor and the highest sphere top."""
+    top = float(np.max(xs[:, 2] + r))
+    margin = float(template.extent_m[0])
+    if container.kind == "box":
+        half = np.array(container.size_m) / 2 - margin
+        return np.array([-half[0], -half[1], margin]), np.array([half[0], half[1], top - margin])
+    h = container.size_m[0] / 2 / np.sqrt(2) - margin
+    return np.array([-h, -h, margin]), np.array([h, h, top - margin])
+
+
+def bed_porosities(xs, r, template, container, grain_volume_m3):
+    """Porosity of the union of spheres (QMC, :func:`union_porosity_in_box`) in the interior box
+    (:func:`interior_box`) and in network's sample region (:func:`network_region`), with errors
+    (NaN where a box is empty), the boxes and the bed top, as summary entries."""
+    lo, hi = interior_box(xs, r, template, container)
+    phi, phi_err = (union_porosity_in_box(xs, r, lo, hi) if np.all(hi > lo) else (float("nan"), float("nan")))
+    net_lo, net_hi = network_region(xs, r, grain_volume_m3)
+    phi_net, phi_net_err = (union_porosity_in_box(xs, r, net_lo, net_hi) if np.all(net_hi > net_lo)
+                            else (float("nan"), float("nan")))
+    return {"porosity_interior_union": phi, "porosity_interior_error": phi_err,
+            "interior_box_m": [lo.tolist(), hi.tolist()], "porosity_network_region": phi_net,
+            "porosity_network_region_error": phi_net_err,
+            "network_region_m": [net_lo.tolist(), net_hi.tolist()], "bed_top_m": float(np.max(xs[:, 2] + r))}
+
+
 def pack_grains(container, template, *, material=SOYBEAN, porosity=0.408, n_grains=None, rng=None,
                 initial_multiplier=None, deposition_friction=0.0, size_cv=0.0, mass_scale=100.0,
                 lid_headroom=0.3, grow_steps=3000, sediment_steps=3000, tol=2e-3, max_steps=40000,
@@ -155,29 +182,15 @@ def pack_grains(container, template, *, material=SOYBEAN, porosity=0.408, n_grai
     stages["settle"] = sim.run(max_steps=max_steps, tol=tol, check_every=check_every, callback=progress)
     xs = sim.sphere_centers()
     r = sim.radii.copy()
-    top = float(np.max(xs[:, 2] + r))
-    margin = float(template.extent_m[0])
-    if container.kind == "box":
-        half = np.array(container.size_m) / 2 - margin
-        lo, hi = np.array([-half[0], -half[1], margin]), np.array([half[0], half[1], top - margin])
-    else:
-        h = container.size_m[0] / 2 / np.sqrt(2) - margin
-        lo, hi = np.array([-h, -h, margin]), np.array([h, h, top - margin])
-    phi, phi_err = (union_porosity_in_box(xs, r, lo, hi) if np.all(hi > lo) else (float("nan"), float("nan")))
-    net_lo, net_hi = network_region(xs, r, float(np.mean(sim.volume_m3)))
-    phi_net, phi_net_err = (union_porosity_in_box(xs, r, net_lo, net_hi) if np.all(net_hi > net_lo)
-                            else (float("nan"), float("nan")))
+    measured = bed_porosities(xs, r, template, container, float(np.mean(sim.volume_m3)))
     wall = time.perf_counter() - t0
     steps = sum(s["steps"] for s in stages.values())
     summary = {"n_grains": n, "n_spheres": len(r), "template": template.name, "template_source": template.source,
                "spheres_per_grain": template.n, "grain_volume_m3": template.volume_m3,
-               "porosity_interior_union": phi, "porosity_interior_error": phi_err,
-               "interior_box_m": [lo.tolist(), hi.tolist()], "porosity_network_region": phi_net,
-               "porosity_network_region_error": phi_net_err,
-               "network_region_m": [net_lo.tolist(), net_hi.tolist()],
+               **measured,
                "deposition_friction": float(deposition_friction), "size_cv": float(size_cv),
                "grain_scale_range": [float(size.min()), float(size.max())],
-               "initial_multiplier": float(initial_multiplier), "bed_top_m": top, "stages": stages,
+               "initial_multiplier": float(initial_multiplier), "stages": stages,
                "steps": steps, "dt_s": sim.dt, "mass_scale": mass_scale, "wall_time_s": wall,
                "material": {k: getattr(material, k) for k in material.__dataclass_fields__},
                "engine": "dem.clumps (numba: the sphere step's kernels and a rigid-body update)"}

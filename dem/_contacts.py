@@ -21,6 +21,7 @@ __all__ = [
     "series_stiffness",
     "damping_coefficient",
     "restitution_coefficient",
+    "damping_ratio_for_restitution",
     "linear_contact_forces",
     "contact_law",
 ]
@@ -71,6 +72,22 @@ def restitution_coefficient(beta):
     if np.any((beta < 0) | (beta >= 1)):
         raise ValueError(f"damping ratio must be in [0, 1), got {beta}")
     return np.exp(-np.pi * beta / np.sqrt(1.0 - beta**2))
+
+
+def damping_ratio_for_restitution(e):
+    r"""Critical-damping ratio β whose linear spring–dashpot contact has restitution e, the
+    inverse of :func:`restitution_coefficient`:
+
+    .. math:: \beta = \frac{-\ln e}{\sqrt{\pi^2 + \ln^2 e}}
+
+    >>> round(float(damping_ratio_for_restitution(0.7292)), 4)
+    0.1
+    """
+    e = np.asarray(e, dtype=float)
+    if np.any((e <= 0) | (e > 1)):
+        raise ValueError(f"restitution must be in (0, 1], got {e}")
+    ln = np.log(e)
+    return -ln / np.sqrt(np.pi**2 + ln**2)
 
 
 @numba.njit(inline="always", cache=True, error_model="numpy")

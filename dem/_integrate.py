@@ -241,7 +241,7 @@ class Simulation:
                         vl.second_start, vl.by_second, self._f_pair, self._t_pair, self._touch, self._wall_kind,
                         self._wall_normal, self._wall_offsets(), self._wall_cyl, self._wall_moves,
                         self.wall_vz_m_s, self.wall_shear, self._wall_fn, self._wall_touch, mat.kn_pw, mat.ks_pw,
-                        mat.damping_ratio, mat.wall_friction, dt, self._inv_m, self._inv_i, self._force,
+                        mat.wall_beta, mat.wall_friction, dt, self._inv_m, self._inv_i, self._force,
                         self._torque, advance)
 
     def forces(self):

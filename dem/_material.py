@@ -17,7 +17,8 @@ class Material:
     """Grain and wall properties (defaults: soybean in Plexiglas, thesis Table 3.1).
 
     Stiffnesses are per-entity values as in PFC3D; a contact uses the series
-    combination (:func:`dem._contacts.series_stiffness`).
+    combination (:func:`dem._contacts.series_stiffness`). ``damping_ratio`` is the critical-damping
+    ratio of grain-grain dashpots; ``wall_damping_ratio`` that of grain-wall ones (None: the same).
     """
 
     density_kg_m3: float = 1285.0
@@ -30,6 +31,7 @@ class Material:
     damping_ratio: float = 0.1
     radius_min_m: float = 0.00275
     radius_max_m: float = 0.00375
+    wall_damping_ratio: float | None = None
 
     def __post_init__(self):
         for name in ("density_kg_m3", "kn_n_m", "ks_n_m", "wall_kn_n_m", "wall_ks_n_m"):
@@ -42,10 +44,17 @@ class Material:
                 raise ValueError(f"{name} must be >= 0, got {v}")
         if not 0 <= self.damping_ratio < 1:
             raise ValueError(f"damping_ratio must be in [0, 1), got {self.damping_ratio}")
+        if self.wall_damping_ratio is not None and not 0 <= self.wall_damping_ratio < 1:
+            raise ValueError(f"wall_damping_ratio must be in [0, 1), got {self.wall_damping_ratio}")
         if not 0 < self.radius_min_m <= self.radius_max_m:
             raise ValueError(
                 f"need 0 < radius_min_m <= radius_max_m, got {self.radius_min_m}, {self.radius_max_m}"
             )
+
+    @property
+    def wall_beta(self):
+        """Critical-damping ratio of grain-wall dashpots."""
+        return self.damping_ratio if self.wall_damping_ratio is None else self.wall_damping_ratio
 
     @cached_property
     def kn_pp(self):

@@ -60,11 +60,20 @@ class Grain:
     friction_pw: Sourced            #: grain-wall sliding friction coefficient
     restitution_pp: Sourced         #: grain-grain coefficient of restitution
     restitution_pw: Sourced         #: grain-wall coefficient of restitution
+    #: bulk lateral pressure ratio K = sigma_h / sigma_v (Janssen)
+    lateral_pressure_ratio: Sourced = Sourced(None, "not found", "no source found for a lateral pressure "
+                                              "ratio; searched: EN 1991-4 Annex E and ASAE EP433 tables "
+                                              "(pages corpus): only wheat's row was readable")
+    #: angle of internal friction of the bulk, degrees (Jaky's K = 1 - sin phi where K is missing)
+    internal_friction_deg: Sourced = Sourced(None, "not found", "no source found for an angle of internal "
+                                             "friction; searched: EN 1991-4 Annex E tables (pages corpus): "
+                                             "only wheat's row was readable")
 
 
 #: the Sourced fields of :class:`Grain`, in order
 GRAIN_FIELDS = ("axes_mm", "axes_sd_mm", "particle_density_kg_m3", "bulk_porosity",
-                "friction_pp", "friction_pw", "restitution_pp", "restitution_pw")
+                "friction_pp", "friction_pw", "restitution_pp", "restitution_pw",
+                "lateral_pressure_ratio", "internal_friction_deg")
 
 _SD_SEARCH = "the abstracts found report means/ranges only, no standard deviations"
 _THESIS = ("thesis Table 3.1 (seed/thesis.txt; PFC parameters reported by Liu et al. 2008a; "
@@ -117,6 +126,9 @@ _SORGHUM = ("Effect of moisture content on physical and aerodynamic properties o
             "of Medical and Bioengineering 2014, abstract (9.06-29.15 % w.b.); https://mdsite.deno."
             "dev/https://www.academia.edu/106744912/Effect%5Fof%5FMoisture%5FContent%5Fon%5F"
             "Physical%5Fand%5FAerodynamic%5FProperties%5Fof%5FSorghum")
+_EN1991_WHEAT = ("EN 1991-4:2006 (Eurocode 1, Actions on silos and tanks) Annex E Table E.1, wheat row "
+                 "(mean values), as tabulated in Studia Geotechnica et Mechanica 2018, "
+                 "doi:10.2478/sgem-2018-0043; https://reference-global.com/article/10.2478/sgem-2018-0043")
 _DEM_SEARCH = "DEM calibration abstracts (pages corpus) for this crop gave no value"
 
 GRAINS: dict[str, Grain] = {
@@ -158,6 +170,11 @@ GRAINS: dict[str, Grain] = {
                             "the 2003 wheat abstract: 0.279-0.450 over several surfaces"),
         restitution_pp=Sourced(0.52, _WHEAT_DEM, "wheat-wheat"),
         restitution_pw=Sourced(0.47, _WHEAT_DEM, "wheat-steel"),
+        lateral_pressure_ratio=Sourced(0.54, _EN1991_WHEAT, "K_m, factor a_K 1.11 (0.49-0.60); the "
+                                       "same row: unit weight 7.5-9.0 kN/m^3, wall friction 0.57 "
+                                       "against concrete (D3)"),
+        internal_friction_deg=Sourced(30.0, _EN1991_WHEAT, "phi_im, factor a_phi 1.12 "
+                                      "(26.8-33.6 degrees)"),
     ),
     "shelled_corn": Grain(
         "shelled_corn",

@@ -5,23 +5,31 @@
     python -m dem.pack --scene cyl-bin --out cyl.csv
     python -m dem.pack --scene box --size 0.1 0.05 --height 0.1 --out box.csv
     python -m dem.pack --scene cylinder --size 0.08 --height 0.1 --out cyl_small.csv
-    python -m dem.pack --scene box --grain soybean --out bed.csv     # multi-sphere grains
-    python -m dem.pack --scene box --grain wheat --porosity 0.402 --out bed.csv   # search, 3-6 packings
+    python -m dem.pack --scene box --grain soybean --out bed.csv     # multi-sphere grains, rain-filled
+    python -m dem.pack --scene box --grain wheat --fill spout --spout-diameter 0.02 --out pile.csv
+    python -m dem.pack --scene box --grain wheat --depth 3.4 --bin-diameter 6 --out deep.csv  # overburden
+    python -m dem.pack --scene box --grain wheat --fill grow --porosity 0.402 --out bed.csv   # search
     python -m dem.pack --scene box --grain my_kernel.csv --template-units mm --out bed.csv
 
 With ``--grain`` (a library name or a template CSV x,y,z,r) the grains are rigid multi-sphere
-clumps (:mod:`dem.clumps`, :mod:`dem._clump_pack`): the CSV gains ``grain_id`` and a second file
-``<stem>.grains.csv`` has one row per grain; ``--scene box`` alone means 0.04 x 0.04 x 0.04 m.
+clumps (:mod:`dem.clumps`): the CSV gains ``grain_id`` and a second file ``<stem>.grains.csv`` has
+one row per grain; ``--scene box`` alone means 0.04 x 0.04 x 0.04 m. Grains are poured
+(``--fill rain``, the default, or ``spout``; :mod:`dem._pour`) with their real masses and the
+library's friction and restitution, or grown in place (``--fill grow``, :mod:`dem._clump_pack`).
+``--depth Z --bin-diameter D`` (or ``--stress PA``) then loads the poured bed through a lid
+servo-controlled to Janssen's vertical stress at that depth (:mod:`dem._load`).
 
 Writes the packing CSV (``x,y,z,r``, m) and its JSON summary (same stem). Exit status 0
-on success, 2 on bad arguments, 1 when the simulation went unstable (nothing written) or
-stopped at the step limit before equilibrium (written, marked ``"converged": false``).
+on success, 2 on bad arguments (nothing written), 1 when the simulation went unstable (nothing
+written) or stopped at the step limit before equilibrium (written, marked ``"converged": false``).
 """
 
 from __future__ import annotations
 
 import argparse
+import math
 import sys
+import time
 from dataclasses import replace
 from pathlib import Path
 
@@ -33,6 +41,9 @@ from ._container import SCENE_DEFAULTS, SCENES, default_measure_spheres
 from ._material import Material
 from ._io import summary_path, write_packing
 from ._clump_pack import grains_path, pack_grains, pack_grains_to_porosity, write_grain_packing
+from ._contacts import damping_ratio_for_restitution
+from ._load import janssen_stress, load_bed
+from ._pour import FILL_METHODS, FillOptions, check_fill_options, poured_bed_summary, pour_grains
 from ._procedures import PROCEDURES, pack_bed
 from .grains import grain
 from .templates import resolve_template
@@ -69,7 +80,8 @@ def _parser():
                    help="--grain: grain-grain friction while the grains grow and fall (default 0: the densest "
                         "bed; friction then loosens it); the material's friction holds afterwards")
     p.add_argument("--n-particles", type=int, help="default: thesis Eq. 3.10")
-    p.add_argument("--mass-scale", type=float, default=100.0, help="density scaling during packing (1 = none)")
+    p.add_argument("--mass-scale", type=float, default=None,
+                   help="density scaling S during packing (1 = real masses; default 100, poured grain fills 1)")
     p.add_argument("--packing-friction", type=float, default=None,
                    help="particle friction during expansion/closed stage (default: the material's)")
     p.add_argument("--procedure", choices=list(PROCEDURES), default=None,
@@ -111,6 +123,25 @@ def _parser():
                    "barley, canola) or a template CSV x,y,z,r; material from the grain library where it has values")
     p.add_argument("--template-units", choices=["mm", "m"], default="mm", help="units of a template CSV (default mm)")
     p.add_argument("--n-grains", type=int, default=None, help="--grain: number of grains (default from --porosity)")
+    p.add_argument("--fill", choices=FILL_METHODS, default=None,
+                   help="--grain: 'rain' (default: a spreader, grains over the whole cross-section), 'spout' (a "
+                        "centre spout; the pile forms at its angle of repose), 'grow' (grown in place and settled; "
+                        "the default with --porosity, --deposition-friction or --size-cv)")
+    p.add_argument("--drop-height", type=float, default=None,
+                   help="rain/spout: height the grains fall from onto the surface, m (default 0.3, at most 10)")
+    p.add_argument("--rate", type=float, default=None,
+                   help="rain/spout: mass flow, kg/s (default: the surface rises one grain diameter per "
+                        "rebound flight 2 e v0/g of a landed grain, so it is at rest before it is covered)")
+    p.add_argument("--spout-diameter", type=float, default=None,
+                   help="spout: diameter, m (default three kernel lengths)")
+    p.add_argument("--depth", type=float, default=None,
+                   help="rain/spout: load the bed to Janssen's vertical stress at this depth of a bin, m "
+                        "(needs --bin-diameter)")
+    p.add_argument("--bin-diameter", type=float, default=None, help="--depth: the bin's diameter, m")
+    p.add_argument("--bin-height", type=float, default=None,
+                   help="--depth: the bin's wall height, m (a deeper --depth is refused)")
+    p.add_argument("--stress", type=float, default=None,
+                   help="rain/spout: load the bed through a lid to this vertical stress, Pa (not with --depth)")
     p.add_argument("--quiet", action="store_true", help="no progress lines on stderr")
     return p
 
@@ -132,16 +163,19 @@ def _grain_material(args, name):
     return replace(mat, **vals), used
 
 
-def _pack_grains(args) -> int:
+def _pack_grains(args, fill) -> int:
     template = resolve_template(args.grain, units=args.template_units)
     size, height = args.size, args.height
     if args.scene == "box" and size is None and height is None:
         size, height = [0.04, 0.04], 0.04
     container = resolve_container(args.scene, size_m=size, height_m=height)
+    if fill.method != "grow":
+        return _pour(args, fill, template, container)
     material, used = _grain_material(args, template.name)
     pr = progress_printer(quiet=args.quiet)
     size_cv, size_cv_source = _size_cv(args, template.name)
-    kw = dict(material=material, n_grains=args.n_grains, rng=args.seed, mass_scale=args.mass_scale, size_cv=size_cv,
+    kw = dict(material=material, n_grains=args.n_grains, rng=args.seed, mass_scale=args.mass_scale or 100.0,
+              size_cv=size_cv,
               tol=args.tol, max_steps=GRAIN_MAX_STEPS if args.max_steps is None else args.max_steps,
               progress=lambda sim, f: pr("grains", _Progress(sim), None))
     if args.porosity is not None and args.deposition_friction is None:
@@ -158,7 +192,7 @@ def _pack_grains(args) -> int:
         xs, r, gid, grains, s = pack_grains(container, template, porosity=_grain_porosity(args, template.name),
                                             deposition_friction=args.deposition_friction or 0.0, **kw)
     s.update(scene=args.scene, seed=args.seed, container=container.to_dict(), material_from_library=used,
-             size_cv_source=size_cv_source)
+             size_cv_source=size_cv_source, fill={"method": "grow"})
     settle = s["stages"]["settle"]
     s["converged"] = bool(settle["converged"])
     write_grain_packing(args.out, xs, r, gid, grains, s)
@@ -257,13 +291,181 @@ def _check_outputs(args):
         check_output(f, f"--out {args.out}: companion")
 
 
+_POUR_ONLY = (("--drop-height", "drop_height"), ("--rate", "rate"), ("--spout-diameter", "spout_diameter"),
+              ("--depth", "depth"), ("--bin-diameter", "bin_diameter"), ("--bin-height", "bin_height"),
+              ("--stress", "stress"))
+
+
+def _fill_options(args):
+    """The fill of a grain bed from the command line (None for spheres); ValueError naming the
+    option and its value for every combination or value the fill and the load refuse."""
+    given = [opt for opt, key in _POUR_ONLY if getattr(args, key) is not None]
+    if args.grain is None:
+        if given or args.fill is not None:
+            raise ValueError(f"{(given or ['--fill'])[0]} needs --grain (poured fills and loads are grain beds)")
+        return None
+    grow_only = args.porosity is not None or args.deposition_friction is not None or args.size_cv is not None
+    method = args.fill or ("grow" if grow_only else "rain")
+    if method == "grow":
+        if given:
+            raise ValueError(f"{given[0]} needs a poured fill (--fill rain or spout), not --fill grow")
+        return FillOptions(method="grow")
+    if args.porosity is not None:
+        raise ValueError(f"--porosity {args.porosity:g} with --fill {method}: a poured bed makes its own porosity; "
+                         "the porosity search grows the bed (--fill grow)")
+    if args.deposition_friction is not None:
+        raise ValueError("--deposition-friction belongs to --fill grow (a poured bed keeps the library's friction)")
+    if args.size_cv is not None:
+        raise ValueError(f"--size-cv {args.size_cv:g} with --fill {method}: poured fills take one kernel size")
+    if args.spout_diameter is not None and method != "spout":
+        raise ValueError(f"--spout-diameter {args.spout_diameter:g} needs --fill spout")
+    for opt, key in (("--depth", "depth"), ("--bin-diameter", "bin_diameter"), ("--bin-height", "bin_height")):
+        v = getattr(args, key)
+        if v is not None and not (math.isfinite(v) and (v >= 0 if key == "depth" else v > 0)):
+            raise ValueError(f"{opt} {v:g} m: must be a finite length, {'>= 0' if key == 'depth' else '> 0'}")
+    if args.stress is not None:
+        if not (math.isfinite(args.stress) and args.stress >= 0):
+            raise ValueError(f"--stress {args.stress:g} Pa: must be finite and >= 0")
+        if args.depth is not None:
+            raise ValueError(f"--stress {args.stress:g} together with --depth {args.depth:g}: give one")
+    if args.depth is not None and args.bin_diameter is None:
+        raise ValueError(f"--depth {args.depth:g} needs --bin-diameter (Janssen's stress depends on it)")
+    if args.depth is None and (args.bin_diameter is not None or args.bin_height is not None):
+        raise ValueError("--bin-diameter and --bin-height go with --depth")
+    if args.depth is not None and args.bin_height is not None and args.depth > args.bin_height:
+        raise ValueError(f"--depth {args.depth:g} m is beyond the bin's wall height (--bin-height {args.bin_height:g} m)")
+    try:
+        return FillOptions(method=method, drop_height_m=0.3 if args.drop_height is None else args.drop_height,
+                           rate_kg_s=args.rate, spout_diameter_m=args.spout_diameter,
+                           mass_scale=1.0 if args.mass_scale is None else args.mass_scale)
+    except ValueError as e:
+        opt = {"drop height": "--drop-height", "rate": "--rate", "spout diameter": "--spout-diameter",
+               "mass scale": "--mass-scale"}
+        raise ValueError(next((f"{o} " + str(e).split(" ", len(k.split())) [-1] for k, o in opt.items()
+                               if str(e).startswith(k)), str(e))) from None
+
+
+def _janssen_inputs(name):
+    """(wall friction, lateral pressure ratio K, what they are) of a library grain for Janssen's
+    stress: the grain-wall friction the DEM walls use, K measured or else Jaky's 1 - sin(phi);
+    ValueError when the library lacks them."""
+    try:
+        g = grain(name)
+    except ValueError:
+        raise ValueError(f"--depth needs a library grain (wall friction and K); {name!r} is a template file: "
+                         "give --stress") from None
+    mu = g.friction_pw.value
+    if mu is None:
+        raise ValueError(f"--depth: the grain library has no wall friction for {g.name}: give --stress")
+    if g.lateral_pressure_ratio.value is not None:
+        k, k_src = g.lateral_pressure_ratio.value, f"measured: {g.lateral_pressure_ratio.source}"
+    elif g.internal_friction_deg.value is not None:
+        phi = g.internal_friction_deg.value
+        k, k_src = 1 - math.sin(math.radians(phi)), f"Jaky 1 - sin({phi:g} deg): {g.internal_friction_deg.source}"
+    else:
+        raise ValueError(f"--depth: the grain library has no lateral pressure ratio K nor angle of internal friction "
+                         f"for {g.name} (Janssen's stress needs one): give --stress")
+    return float(mu), float(k), {"wall_friction": mu, "wall_friction_source": g.friction_pw.source,
+                                 "lateral_pressure_ratio": k, "lateral_pressure_ratio_source": k_src}
+
+
+def _pour_material(args, name):
+    """The grow fill's library material plus the damping of the library's restitution
+    (grain-grain, and grain-wall where sourced; else the grain-grain value)."""
+    mat, used = _grain_material(args, name)
+    try:
+        g = grain(name)
+    except ValueError:
+        return mat, used, None
+    e_pp, e_pw = g.restitution_pp.value, g.restitution_pw.value
+    if e_pp is None:
+        return mat, used, None
+    used["restitution_pp"] = {"value": e_pp, "source": g.restitution_pp.source}
+    if e_pw is not None:
+        used["restitution_pw"] = {"value": e_pw, "source": g.restitution_pw.source}
+    mat = replace(mat, damping_ratio=float(damping_ratio_for_restitution(e_pp)),
+                  wall_damping_ratio=float(damping_ratio_for_restitution(e_pw if e_pw is not None else e_pp)))
+    return mat, used, float(e_pp)
+
+
+def _pour(args, fill, template, container) -> int:
+    """--fill rain|spout, then the load of --depth or --stress."""
+    t0, c0 = time.perf_counter(), time.process_time()
+    check_fill_options(fill, container, template)
+    janssen = _janssen_inputs(template.name) if args.depth is not None else None
+    material, used, e_pp = _pour_material(args, template.name)
+    phi_count = _grain_porosity(args, template.name)
+    n = args.n_grains if args.n_grains is not None else int((1 - phi_count) * container.volume_m3 / template.volume_m3)
+    if n < 1:
+        raise ValueError(f"no grain of {template.volume_m3:.3g} m^3 fits the container")
+    pr = progress_printer(quiet=args.quiet)
+    max_steps = GRAIN_MAX_STEPS if args.max_steps is None else args.max_steps
+    cb = lambda sim, f: pr(fill.method, _Progress(sim), None)
+    sim, record = pour_grains(container, template, material=material, fill=fill, n_grains=n, rng=args.seed,
+                              tol=args.tol, max_steps=max_steps, progress=cb, restitution=e_pp, porosity=phi_count)
+    s = {"n_grains": n, "n_spheres": sim.n, "template": template.name, "template_source": template.source,
+         "spheres_per_grain": template.n, "grain_volume_m3": template.volume_m3, "fill": record}
+    converged = record["converged"]
+    stress = args.stress
+    if janssen is not None or (stress is not None and stress > 0):
+        before = poured_bed_summary(sim, template, container, record)
+        load = {"porosity_before_load": before["porosity_network_region"]}
+        if janssen is not None:
+            mu, k, load_src = janssen
+            rho_b = material.density_kg_m3 * (1 - before["porosity_network_region"])
+            stress = janssen_stress(args.depth, bulk_density_kg_m3=rho_b, diameter_m=args.bin_diameter,
+                                    wall_friction=mu, lateral_ratio=k)
+            load.update(depth_m=args.depth, bin_diameter_m=args.bin_diameter, bin_height_m=args.bin_height,
+                        bulk_density_kg_m3=rho_b, janssen=load_src)
+        if stress > 0:
+            load.update(load_bed(sim, container, stress, tol=args.tol, max_steps=max_steps,
+                                 callback=lambda sim, f: pr("load", _Progress(sim), None)))
+            converged = converged and load["converged"]
+        else:
+            load.update(target_pa=0.0, converged=True)
+        s["load"] = load
+    s.update(poured_bed_summary(sim, template, container, record))
+    s.update(steps=sim.steps, simulated_time_s=sim.time_s, dt_s=sim.dt, mass_scale=fill.mass_scale,
+             wall_time_s=time.perf_counter() - t0, cpu_time_s=time.process_time() - c0,
+             particle_steps=record["particle_steps"] + s.get("load", {}).get("steps", 0) * sim.n,
+             material={k: getattr(material, k) for k in material.__dataclass_fields__},
+             engine="dem.clumps (numba: the sphere step's kernels and a rigid-body update)",
+             scene=args.scene, seed=args.seed, container=container.to_dict(), material_from_library=used,
+             converged=bool(converged))
+    s["particle_steps_per_cpu_s"] = s["particle_steps"] / max(s["cpu_time_s"], 1e-9)
+    write_grain_packing(args.out, sim.sphere_centers(), sim.radii.copy(), sim.gid.copy(),
+                        {"centers": sim.X.copy(), "quaternions": sim.q.copy(), "volume_m3": sim.volume_m3.copy(),
+                         "template": [template.name] * sim.n_grains}, s)
+    print(f"{n} grains of {template.n} spheres ({sim.n} spheres), {fill.method} from {fill.drop_height_m:g} m at "
+          f"{record['rate_kg_s']:.3g} kg/s -> {args.out} (+ {grains_path(args.out).name}, {summary_path(args.out).name})")
+    print(f"porosity (union of spheres): network's sample region {s['porosity_network_region']:.4f} +- "
+          f"{s['porosity_network_region_error']:.4f}; orientation order S {_num(s['orientation_order_S'], 3)}"
+          + (f"; angle of repose {_num(s['angle_of_repose']['angle_deg'], 1)} deg" if "angle_of_repose" in s else "")
+          + f"; {sim.steps} steps, wall {s['wall_time_s']:.1f} s")
+    if "load" in s and s["load"].get("target_pa"):
+        ld = s["load"]
+        print(f"load: lid stress {ld['lid_stress_pa']:.4g} Pa (target {ld['target_pa']:.4g} Pa), porosity "
+              f"{ld['porosity_before_load']:.4f} -> {s['porosity_network_region']:.4f}")
+    if not converged:
+        what = "fill" if not record["converged"] else "load"
+        st = record["rest"] if what == "fill" else s["load"]
+        print(f"error: not at rest: the {what} stopped at its step limit ({st['steps']} steps, unbalanced force "
+              f"ratio {st['ratio']:.3g} > tol {args.tol:.3g}); written with \"converged\": false (give --max-steps)",
+              file=sys.stderr)
+        return EXIT_FAILED
+    return 0
+
+
 def _pack(args) -> int:
     check_seed(args.seed)
     if args.max_steps is not None and args.max_steps < 1:
         raise ValueError(f"--max-steps must be >= 1, got {args.max_steps}")
+    fill = _fill_options(args)
     _check_outputs(args)
     if args.grain is not None:
-        return _pack_grains(args)
+        return _pack_grains(args, fill)
+    if args.mass_scale is None:
+        args.mass_scale = 100.0
     material = _material(args)
     container = resolve_container(args.scene, size_m=args.size, height_m=args.height)
     measure = None
@@ -304,8 +506,8 @@ def _pack(args) -> int:
     return 0
 
 
-def _num(v) -> str:
-    return "n/a" if v is None else f"{v:.2f}"
+def _num(v, digits=2) -> str:
+    return "n/a" if v is None else f"{v:.{digits}f}"
 
 
 def main(argv=None) -> int:

@@ -51,7 +51,7 @@ def test_grain_beds_take_the_users_step_limit(tmp_path, monkeypatch, capsys):
         raise KeyboardInterrupt          # stop before any work: exit 1, nothing written
 
     monkeypatch.setattr(pack, "pack_grains", fake_pack_grains)
-    base = ["--scene", "box", "--grain", "soybean", "--out", str(tmp_path / "g.csv"), "--quiet"]
+    base = ["--scene", "box", "--grain", "soybean", "--fill", "grow", "--out", str(tmp_path / "g.csv"), "--quiet"]
     assert pack.main([*base, "--max-steps", "240000"]) == 1
     assert pack.main(base) == 1
     assert seen == [240000, pack.GRAIN_MAX_STEPS] and pack.GRAIN_MAX_STEPS == 60000

@@ -96,7 +96,7 @@ def test_grain_bed_not_at_equilibrium_exits_1(tmp_path, capsys):
     tpl.write_text("x,y,z,r\n0,0,0,1\n")
     out = tmp_path / "bed.csv"
     assert main(["--scene", "box", "--size", "0.01", "0.01", "--height", "0.01", "--grain",
-                 str(tpl), "--max-steps", "200", "--out", str(out), "--quiet"]) == 1
+                 str(tpl), "--fill", "grow", "--max-steps", "200", "--out", str(out), "--quiet"]) == 1
     err = capsys.readouterr().err.strip().splitlines()
     assert len(err) == 1 and err[0].startswith("error: not at equilibrium"), err
     s = json.loads(out.with_suffix(".json").read_text())

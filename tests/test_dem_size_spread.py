@@ -74,6 +74,6 @@ def test_cli_bad_spread_exit_2_and_library_default_stated(tmp_path, capsys):
                       "--size-cv", "0.5", "--out", str(out), "--quiet"])
     assert code == 2 and "size spread" in capsys.readouterr().err and not out.exists()
     code = pack.main(["--scene", "box", "--size", "0.03", "0.03", "--height", "0.03", "--grain", "soybean",
-                      "--n-grains", "8", "--max-steps", "300", "--out", str(out), "--quiet"])
+                      "--fill", "grow", "--n-grains", "8", "--max-steps", "300", "--out", str(out), "--quiet"])
     summary = json.loads(out.with_suffix(".json").read_text())
     assert summary["size_cv"] == 0.0 and "no axis standard deviations" in summary["size_cv_source"]

@@ -19,6 +19,8 @@ BOUNDS = {
     "restitution_pw": (0.1, 0.95),
     "axes_mm": (1.0, 15.0),
     "axes_sd_mm": (0.0, 3.0),
+    "lateral_pressure_ratio": (0.2, 1.0),
+    "internal_friction_deg": (15.0, 50.0),
 }
 
 

@@ -1,0 +1,455 @@
+r"""Poured fills: grains rain over the whole cross-section or run from a centre spout.
+
+A bin is filled by pouring: from a spreader (a uniform rain over the cross-section) or a centre
+spout (a pile at its angle of repose whose grains slide down the slope). :func:`pour_grains`
+does the same with rigid multi-sphere grains (:class:`dem.clumps.ClumpSimulation`), their real
+masses (``FillOptions.mass_scale`` = 1) and the contact friction and restitution of the grain
+library.
+
+**Entry.** The fall from the drop height H costs no steps: a grain enters just above the bed
+surface with the speed of that fall,
+
+.. math:: v_0 = \min\left(\sqrt{2 g H},\; v_t\right),\qquad
+          v_t = \sqrt{\frac{4 g d_v (\rho_p - \rho_a)}{3 C_D \rho_a}},
+
+capped at the terminal velocity :math:`v_t` of its volume-equivalent sphere (diameter
+:math:`d_v`) in air (:math:`\rho_a` = 1.2 kg/m³, 20 °C) with Newton's drag coefficient
+:math:`C_D` = 0.44 (constant for a sphere at 10³ < Re < 2·10⁵; Clift, Grace & Weber 1978,
+*Bubbles, Drops and Particles*, ch. 5). A wheat kernel (:math:`d_v` = 4.1 mm) has
+:math:`v_t` = 11.2 m/s at Re ≈ 3000: the cap acts only for drops above 6.4 m. Kernels
+enter with a random orientation (uniform on SO(3)) and no spin.
+
+**Stream.** Grains enter in batches every :math:`\tau` (:func:`batch_interval`), each batch the
+mass :math:`\dot m \tau` of the stream, placed at random without overlap (bounding spheres)
+in the slab the stream fills in that time, :math:`h = v_0\tau` thick, starting one bounding
+radius above the surface (the highest sphere of the grains not falling at entry speed; under
+the spout, within its footprint). A grain placed at height :math:`s` above the slab's bottom
+gets the speed it has there on its fall, :math:`\sqrt{v_0^2 - 2 g s}` (so every grain reaches
+the surface at :math:`v_0`). Rain: the footprint is the whole cross-section; spout: a disk of
+the spout's diameter about the axis.
+
+**Rate.** The default mass flow makes the surface rise one grain diameter :math:`d_v` in the
+time of a landed grain's first rebound flight, :math:`t_f = 2 e v_0 / g` (grain-grain
+restitution e): :math:`\dot m = \rho_p (1-\varphi) A\, d_v g/(2 e v_0)` (φ the middle of the
+grain's measured loose-fill porosity). A grain hitting the bed loses more than a grain-grain
+contact takes, so in that time it has come to rest before the next layer covers it.
+
+**Rest.** When all grains are in, the bed settles until the mean unbalanced-force ratio is
+below ``tol`` (``converged``) or ``max_steps`` pass.
+
+**Measured.** The long-axis orientation order :math:`S = \langle \tfrac32\cos^2\theta -
+\tfrac12\rangle` (θ between a kernel's long axis and the vertical; 0 random, -1/2 all lying
+flat, 1 all upright), porosity in 10 layers from the floor to the surface, and, for a spout,
+the angle of repose of the pile's slope (:func:`angle_of_repose`).
+"""
+
+from __future__ import annotations
+
+import math
+import time
+from dataclasses import dataclass
+
+import numpy as np
+from scipy.spatial import cKDTree
+
+from ._contacts import restitution_coefficient
+from ._rigid import quat_to_matrix, random_quaternions
+from .clumps import ClumpSimulation
+
+__all__ = ["FILL_METHODS", "FillOptions", "AIR_DENSITY_KG_M3", "DRAG_COEFFICIENT", "MAX_DROP_HEIGHT_M",
+           "entry_speed", "terminal_velocity", "default_rate", "batch_interval", "pour_grains",
+           "orientation_order", "porosity_by_depth", "surface_heights", "angle_of_repose",
+           "check_fill_options"]
+
+#: fills of a grain bed: 'rain' (spreader), 'spout' (centre spout), 'grow' (grown in place)
+FILL_METHODS = ("rain", "spout", "grow")
+#: air at 20 °C, kg/m³
+AIR_DENSITY_KG_M3 = 1.2
+#: Newton's drag coefficient of a sphere, 10³ < Re < 2e5 (Clift, Grace & Weber 1978)
+DRAG_COEFFICIENT = 0.44
+#: highest drop height taken, m
+MAX_DROP_HEIGHT_M = 10.0
+#: gravity, m/s²
+G = 9.81
+
+
+@dataclass(frozen=True, kw_only=True)
+class FillOptions:
+    """How a grain bed is filled (module notes).
+
+    Parameters
+    ----------
+    method : {'rain', 'spout', 'grow'}
+        'rain' (default): a spreader, grains over the whole cross-section; 'spout': a centre
+        spout; 'grow': grains grown in place and settled (:func:`dem._clump_pack.pack_grains`).
+    drop_height_m : float
+        Height the grains fall from onto the surface, m, in (0, 10] (default 0.3).
+    rate_kg_s : float | None
+        Mass flow, kg/s, > 0; None: :func:`default_rate`.
+    spout_diameter_m : float | None
+        'spout': the spout's diameter, m; None: three kernel lengths.
+    mass_scale : float
+        Density scaling S >= 1 of the pour (default 1: real masses).
+    """
+
+    method: str = "rain"
+    drop_height_m: float = 0.3
+    rate_kg_s: float | None = None
+    spout_diameter_m: float | None = None
+    mass_scale: float = 1.0
+
+    def __post_init__(self):
+        if self.method not in FILL_METHODS:
+            raise ValueError(f"fill must be one of {', '.join(FILL_METHODS)}, got {self.method!r}")
+        h = self.drop_height_m
+        if not (math.isfinite(h) and 0 < h <= MAX_DROP_HEIGHT_M):
+            raise ValueError(f"drop height {h:g} m: must be > 0 and <= {MAX_DROP_HEIGHT_M:g} m")
+        if self.rate_kg_s is not None and not (math.isfinite(self.rate_kg_s) and self.rate_kg_s > 0):
+            raise ValueError(f"rate {self.rate_kg_s:g} kg/s: must be > 0")
+        d = self.spout_diameter_m
+        if d is not None and not (math.isfinite(d) and d > 0):
+            raise ValueError(f"spout diameter {d:g} m: must be > 0")
+        if not (math.isfinite(self.mass_scale) and self.mass_scale >= 1):
+            raise ValueError(f"mass scale {self.mass_scale:g}: must be >= 1")
+
+
+def terminal_velocity(diameter_m, density_kg_m3):
+    r"""Terminal velocity in air of a sphere of diameter ``diameter_m`` (m) and density
+    ``density_kg_m3``, m/s: :math:`\sqrt{4 g d (\rho_p - \rho_a)/(3 C_D \rho_a)}`, Newton's
+    regime (:data:`DRAG_COEFFICIENT`, :data:`AIR_DENSITY_KG_M3`).
+
+    >>> round(terminal_velocity(4.1e-3, 1240.0), 1)
+    11.2
+    """
+    return float(np.sqrt(4 * G * diameter_m * (density_kg_m3 - AIR_DENSITY_KG_M3)
+                         / (3 * DRAG_COEFFICIENT * AIR_DENSITY_KG_M3)))
+
+
+def entry_speed(drop_height_m, diameter_m, density_kg_m3):
+    r"""Speed of a grain reaching the surface from the drop height, :math:`\min(\sqrt{2gH}, v_t)`, m/s.
+
+    >>> round(entry_speed(0.3, 4.1e-3, 1240.0), 3)
+    2.426
+    """
+    return min(math.sqrt(2 * G * drop_height_m), terminal_velocity(diameter_m, density_kg_m3))
+
+
+def default_rate(area_m2, diameter_m, density_kg_m3, porosity, restitution, speed_m_s):
+    r"""Default mass flow, kg/s: the surface rises one grain diameter in a grain's first rebound
+    flight, :math:`\dot m = \rho_p(1-\varphi) A\, d_v g / (2 e v_0)` (module notes).
+
+    >>> round(default_rate(1.6e-3, 4.1e-3, 1240.0, 0.402, 0.52, 2.426), 5)
+    0.01891
+    """
+    t_flight = 2 * restitution * speed_m_s / G
+    return density_kg_m3 * (1 - porosity) * area_m2 * diameter_m / t_flight
+
+
+def batch_interval(speed_m_s, bounding_radius_m, drop_height_m):
+    """Time between two batches of the stream, s: the stream fills a slab 8 bounding radii thick
+    (``speed * tau``), at most half the drop height."""
+    return min(8 * bounding_radius_m, 0.5 * drop_height_m) / speed_m_s
+
+
+def check_fill_options(fill, container, template):
+    """ValueError naming the value when a fill does not fit ``container`` (a spout wider than
+    the container or narrower than a grain)."""
+    if fill.method != "spout" or fill.spout_diameter_m is None:
+        return
+    width = min(container.size_m)
+    if fill.spout_diameter_m > width:
+        raise ValueError(f"spout diameter {fill.spout_diameter_m:g} m is wider than the container "
+                         f"({width:g} m)")
+    if fill.spout_diameter_m < 2 * template.bounding_radius_m:
+        raise ValueError(f"spout diameter {fill.spout_diameter_m:g} m is narrower than a grain "
+                         f"({2 * template.bounding_radius_m:.4g} m across)")
+
+
+def _footprint(container, fill, template):
+    """(kind, size) where grain centres enter: ('box', (hx, hy)) or ('disk', radius), m."""
+    rb = template.bounding_radius_m
+    if fill.method == "spout":
+        d = fill.spout_diameter_m if fill.spout_diameter_m is not None else 3 * float(template.extent_m[0])
+        d = min(d, min(container.size_m))
+        return "disk", max(d / 2 - rb, 0.25 * rb), d
+    if container.kind == "box":
+        return "box", (container.size_m[0] / 2 - rb, container.size_m[1] / 2 - rb), None
+    return "disk", container.size_m[0] / 2 - rb, None
+
+
+def _sample_lateral(kind, size, n, rng):
+    if kind == "box":
+        return np.column_stack([rng.uniform(-size[0], size[0], n), rng.uniform(-size[1], size[1], n)])
+    rho = size * np.sqrt(rng.random(n))
+    phi = rng.uniform(0, 2 * np.pi, n)
+    return np.column_stack([rho * np.cos(phi), rho * np.sin(phi)])
+
+
+def _place(n, kind, size, z_lo, thickness, rb, old_x, rng, tries=200):
+    """n grain centres in the slab [z_lo, z_lo + thickness] over the footprint, bounding spheres
+    (radius rb) apart from each other and from the grains ``old_x`` (G, 3)."""
+    tree = cKDTree(old_x) if len(old_x) else None
+    placed = np.empty((0, 3))
+    for _ in range(tries):
+        need = n - len(placed)
+        if need <= 0:
+            break
+        m = 4 * need + 8
+        c = np.column_stack([_sample_lateral(kind, size, m, rng), z_lo + thickness * rng.random(m)])
+        ok = np.ones(m, bool)
+        if tree is not None:
+            ok &= np.isinf(tree.query(c, k=1, distance_upper_bound=2 * rb)[0])
+        for k in np.flatnonzero(ok):
+            if len(placed) >= n:
+                ok[k:] = False
+                break
+            if len(placed) and np.min(np.sum((placed - c[k]) ** 2, axis=1)) < (2 * rb) ** 2:
+                ok[k] = False
+                continue
+            placed = np.vstack([placed, c[k]])
+    if len(placed) < n:
+        raise ValueError(f"the stream is too dense to enter: {n} grains do not fit a slab "
+                         f"{thickness:.3g} m thick over the footprint; lower the rate or widen the spout")
+    return placed
+
+
+def _grown(sim, template, x_new, v_new, q_new):
+    """A ClumpSimulation holding ``sim``'s grains (state, contact springs, time) plus new ones."""
+    g_old, n_old = sim.n_grains, sim.n
+    x = np.vstack([sim.X, x_new])
+    q = np.vstack([sim.q, q_new])
+    new = ClumpSimulation([template], np.zeros(len(x), int), x, q, np.ones(len(x)), sim.walls, sim.material,
+                          mass_scale=sim.mass_scale, dt_safety=sim.dt_safety, skin_m=sim.verlet.skin,
+                          gravity_m_s2=sim.gravity_m_s2)
+    new.V[:g_old], new.V[g_old:] = sim.V, v_new
+    new.L[:g_old] = sim.L
+    new.time_s, new.steps = sim.time_s, sim.steps
+    n_new = new.n
+    keys = sim.verlet.keys
+    new.verlet.keys = (keys // n_old) * n_new + keys % n_old     # same (i, j), new N: still sorted
+    new.shear, new._touch = sim.shear.copy(), sim._touch.copy()  # remapped at the first rebuild
+    new.wall_shear[:, :n_old] = sim.wall_shear
+    new._wall_touch[:, :n_old] = sim._wall_touch
+    new.stats = sim.stats
+    new._poses()
+    return new
+
+
+def pour_grains(container, template, *, material, fill=FillOptions(), n_grains, rng=None, tol=2e-3,
+                max_steps=60_000, check_every=200, progress=None, restitution=None, porosity=0.4):
+    r"""Pour ``n_grains`` grains of ``template`` into ``container`` (module notes) and settle.
+
+    Parameters
+    ----------
+    container : Container
+    template : Template
+    material : Material
+        Density, stiffness, friction and damping (from the grains' restitution).
+    fill : FillOptions
+        'rain' or 'spout', drop height, rate, spout diameter, mass scale.
+    n_grains : int
+    rng : numpy.random.Generator | int | None
+    tol : float
+        Mean unbalanced-force ratio of the rest (after the last grain is in).
+    max_steps : int
+        Step budget of the rest.
+    restitution : float | None
+        Grain-grain restitution e of the default rate (None: from ``material.damping_ratio``).
+    porosity : float
+        Porosity φ of the default rate's bulk density.
+
+    Returns
+    -------
+    (ClumpSimulation, dict)
+        The settled simulation and the fill record: method, drop height, entry and terminal
+        speed, rate (and where it came from), spout diameter, mass scale, fill time and steps,
+        the rest stage (``steps``, ``ratio``, ``converged``).
+    """
+    if fill.method not in ("rain", "spout"):
+        raise ValueError(f"pour_grains pours 'rain' or 'spout', got {fill.method!r}")
+    check_fill_options(fill, container, template)
+    n_grains = int(n_grains)
+    if n_grains < 1:
+        raise ValueError(f"no grain to pour: n_grains = {n_grains}")
+    rng = np.random.default_rng(rng)
+    t0 = time.perf_counter()
+    psteps = 0
+    rho = material.density_kg_m3
+    d_v = 2 * template.equivalent_radius_m
+    rb = template.bounding_radius_m
+    v0 = entry_speed(fill.drop_height_m, d_v, rho)
+    e = float(restitution_coefficient(material.damping_ratio)) if restitution is None else float(restitution)
+    if fill.rate_kg_s is None:
+        rate = default_rate(container.area_m2, d_v, rho, porosity, e, v0)
+        rate_source = (f"default: surface rises one grain diameter ({d_v * 1e3:.2f} mm) per rebound flight "
+                       f"2 e v0 / g = {2 * e * v0 / G:.3f} s (e = {e:.3g}, bulk porosity {porosity:.3f})")
+    else:
+        rate, rate_source = float(fill.rate_kg_s), "given"
+    m_grain = rho * template.volume_m3
+    kind, size, spout_d = _footprint(container, fill, template)
+    area_in = 4 * size[0] * size[1] if kind == "box" else math.pi * size**2
+    tau = batch_interval(v0, rb, fill.drop_height_m)
+    per_batch = rate * tau / m_grain
+    walls = container.walls(lid=False)
+    sim = None
+    carry, inserted, batches = 0.0, 0, 0
+    steps_per_batch = None
+    while inserted < n_grains:
+        carry += per_batch
+        k = min(int(carry), n_grains - inserted)
+        if k == 0 and sim is None:
+            k = 1
+        carry -= k
+        if k:
+            if sim is None:
+                surface, old = 0.0, np.empty((0, 3))
+            else:
+                surface, old = _surface_for_entry(sim, kind, size, rb, v0), sim.X
+            x_new = _place(k, kind, size, surface + rb, v0 * tau, rb, old, rng)
+            s = x_new[:, 2] - (surface + rb)
+            v_new = np.zeros((k, 3))
+            v_new[:, 2] = -np.sqrt(np.maximum(v0**2 - 2 * G * s, 0.0))
+            q_new = random_quaternions(k, rng)
+            if sim is None:
+                sim = ClumpSimulation([template], np.zeros(k, int), x_new, q_new, np.ones(k), walls, material,
+                                      mass_scale=fill.mass_scale)
+                sim.V[:] = v_new
+                steps_per_batch = max(1, int(round(tau / sim.dt)))
+            else:
+                sim = _grown(sim, template, x_new, v_new, q_new)
+            inserted += k
+            batches += 1
+        psteps += sim.run(max_steps=steps_per_batch, check_every=check_every, callback=progress)["steps"] * sim.n
+    fill_time, fill_steps = sim.time_s, sim.steps
+    rest = sim.run(max_steps=max_steps, tol=tol, check_every=check_every, callback=progress)
+    psteps += rest["steps"] * sim.n
+    record = {"method": fill.method, "drop_height_m": fill.drop_height_m, "entry_speed_m_s": v0,
+              "terminal_velocity_m_s": terminal_velocity(d_v, rho),
+              "drag_law": (f"Newton's regime, C_D = {DRAG_COEFFICIENT} for a sphere of the kernel's volume "
+                           f"(d_v = {d_v * 1e3:.3f} mm) in air of {AIR_DENSITY_KG_M3} kg/m^3 (Clift, Grace & "
+                           "Weber 1978)"),
+              "rate_kg_s": rate, "rate_source": rate_source,
+              "surface_rise_m_s": rate / (rho * (1 - porosity) * container.area_m2),
+              "spout_diameter_m": spout_d, "entry_area_m2": area_in, "mass_scale": fill.mass_scale,
+              "restitution_pp": e, "batches": batches, "batch_interval_s": tau,
+              "fill_time_s": fill_time, "fill_steps": fill_steps,
+              "rest": rest, "converged": bool(rest["converged"]), "particle_steps": int(psteps),
+              "wall_time_s": time.perf_counter() - t0}
+    return sim, record
+
+
+def _surface_for_entry(sim, kind, size, rb, v0):
+    """Height of the bed surface under the footprint: the highest sphere top of the grains not
+    falling at entry speed (|V| < v0 / 2), m; 0 for an empty bin."""
+    xs = sim._x
+    slow = np.linalg.norm(sim.V, axis=1) < 0.5 * v0
+    keep = slow[sim.gid]
+    if kind == "disk":
+        keep &= np.hypot(xs[:, 0], xs[:, 1]) < size + 2 * rb
+    if not np.any(keep):
+        return 0.0
+    return float(np.max(xs[keep, 2] + sim.radii[keep]))
+
+
+def orientation_order(quaternions):
+    r"""Long-axis order about the vertical, :math:`S = \langle\tfrac32\cos^2\theta - \tfrac12\rangle`
+    (θ between the body x axis, a kernel's long axis, and z): 0 random, -1/2 all horizontal.
+
+    >>> orientation_order(np.array([[1.0, 0, 0, 0]]))   # x horizontal
+    -0.5
+    """
+    q = np.asarray(quaternions, dtype=float).reshape(-1, 4)
+    cz = quat_to_matrix(q)[:, 2, 0]
+    return float(np.mean(1.5 * cz**2 - 0.5))
+
+
+def surface_heights(centers, radii, lo_xy, hi_xy, cell_m):
+    """Highest sphere top in each lateral cell (cell size ``cell_m``) over [lo_xy, hi_xy], m;
+    NaN where a cell holds no sphere. Returns (cell centres (M, 2), heights (M,))."""
+    lo_xy, hi_xy = np.asarray(lo_xy, float), np.asarray(hi_xy, float)
+    nxy = np.maximum(1, np.floor((hi_xy - lo_xy) / cell_m).astype(int))
+    idx = np.floor((centers[:, :2] - lo_xy) / (hi_xy - lo_xy) * nxy).astype(int)
+    ok = np.all((idx >= 0) & (idx < nxy), axis=1)
+    flat = idx[ok, 0] * nxy[1] + idx[ok, 1]
+    top = np.full(nxy[0] * nxy[1], -np.inf)
+    np.maximum.at(top, flat, centers[ok, 2] + radii[ok])
+    top[np.isinf(top)] = np.nan
+    ix, iy = np.divmod(np.arange(nxy[0] * nxy[1]), nxy[1])
+    cxy = lo_xy + (np.column_stack([ix, iy]) + 0.5) * (hi_xy - lo_xy) / nxy
+    return cxy, top
+
+
+def angle_of_repose(centers, radii, container, *, inner_m, cell_m):
+    r"""Angle of repose of a centre pile, degrees, and the fit: the highest sphere top h in
+    lateral cells (:func:`surface_heights`) against the distance r from the axis, a straight line
+    :math:`h = h_0 - r\tan\alpha` fitted by least squares over the cells farther than ``inner_m``
+    from the axis and at least one cell from every wall (a box's corners included).
+
+    Returns dict: ``angle_deg``, ``r_range_m``, ``cells``, ``rms_m`` (residual).
+    """
+    if container.kind == "box":
+        hx, hy = container.size_m[0] / 2, container.size_m[1] / 2
+        cxy, h = surface_heights(centers, radii, (-hx, -hy), (hx, hy), cell_m)
+        away = (np.abs(cxy[:, 0]) < hx - cell_m) & (np.abs(cxy[:, 1]) < hy - cell_m)
+    else:
+        rad = container.size_m[0] / 2
+        cxy, h = surface_heights(centers, radii, (-rad, -rad), (rad, rad), cell_m)
+        away = np.hypot(cxy[:, 0], cxy[:, 1]) < rad - cell_m
+    r = np.hypot(cxy[:, 0], cxy[:, 1])
+    sel = np.isfinite(h) & (r > inner_m) & away
+    rng = [float(inner_m), float(r[sel].max()) if sel.any() else float(inner_m)]
+    if sel.sum() < 3 or np.ptp(r[sel]) < cell_m:
+        return {"angle_deg": None, "r_range_m": rng, "cells": int(sel.sum()), "rms_m": None}
+    a, b = np.polyfit(r[sel], h[sel], 1)
+    res = h[sel] - (a * r[sel] + b)
+    return {"angle_deg": float(np.degrees(np.arctan(-a))), "r_range_m": rng,
+            "cells": int(sel.sum()), "rms_m": float(np.sqrt(np.mean(res**2)))}
+
+
+def porosity_by_depth(centers, radii, lo_xy, hi_xy, surface_m, *, layers=10, porosity_fn):
+    """Porosity in ``layers`` equal horizontal slabs from the floor to ``surface_m`` over the
+    lateral box [lo_xy, hi_xy]; ``porosity_fn(lo, hi) -> (porosity, error)``. Listed from the
+    surface down: ``depth_m`` is each slab's middle below the surface."""
+    edges = np.linspace(0.0, surface_m, layers + 1)
+    out = []
+    for k in range(layers - 1, -1, -1):
+        lo = np.array([lo_xy[0], lo_xy[1], edges[k]])
+        hi = np.array([hi_xy[0], hi_xy[1], edges[k + 1]])
+        phi, err = porosity_fn(lo, hi)
+        out.append({"z_lo_m": float(edges[k]), "z_hi_m": float(edges[k + 1]),
+                    "depth_m": float(surface_m - 0.5 * (edges[k] + edges[k + 1])),
+                    "porosity": phi, "error": err})
+    return out
+
+
+
+def poured_bed_summary(sim, template, container, record):
+    """The summary entries of a poured bed: the porosities of :func:`dem._clump_pack.bed_porosities`,
+    ``orientation_order_S`` (grains with their centre in the interior box) and
+    ``orientation_order_S_all``, ``surface_m`` (mean of the highest sphere tops in cells one
+    grain diameter wide over the interior box), ``porosity_by_depth`` (10 layers from the floor
+    to ``surface_m`` over the interior box) and, for a spout, ``angle_of_repose``
+    (:func:`angle_of_repose`, from one spout radius plus one grain diameter out)."""
+    from ._clump_pack import bed_porosities, union_porosity_in_box
+
+    xs = sim.sphere_centers()
+    r = sim.radii.copy()
+    out = bed_porosities(xs, r, template, container, float(np.mean(sim.volume_m3)))
+    lo, hi = (np.array(b) for b in out["interior_box_m"])
+    inside = np.all((sim.X >= lo) & (sim.X <= hi), axis=1)
+    d_v = 2 * template.equivalent_radius_m
+    _, tops = surface_heights(xs, r, lo[:2], hi[:2], d_v)
+    surface = float(np.nanmean(tops)) if np.any(np.isfinite(tops)) else out["bed_top_m"]
+    out.update({
+        "orientation_order_S": orientation_order(sim.q[inside]) if inside.any() else None,
+        "orientation_order_S_all": orientation_order(sim.q),
+        "orientation_order_grains": int(inside.sum()),
+        "surface_m": surface,
+        "porosity_by_depth": porosity_by_depth(
+            xs, r, lo[:2], hi[:2], surface, layers=10,
+            porosity_fn=lambda a, b: union_porosity_in_box(xs, r, a, b, log2_points=12)),
+    })
+    if record["method"] == "spout":
+        out["angle_of_repose"] = angle_of_repose(xs, r, container, inner_m=record["spout_diameter_m"] / 2 + d_v,
+                                                 cell_m=d_v)
+    return out
