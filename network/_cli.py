@@ -10,6 +10,7 @@ the packing file's unit (``--units``, default m); physical quantities (``--depth
 
 from __future__ import annotations
 
+import argparse
 import math
 import os
 from pathlib import Path
@@ -21,7 +22,6 @@ from .core import (EXIT_BAD_INPUT, EXIT_FAILED, EXIT_OK, CliError, CliParser, ba
                    progress_log, run, warn)
 from .packing import (UNITS, check_three_dimensional, default_packing_path, read_container,
                       read_packing, scale_warning)
-from .flow import DEFAULT_INERTIAL_LAW, INERTIAL_LAWS
 
 __all__ = ["EXIT_OK", "EXIT_FAILED", "EXIT_BAD_INPUT", "CliError", "CliParser", "bad_input",
            "computing", "run", "finish", "progress_log", "add_packing", "add_sample", "add_air",
@@ -33,6 +33,19 @@ __all__ = ["EXIT_OK", "EXIT_FAILED", "EXIT_BAD_INPUT", "CliError", "CliParser", 
 #: Newton solve (Re_p 1e16 at 1e-20 Pa s: a gradient 8 times low, exit 0; at 1e-30 no
 #: convergence after two minutes).
 MIN_VISCOSITY_PA_S = 1e-7
+
+
+class RemovedOption(argparse.Action):
+    """An option the command does not take: its use is bad input (exit 2) whose one line names
+    what to use instead (``replacement``); hidden from ``--help``."""
+
+    def __init__(self, option_strings, dest, *, replacement: str, **kw):
+        kw.update(nargs="?", default=argparse.SUPPRESS, help=argparse.SUPPRESS)
+        super().__init__(option_strings, dest, **kw)
+        self.replacement = replacement
+
+    def __call__(self, parser, namespace, values, option_string=None):
+        parser.error(f"{option_string} is not an option: {self.replacement}")
 
 
 #: Largest particle Reynolds number the inertial law is checked at (against the Beetstra law
@@ -111,15 +124,10 @@ def add_air(ap, *, density: bool = True) -> None:
     if density:
         ap.add_argument("--density", type=float, default=RHO_AIR_KG_M3,
                         help="air density for the inertial losses, kg/m^3, > 0")
-        ap.add_argument("--inertial-law", default=DEFAULT_INERTIAL_LAW,
-                        choices=tuple(INERTIAL_LAWS),
-                        help="per-conduit inertial loss: window = the law from resolved 3-D "
-                             "pore bodies in a chain, its two constants from each conduit's "
-                             "window ratio (default), chain = the same with one pore's "
-                             "constants (the default of sessions 8-10), pore = one body alone "
-                             "(session 7's default), onset = laminar-jet expansion with X/(1+X) "
-                             "onset (before session 7), quadratic = flat-profile K q|q| from the "
-                             "start (docs/inertial-flow.md)")
+        ap.add_argument("--inertial-law", action=RemovedOption,
+                        replacement="the inertial loss is the conduit window law "
+                                    "(docs/inertial-flow.md); python -m network.solve "
+                                    "--stokes gives the linear (Stokes) answer")
 
 
 # ------------------------------------------------------------------ checks

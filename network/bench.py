@@ -121,15 +121,15 @@ def build_parser() -> CliParser:
                     help="run alone: wall time of the whole `python -m network.solve FILE` "
                          "command on the --sizes bench packings (default 5000 20000 here) and "
                          "the bundled scene, --stokes and default, --repeats runs each (default "
-                         "7 here) after a warm-up, against issue 18's targets and YADE's 0.84 s")
+                         "7 here) after a warm-up, against the targets of 0.8 s (5000) and 2 s "
+                         "(20000)")
     ap.add_argument("--yade", action="store_true",
                     help="with --per-packing: also time YADE's FlowEngine on the same packings "
                          "here (needs the yade program; docs/scripts/yade_flowengine.py)")
     ap.add_argument("--baseline", metavar="DIR", default=None,
-                    help="with --per-packing: an earlier commit of this checkout (e.g. b8b05a2, "
-                         "the code issue 18 timed; extracted for the run) or a source checkout "
-                         "of one, whose command runs right after each --stokes run of ours: "
-                         "the paired speed-up, on this host, beside the one the issue asks for")
+                    help="with --per-packing: a commit of this checkout (extracted for the run) "
+                         "or a source checkout, whose command runs right after each --stokes "
+                         "run of ours: the paired speed-up on this host")
     ap.add_argument("--one", default=None, help=argparse.SUPPRESS)
     ap.add_argument("--no-trace", action="store_true", help=argparse.SUPPRESS)
     return ap

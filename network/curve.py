@@ -28,7 +28,7 @@ from ._cli import (CliError, CliParser, add_air, add_packing, add_sample, add_ta
                    warn_curve)
 from .conductance import POLICIES
 from ._grains import d272_constants, d272_velocity_range, grains_with_d272, packing_grain
-from .flow import (DEFAULT_DEPTH_M, GRAINS, asabe_d272_gradient, ergun_gradient,
+from .flow import (DEFAULT_DEPTH_M, GRAINS, INERTIAL_LAW, asabe_d272_gradient, ergun_gradient,
                    solve_network)
 from .packing import default_packing_path, read_container
 from .pores import sample_region
@@ -212,7 +212,7 @@ def _main(args) -> int:
                             viscosity_pa_s=args.viscosity, velocity_m_s=us[0],
                             depth_m=args.depth, rtol=args.rtol, db=args.db, inertia=True,
                             density_kg_m3=args.density, curve_velocities_m_s=us[1:],
-                            inertial_law=args.inertial_law, inertial_workers=args.workers,
+                            inertial_workers=args.workers,
                             threads=args.workers)
         pts = [{k: p[k] for k in KEYS} | {"newton_iterations": p["newton_iterations"],
                                           "cg_iterations": p["cg_iterations"]}
@@ -239,7 +239,7 @@ def _main(args) -> int:
     print(f"total {total:.2f} s")
     out = {"packing": str(path), "units": args.units, "n_spheres": packing.n, "axis": args.axis,
            "grain": grain, "workers": args.workers, "density_kg_m3": args.density,
-           "inertial_law": args.inertial_law,
+           "inertial_law": INERTIAL_LAW,
            "viscosity_pa_s": args.viscosity,
            "porosity": res.porosity, "sauter_diameter_m": res.sauter_diameter_m,
            "permeability_stokes_m2": res.permeability_m2, "points": pts} | fits | {

@@ -257,7 +257,7 @@ def _main(args) -> int:
             viscosity_pa_s=args.viscosity, velocity_m_s=args.velocity, depth_m=args.depth,
             rtol=args.rtol, db=args.db, workers=args.workers, progress=not args.quiet,
             inertia=not args.stokes and args.conductance_model == "conduit",
-            density_kg_m3=args.density, inertial_law=args.inertial_law, tessellation=tess,
+            density_kg_m3=args.density, tessellation=tess,
             threads=args.threads)
         results = [dataclasses.replace(r, grain=grain) for r in results]
         written = [p for res in results for p in (_write_tables(res, tess, args, len(axes) > 1)

@@ -1,4 +1,4 @@
-"""Inertial network flow, network.curve and network.solve with inertia (issue 14)."""
+"""Inertial network flow, network.curve and network.solve with inertia."""
 
 import json
 
@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 from network import curve
-from network.conductance import contraction_coefficient, expansion_coefficient
+from network.conductance import expansion_coefficient
 from network.flow import conduit_flow, fit_curve, solve_inertial, solve_network
 from network.packing import default_packing_path, read_packing
 
@@ -29,7 +29,7 @@ def test_chain_of_conduits_exact():
 def test_signed_flow_and_loss_coefficients():
     q, w = conduit_flow(np.array([-1.5, 0.0]), np.ones(2), np.array([[9.0, 0.5], [1.0, 1.0]]))
     assert q.tolist() == [-1.0, 0.0] and w.tolist() == [0.5, 1.0]     # reverse uses K[:, 1]
-    assert contraction_coefficient(1.0) == 0.0 and expansion_coefficient(1.0) == 0.0
+    assert expansion_coefficient(1.0) == 0.0 and expansion_coefficient(0.0) == 1.0
 
 
 @pytest.fixture(scope="module")
@@ -55,9 +55,7 @@ def test_stokes_limit_mass_balance_and_iterations(scene):
         fixed[inl] = True
         fixed[pt.pressure_pa == 0] = True
         assert np.max(np.abs(net[~fixed])) <= 1e-10 * Q
-    # resistance grows with Re; the default law ('window' since session 11): k/k_app recorded
-    # with the nine-row window table ('chain', the default of sessions 8-10: 1.1777, 3.0273;
-    # session 8's chain 1.1621, 2.8877; 'pore' before: 1.1277 and 2.4000; onset: 1.09, 1.91)
+    # resistance grows with Re; the window law's k/k_app recorded with the nine-row table
     ratio = [scene.permeability_m2 / r["apparent_permeability_m2"] for r in rows]
     assert ratio[0] == pytest.approx(1.0, abs=1e-6) and 1.0 < ratio[2] < ratio[3]
     np.testing.assert_allclose(ratio[2:], [1.1677, 3.1076], rtol=2e-3)
@@ -114,17 +112,15 @@ def test_galerkin_preconditioner_is_the_hierarchy_for_its_own_matrix():
     assert it[0] <= 25
 
 
-def test_solve_reports_inertia_and_stokes_keeps_old_answer(tmp_path):
+def test_solve_reports_inertia_and_stokes_gives_the_linear_answer(tmp_path):
     out_i, out_s = tmp_path / "i.json", tmp_path / "s.json"
     from network import solve
     assert solve.main(["-q", "--json", str(out_i)]) == 0
     assert solve.main(["-q", "--stokes", "--json", str(out_s)]) == 0
     i, s = json.loads(out_i.read_text()), json.loads(out_s.read_text())
-    # the whole-sample Stokes answer of issue 12 (4.2023528e-08 m2, 1.4941630 Pa over 0.25 m)
-    # and the boundary-free one reported since the inset estimator (commit of
-    # docs/sample-boundary.md's change, faces weighted by their area in the window):
-    # 4.22808e-08 m2, 1.48507 Pa; reading every throat in one vertex order (cache/_order.py,
-    # session 21) moved them by +6e-5 and +7e-5: 4.2026085e-08 and 4.22839e-08 m2, 1.48496 Pa
+    # the whole-sample Stokes permeability and the inset one (faces weighted by their area in
+    # the window, docs/sample-boundary.md), every throat read in one vertex order
+    # (cache/_order.py): 4.2026085e-08 and 4.22839e-08 m2, 1.48496 Pa over 0.25 m
     assert s["permeability_whole_m2"] == pytest.approx(4.2026085e-08, rel=1e-7)
     assert s["permeability_m2"] == pytest.approx(4.22839e-08, rel=1e-5)
     assert s["pressure_drop_pa"] == pytest.approx(1.48496, rel=1e-5)
@@ -157,7 +153,7 @@ def test_curve_bad_input_exit_2(argv, match, capsys):
 
 @pytest.mark.parametrize("grain", ["wheat", "corn", "shelled_corn", "sorghum", "rice"])
 def test_curve_takes_every_grain_with_d272(grain):
-    """Issue 16 item 1: the grains with D272 constants (network._grains) are --grain choices."""
+    """The grains with D272 constants (network._grains) are --grain choices."""
     from network.flow import GRAINS
     args = curve.build_parser().parse_args(["--grain", grain])
     assert curve._check_options(args)

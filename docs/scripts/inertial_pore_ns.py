@@ -1,9 +1,9 @@
 """Steady 3-D Navier-Stokes through one regular tetrahedral pore body (docs/inertial-flow.md).
 
-The pore-body reference for the turning loss of ``network.validation.DERIVED_LAW``: four
-spheres of radius r at the vertices of a regular tetrahedron of edge L (default r 0.9, L 2:
-open windows, sigma = A_w/A_b = 0.637 in the conduit model's definition). The jet enters
-through face (0, 1, 2) from a prism of length e extruded below it (plug inflow at its far end,
+The pore-body reference for the turning loss of the conduit window law
+(``network.conductance.CHAIN_WINDOW_TABLE``): four spheres of radius r at the vertices of a
+regular tetrahedron of edge L (default r 0.9, L 2: open windows, sigma = A_w/A_b = 0.637 in the
+conduit model's definition). The jet enters through face (0, 1, 2) from a prism of length e extruded below it (plug inflow at its far end,
 no-slip on spheres and prism sides) and leaves through the three other faces (do-nothing
 outlets). Taylor-Hood P2/P1 on a gmsh mesh of characteristic length h, Newton with
 continuation in Re, scikit-fem. Printed per window Reynolds number

@@ -31,8 +31,16 @@ import sys
 import numpy as np
 
 
-#: Network laws of the table: flow's CLI laws beside the single-constriction DERIVED_LAW.
-LAW_NAMES = ("onset", "derived", "pore", "chain", "window")
+#: Network laws of the table, each the window law's form with its own constants (a one-row
+#: table holds one onset slope and recovered share for every conduit; docs/inertial-flow.md):
+#: 'derived' the single-constriction Navier-Stokes slope without recovery, 'pore' the 3-D pore
+#: body alone, 'chain' that body in a chain at its own window ratio, 'window' the package's
+#: table (network.conductance.CHAIN_WINDOW_TABLE).
+LAW_TABLES = {"derived": {"sigma": (0.5,), "onset_slope": (0.0235,), "recovery": (0.0,)},
+              "pore": {"sigma": (0.5,), "onset_slope": (0.1250,), "recovery": (0.455,)},
+              "chain": {"sigma": (0.5,), "onset_slope": (0.1089,), "recovery": (0.097,)},
+              "window": None}
+LAW_NAMES = tuple(LAW_TABLES)
 
 
 def _runs(data):
@@ -53,14 +61,6 @@ def _runs(data):
             for (phi, n, seed), rows in groups.items()]
 
 
-def _law_options():
-    """The network's laws by name: flow's CLI laws and the single-constriction 'derived'."""
-    from network.flow import INERTIAL_LAWS
-    from network.validation import DERIVED_LAW
-
-    return dict(INERTIAL_LAWS, derived=DERIVED_LAW)
-
-
 def _npz_packing(path, phi, n):
     """The unit-sphere packing of an NPZ of ``lbm_periodic.py --packing`` (checked against the
     LBM run's phi and n)."""
@@ -78,16 +78,15 @@ def compare(data, laws=LAW_NAMES, packing=None):
     the NPZ the LBM ran, else the packing is rebuilt from (phi, n, seed)."""
     from network.validation import periodic_inertial_case, random_inertial_case
 
-    options = _law_options()
     out = []
     for phi, n, seed, resolution, k_d2, rows in _runs(data):
         re = np.array([r["re"] for r in rows])
         if packing is None:
             net = {name: random_inertial_case(phi, re, n_spheres=n, rng=seed,
-                                              **options[name]).k_ratio for name in laws}
+                                              table=LAW_TABLES[name]).k_ratio for name in laws}
         else:
             base = _npz_packing(packing, phi, n)
-            net = {name: periodic_inertial_case(base, phi, re, **options[name]).k_ratio
+            net = {name: periodic_inertial_case(base, phi, re, table=LAW_TABLES[name]).k_ratio
                    for name in laws}
         for i, r in enumerate(rows):
             out.append({"phi": phi, "seed": seed, "resolution": r.get("resolution", resolution),
@@ -103,14 +102,13 @@ def compare_arrays(data, laws=LAW_NAMES):
     k/k_app of the same array (``lattice_inertial_case``, flow along a cube axis)."""
     from network.validation import lattice_inertial_case
 
-    options = _law_options()
     groups = {}
     for r in data["rows"]:
         groups.setdefault((r["kind"], r["phi"]), []).append(r)
     out = []
     for (kind, phi), rows in groups.items():
         re = np.array([r["re"] for r in rows])
-        net = {name: lattice_inertial_case(kind, phi, re, **options[name]).k_ratio
+        net = {name: lattice_inertial_case(kind, phi, re, table=LAW_TABLES[name]).k_ratio
                for name in laws}
         out += [{"kind": kind, "phi": phi, "re": r["re"], "converged": r["converged"],
                  "lbm": r["lbm"], **{name: float(net[name][i]) for name in laws}}

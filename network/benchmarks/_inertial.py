@@ -7,8 +7,7 @@ tessellation, conductances, the Stokes solve and the Newton curve each timed, wi
 iterations per velocity and the 1-minute load average. :func:`inertial_validation` runs the
 drag-law cases of :mod:`network.validation` (Finney's packing, periodic random packings and,
 given a work folder, settled beds of our DEM packer, :data:`DEM_BEDS`, flow vertical and
-horizontal) for the conduit laws of :data:`INERTIAL_LAWS` (quadratic, onset, derived, pore,
-chain, window), and :func:`inertial_lines` prints both. Measurements: ``docs/inertial-flow.md``.
+horizontal) for the conduit window law, and :func:`inertial_lines` prints both. Measurements: ``docs/inertial-flow.md``.
 """
 
 from __future__ import annotations
@@ -24,11 +23,11 @@ import numpy as np
 from .._cli import available_cores
 from ..packing import random_packing
 from ..pores import default_region
-from ..flow import DEFAULT_INERTIAL_LAW, INERTIAL_LAWS as FLOW_LAWS
-from ..validation import (DERIVED_LAW, bed_inertial_case, finney_inertial_case,
-                          random_inertial_case, solve_sample_curve)
+from ..flow import INERTIAL_LAW
+from ..validation import (bed_inertial_case, finney_inertial_case, random_inertial_case,
+                          solve_sample_curve)
 
-__all__ = ["DEM_BEDS", "INERTIAL_LAWS", "INERTIAL_REYNOLDS", "dem_bed_file", "inertial_lines",
+__all__ = ["DEM_BEDS", "INERTIAL_REYNOLDS", "dem_bed_file", "inertial_lines",
            "inertial_speed", "inertial_validation"]
 
 #: Reynolds numbers of the validation table.
@@ -77,10 +76,8 @@ def _cpu_s() -> float:
 
 
 def inertial_speed(n_spheres: int = 20_000, *, seed: int = 1, n_points: int = 12,
-                   policy: str = "table-only", db=None, law: str = DEFAULT_INERTIAL_LAW,
-                   workers: int | None = None) -> dict:
-    """Stage times (s) of a ``n_points`` curve 0.005-0.3 m/s on the benchmark packing, with
-    the conduit ``law`` of :data:`INERTIAL_LAWS` (default ``network.solve``'s, 'window'), its
+                   policy: str = "table-only", db=None, workers: int | None = None) -> dict:
+    """Stage times (s) of a ``n_points`` curve 0.005-0.3 m/s on the benchmark packing, its
     Newton solves in ``workers`` continuation chains (default: the usable cores); the
     process CPU time of the whole curve beside the wall times."""
     if workers is None:
@@ -94,10 +91,10 @@ def inertial_speed(n_spheres: int = 20_000, *, seed: int = 1, n_points: int = 12
     cpu0 = _cpu_s()
     k, _, pts, t = solve_sample_curve(pk, region, us, axis=2, policy=policy, db=db,
                                       viscosity_pa_s=1.932e-5, density_kg_m3=1.2,
-                                      workers=workers, **INERTIAL_LAWS[law])
+                                      workers=workers)
     cpu = _cpu_s() - cpu0
     stokes = t["tessellate"] + t["conductance"] + t["stokes"]
-    return {"n_spheres": int(n_spheres), "law": law, "workers": int(workers),
+    return {"n_spheres": int(n_spheres), "law": INERTIAL_LAW, "workers": int(workers),
             "cpu_s": cpu, "generate_s": gen,
             **{f"{k2}_s": v for k2, v in t.items()},
             "stokes_pipeline_s": stokes, "curve_total_s": stokes + t["inertial"],
@@ -108,43 +105,27 @@ def inertial_speed(n_spheres: int = 20_000, *, seed: int = 1, n_points: int = 12
             "load_before": load0, "load_after": _load()}
 
 
-#: Laws of the validation table: name -> keyword options of the validation cases
-#: (``docs/inertial-flow.md``): 'quadratic' flat-profile K q|q|; 'onset' laminar profile +
-#: X_c = 1 (``network.solve``'s default until session 7); 'derived' the single-constriction
-#: Navier-Stokes law; 'pore' the same form with the 3-D pore body's onset slope and recovery
-#: (``network.solve``'s default in session 7); 'chain' that body's in a chain (the default of
-#: sessions 8-10); 'window' the chained body's constants per conduit from its window ratio
-#: (session 10; the default since session 11).
-INERTIAL_LAWS = ({"quadratic": FLOW_LAWS["quadratic"], "onset": FLOW_LAWS["onset"],
-                  "derived": DERIVED_LAW}
-                 | {k: v for k, v in FLOW_LAWS.items() if k not in ("quadratic", "onset")})
-
-
 def inertial_validation(*, reynolds=INERTIAL_REYNOLDS, solid_fractions=(0.55, 0.60, 0.64),
                         n_spheres: int = 800, seed: int = 1, policy: str = "table-only",
-                        db=None, laws=tuple(INERTIAL_LAWS), workdir=None,
-                        beds=tuple(DEM_BEDS)) -> list[dict]:
+                        db=None, workdir=None, beds=tuple(DEM_BEDS)) -> list[dict]:
     """Rows (law, case, Re, network k/k_app, each drag law's ratio and error) for Finney's
     packing, the random packings and (``workdir`` given) the DEM ``beds`` with vertical and
-    horizontal flow, per conduit law of :data:`INERTIAL_LAWS`."""
+    horizontal flow."""
     paths = [dem_bed_file(name, workdir) for name in beds] if workdir is not None else []
-    rows = []
-    for law in laws:
-        kw = dict(policy=policy, db=db, **INERTIAL_LAWS[law])
-        cases = [finney_inertial_case(reynolds, **kw)]
-        cases += [random_inertial_case(phi, reynolds, n_spheres=n_spheres, rng=seed, **kw)
-                  for phi in solid_fractions]
-        cases += [bed_inertial_case(path, reynolds, axis=axis, **kw)
-                  for path in paths for axis in (2, 0)]
-        rows += [{"law": law} | r for c in cases for r in c.rows()]
-    return rows
+    kw = dict(policy=policy, db=db)
+    cases = [finney_inertial_case(reynolds, **kw)]
+    cases += [random_inertial_case(phi, reynolds, n_spheres=n_spheres, rng=seed, **kw)
+              for phi in solid_fractions]
+    cases += [bed_inertial_case(path, reynolds, axis=axis, **kw)
+              for path in paths for axis in (2, 0)]
+    return [{"law": INERTIAL_LAW} | r for c in cases for r in c.rows()]
 
 
 def inertial_lines(speed: dict | None, rows: list[dict]) -> list[str]:
     """The printed table of part 4."""
     out = []
     if speed:
-        law = speed.get("law", DEFAULT_INERTIAL_LAW)
+        law = speed.get("law", INERTIAL_LAW)
         out.append(f"inertial curve ({law} law), {speed['n_spheres']} "
                    f"spheres: tessellate {speed['tessellate_s']:.2f} s, conductance "
                    f"{speed['conductance_s']:.2f} s, "

@@ -1,4 +1,4 @@
-"""Per packing (issue 18 item 2): the whole ``python -m network.solve FILE`` command, wall time.
+"""Per packing: the whole ``python -m network.solve FILE`` command, wall time.
 
 What a user waits for: a fresh interpreter, the imports, reading the file, every stage,
 printing, exit. Each command runs ``repeats`` times after one warm-up run (which writes the
@@ -6,28 +6,24 @@ bytecode caches and the Q* table's derived arrays, as a user's first run does); 
 packings of the scaling part and the bundled scene, ``--stokes`` (file to permeability, the
 target) and the default command (with inertia). The child's environment is the user's (without
 this command process's ``OPENBLAS_NUM_THREADS``, ``network._lean``) and drops
-``PYTHONDONTWRITEBYTECODE`` so that Python caches bytecode as it does by default.
+``PYTHONDONTWRITEBYTECODE`` so that Python caches bytecode as it does by default. The speed
+targets (:data:`TARGETS_S`) are 0.8 s at 5 000 spheres and 2 s at 20 000.
 
-YADE's FlowEngine on the 5 000-sphere packing (its own triangulation and Cholesky solve):
-0.84 s, the figure quoted in issue 18; the targets are 0.8 s (5 000) and 2 s (20 000). With
-``yade=True`` (``network.bench --per-packing --yade``) YADE itself runs on the same packings
-on this machine (``docs/scripts/yade_flowengine.py`` through ``yade -n -x``; Debian's ``yade``
-package): its first ``emulateAction`` (FlowEngine's triangulation, factorisation and solve,
-without YADE's start-up) and its whole command, one YADE run right after each of ours on the
-``--stokes`` rows, so that each pair sees the same host speed (a shared host's speed moves by
-25 % within an hour): the row carries the paired ratio ours / FlowEngine. Our counted runs
-follow one of ours, as without ``--yade``; the run right after each YADE run is timed apart
-(``ours_after_yade_s``), so that the two can be compared (session 16: 0.957 against 0.959 s at
-5 000 spheres, 2.312 against 2.235 s at 20 000).
+With ``yade=True`` (``network.bench --per-packing --yade``) YADE's FlowEngine (its own
+triangulation and Cholesky solve) runs on the same packings on this machine
+(``docs/scripts/yade_flowengine.py`` through ``yade -n -x``; Debian's ``yade`` package): its
+first ``emulateAction`` (FlowEngine's triangulation, factorisation and solve, without YADE's
+start-up) and its whole command, one YADE run right after each of ours on the ``--stokes``
+rows, so that each pair sees the same host speed (a shared host's speed moves within an hour):
+the row carries the paired ratio ours / FlowEngine. Our counted runs follow one of ours, as
+without ``--yade``; the run right after each YADE run is timed apart (``ours_after_yade_s``),
+so that the two can be compared.
 
-A shared host's speed also moves between sessions (YADE's FlowEngine 0.59-1.06 s on the same
-input), so a wall-time target is judged best against the code the issue timed, on the same host:
-``baseline=DIR`` (``network.bench --per-packing --baseline DIR``, DIR a source checkout of an
-earlier commit, or that commit itself, extracted from this checkout's git: ``--baseline
-b8b05a2``) runs DIR's own command, its packages imported from DIR, right after each counted
-``--stokes`` run of ours; the row carries
-the paired speed-up baseline / ours beside the one the issue asks of its own figures
-(:data:`ISSUE_S` / :data:`TARGETS_S`: 1.75x at 5 000 spheres, 2.15x at 20 000).
+A shared host's speed also moves from one hour to the next, so a speed-up is judged against
+other code on the same host at the same time: ``baseline=DIR`` (``network.bench --per-packing
+--baseline DIR``, DIR a source checkout, or a commit of this checkout's git, extracted for the
+run: ``--baseline REF``) runs DIR's own command, its packages imported from DIR, right after
+each counted ``--stokes`` run of ours; the row carries the paired speed-up baseline / ours.
 """
 
 from __future__ import annotations
@@ -48,14 +44,8 @@ from .._lean import user_environment
 from ..packing import default_packing_path
 from ._scaling import packing_file
 
-#: Wall-time targets of issue 18 (s) and YADE FlowEngine's time where the issue quotes one.
+#: Wall-time targets of ``python -m network.solve FILE --stokes`` by sphere count, s.
 TARGETS_S = {5000: 0.8, 20000: 2.0}
-YADE_S = {5000: 0.84}
-#: Wall times (s) of the command when issue 18 was filed, on the host that timed them (commit
-#: b8b05a2 is that code): the speed-up each target asks for is ISSUE_S / TARGETS_S.
-ISSUE_S = {5000: 1.4, 20000: 4.3}
-#: the commit whose code issue 18 timed: only against it is the asked speed-up judged
-ISSUE_COMMIT = "b8b05a2"
 MODES = {"stokes": ["--stokes"], "default": []}
 
 
@@ -163,20 +153,13 @@ def baseline_source(spec, workdir=None) -> dict:
             "temporary": temporary}
 
 
-def baseline_summary(source: dict, runs: list, ours: list, n) -> dict:
+def baseline_summary(source: dict, runs: list, ours: list) -> dict:
     """Times of the baseline's runs, each right after the run of ``ours`` at the same index:
-    medians and the paired speed-up baseline / ours, beside the one issue 18 asks for when the
-    baseline is the code it timed (:data:`ISSUE_COMMIT`)."""
+    medians and the paired speed-up baseline / ours."""
     ratio = [b / a for a, b in zip(ours, runs)]
-    issue = (source["commit"] or "").startswith(ISSUE_COMMIT)
-    want = ISSUE_S[n] / TARGETS_S[n] if issue and n in ISSUE_S and n in TARGETS_S else None
-    out = {"dir": source["dir"], "commit": source["commit"], "times_s": runs,
-           "median_s": statistics.median(runs), "speedup": ratio,
-           "speedup_median": statistics.median(ratio), "speedup_min": min(ratio),
-           "speedup_asked": want}
-    if want is not None:
-        out["met"] = out["speedup_median"] >= want
-    return out
+    return {"dir": source["dir"], "commit": source["commit"], "times_s": runs,
+            "median_s": statistics.median(runs), "speedup": ratio,
+            "speedup_median": statistics.median(ratio), "speedup_min": min(ratio)}
 
 
 def per_packing(sizes, workdir: Path, seed: int, repeats: int = 7,
@@ -233,7 +216,6 @@ def _per_packing_rows(sizes, workdir, seed, repeats, bundled, yade, source, env)
                    "min_s": min(times), "median_s": statistics.median(times),
                    "max_s": max(times), "times_s": times,
                    "target_s": TARGETS_S.get(n) if mode == "stokes" else None,
-                   "yade_s": YADE_S.get(n) if mode == "stokes" else None,
                    "loadavg_after": os.getloadavg()[0]}
             if row["target_s"] is not None:
                 row["met"] = row["median_s"] <= row["target_s"]
@@ -243,7 +225,7 @@ def _per_packing_rows(sizes, workdir, seed, repeats, bundled, yade, source, env)
                     row["yade_here"]["ours_after_yade_s"] = after_yade
                     row["yade_here"]["ours_after_yade_median_s"] = statistics.median(after_yade)
             if paired:
-                row["baseline"] = baseline_summary(source, base_runs, times, n)
+                row["baseline"] = baseline_summary(source, base_runs, times)
             rows.append(row)
             print("  " + per_packing_line(row), flush=True)
     return rows
@@ -266,8 +248,6 @@ def per_packing_line(row: dict) -> str:
     tail = ""
     if row.get("target_s") is not None:
         tail = f"; target {row['target_s']:.1f} s: {'met' if row['met'] else 'MISSED'}"
-        if row.get("yade_s"):
-            tail += f" (YADE {row['yade_s']:.2f} s)"
     here = row.get("yade_here")
     if here:
         tail += (f"; YADE here, each run after one of ours: FlowEngine "
@@ -282,11 +262,9 @@ def per_packing_line(row: dict) -> str:
         tail += "; YADE here: not installed"
     base = row.get("baseline")
     if base:
-        asked = base["speedup_asked"]
         tail += (f"; baseline {base['commit'] or base['dir']} right after each: median "
                  f"{base['median_s']:.3f} s, speed-up {base['speedup_median']:.2f}x (min "
-                 f"{base['speedup_min']:.2f})" + (f", issue asks {asked:.2f}x: "
-                 f"{'met' if base['met'] else 'MISSED'}" if asked else ""))
+                 f"{base['speedup_min']:.2f})")
     return (f"{name:>16s} {row['mode']:>8s}: median {row['median_s']:.3f} s, min "
             f"{row['min_s']:.3f}, max {row['max_s']:.3f} over {row['runs']} runs (load "
             f"{row['loadavg_after']:.2f}){tail}")

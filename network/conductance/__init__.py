@@ -6,9 +6,7 @@ thesis model (:func:`thesis_conductance`); both give a :class:`ConductanceResult
 
 from ._conduit import KERNEL_MIN_THROATS, SECTION_MODES, conduit_conductance, load_conduit_kernel
 from ._sections import section_estimate, side_resistance
-from ._inertial import (CHAIN_ONSET_SLOPE, CHAIN_RECOVERY, CHAIN_WINDOW_TABLE, ONSET_SLOPE,
-                        PORE_ONSET_SLOPE, PORE_RECOVERY, conduit_law,
-                        contraction_coefficient, expansion_coefficient,
+from ._inertial import (CHAIN_WINDOW_TABLE, conduit_law, expansion_coefficient,
                         inertial_coefficients, onset_scales, turning_cosines, window_constants)
 from ._models import MODELS, check_model, throat_conductance
 from ._qstar import POLICIES, QstarResult, check_policy, qstar_from_function, throat_qstar
@@ -16,11 +14,10 @@ from ._result import ConductanceResult
 from ._table import default_table, has_grid, table_totals
 from ._thesis import thesis_conductance
 
-__all__ = ["CHAIN_ONSET_SLOPE", "CHAIN_RECOVERY", "CHAIN_WINDOW_TABLE", "KERNEL_MIN_THROATS",
-           "MODELS", "ONSET_SLOPE", "PORE_ONSET_SLOPE", "PORE_RECOVERY", "POLICIES",
+__all__ = ["CHAIN_WINDOW_TABLE", "KERNEL_MIN_THROATS", "MODELS", "POLICIES",
            "SECTION_MODES", "ConductanceResult", "QstarResult", "check_model", "check_policy",
            "conduit_conductance", "conduit_law",
-           "contraction_coefficient", "default_table", "expansion_coefficient", "has_grid",
+           "default_table", "expansion_coefficient", "has_grid",
            "inertial_coefficients", "load_conduit_kernel", "onset_scales",
            "qstar_from_function", "section_estimate",
            "side_resistance", "table_totals", "thesis_conductance", "throat_conductance",

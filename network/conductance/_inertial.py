@@ -1,34 +1,28 @@
-r"""Inertial (kinetic-energy) loss of a conduit from its own geometry: contraction + expansion.
+r"""The conduit window law: each conduit's inertial (kinetic-energy) loss from its own geometry.
 
 A conduit runs pore body P → window → pore body Q (:mod:`._conduit`). Its pressure drop is
 
-.. math:: \Delta p = \frac{Q}{g} + K\,Q|Q|, \qquad
-          K = \frac{\rho}{2A_w^2}\bigl[K_c(\sigma_\mathrm{up}) + K_e(\sigma_\mathrm{down})\bigr],
+.. math:: \Delta p = \frac{q}{g} + K_\pm\,q|q|\,\frac{t}{\sqrt{1+t^2}}, \qquad
+          K = \frac{\rho}{2A_w^2}\,K_e(\sigma, \cos\theta), \qquad t = \frac{Re_w}{Re_c},
 
 with :math:`A_w` the window's open area (:func:`throats.open_area` of the face) and
-:math:`\sigma = A_w/A_b` the window-to-body area ratio on each side. :math:`A_b` is the conduit's
-own section at the height of the pore body's centre (the face triangle less the sphere
-sections of radius :math:`\sqrt{r_k^2-h_P^2}`, the last section of the conduit model). The
-irreversible losses are those of El-Zehairy, Nezhad & Joekar-Niasar (2019, Adv. Water Resour.
-131:103378; DuMux ``NonCreepingFlow``) with unit momentum and energy coefficients:
-contraction to a vena contracta :math:`C_c = 1 - (1-\sigma)/(2.08(1-\sigma)+0.5371)`,
-:math:`K_c = (1/C_c - 1)^2`, and Borda-Carnot expansion :math:`K_e = (1-\sigma)^2`. Their
-reversible Bernoulli parts, :math:`\pm(1-\sigma^2)`, change the static pressure of a body by
-its own kinetic energy and cancel along every path between inlet and outlet bodies; they are
-left out so that every conduit's law is monotone (Newton's Jacobian stays a weighted graph
-Laplacian). ``profile='laminar'`` takes the expansion's momentum and energy balances with the
-Poiseuille-tube profile coefficients (alpha 2, beta 4/3) instead of flat ones; the weak-inertia
-onset is the solver's (:func:`network.flow.conduit_flow`, ``crossover``).
-
-The law derived from single-constriction Navier-Stokes (``network.validation.DERIVED_LAW``)
-uses ``contraction='smooth'`` (no vena contracta at a sphere-rounded window), the expansion
-against the downstream body's outflow direction (``cos_theta`` from :func:`turning_cosines`)
-and the window-Reynolds onset of :func:`onset_scales`; ``network.solve``'s default law
-'chain' (``CHAIN_LAW``) takes the onset slope and the cross-momentum recovery of a resolved 3-D
-pore body in a chain (:data:`CHAIN_ONSET_SLOPE`, :data:`CHAIN_RECOVERY`), 'pore' those of the
-same body alone (:data:`PORE_ONSET_SLOPE`, :data:`PORE_RECOVERY`); :func:`conduit_law`
-assembles any of them. No coefficient is fitted to bed-scale data. Derivations, the Navier-Stokes
-table and the validation against the LBM drag laws: ``docs/inertial-flow.md``.
+:math:`\sigma = A_w/A_b` the window-to-body area ratio of the body the flow expands into.
+:math:`A_b` is the conduit's own section at the height of the pore body's centre (the face
+triangle less the sphere sections of radius :math:`\sqrt{r_k^2-h_P^2}`, the last section of the
+conduit model). A sphere-rounded window has no vena contracta (no contraction loss); the jet
+expands against the outflow direction of the body it enters, :math:`K_e = 1 - 2\sigma\cos\theta
++ \sigma^2` (flat-profile momentum balance, :func:`expansion_coefficient`), with the share f of
+its cross momentum that the body recovers, :math:`\cos\theta \to \cos\theta + f(1-\cos\theta)`
+(:func:`turning_cosines`). The loss sets in with the window Reynolds number,
+:math:`Re_c = k_\infty/(c_1 h/a)` (:func:`onset_scales`). The two constants :math:`c_1` and f of
+each conduit come from its window ratio through :data:`CHAIN_WINDOW_TABLE`: steady 3-D
+Navier-Stokes through a regular tetrahedral pore body in a chain at nine window ratios
+(:func:`window_constants`). The reversible Bernoulli parts, :math:`\pm(1-\sigma^2)`, change the
+static pressure of a body by its own kinetic energy and cancel along every path between inlet
+and outlet bodies; they are left out so that every conduit's law is monotone (Newton's Jacobian
+stays a weighted graph Laplacian). :func:`conduit_law` assembles the law. No coefficient is
+fitted to bed-scale data. Derivation, the Navier-Stokes tables and the validation against
+resolved flow and the drag laws: ``docs/inertial-flow.md``.
 """
 
 from __future__ import annotations
@@ -41,47 +35,20 @@ import throats
 
 from .._air import MU_AIR_PA_S, RHO_AIR_KG_M3, check_density, check_viscosity
 
-__all__ = ["CHAIN_ONSET_SLOPE", "CHAIN_RECOVERY", "CHAIN_WINDOW_TABLE", "ONSET_SLOPE",
-           "PORE_ONSET_SLOPE", "PORE_RECOVERY", "PROFILES", "conduit_law",
-           "contraction_coefficient", "expansion_coefficient",
-           "inertial_coefficients", "onset_scales", "turning_cosines", "window_constants"]
+__all__ = ["CHAIN_WINDOW_TABLE", "conduit_law", "expansion_coefficient", "inertial_coefficients",
+           "onset_scales", "turning_cosines", "window_constants"]
 
-#: Low-Re slope of a single sphere-ring constriction's excess loss coefficient,
-#: :math:`dk/dRe_w = c_1 h/a`: axisymmetric Navier-Stokes of six constrictions
-#: (``docs/inertial-flow.md``); not fitted to bed data.
-ONSET_SLOPE = 0.0235
-
-#: The same slope and the recovered share of the jet's cross momentum of a 3-D pore body:
-#: steady Navier-Stokes through a regular tetrahedral pore (``docs/scripts/
-#: inertial_pore_ns.py``; the finest mesh run: h 0.10, 8 elements across the gaps, 57 489 tets;
-#: ``docs/inertial-flow.md``, "The pore table corrected"). Its body loss
-#: k(Re_w) = k_peak t/sqrt(1+t^2), t = Re_w/Re_c, has Re_c = 10.49 (from Re_w 5 and 10),
-#: k_peak = 0.595 at h/a = 0.4536: c_1 = 0.595/(10.49 * 0.4536) = 0.1250, and f = 0.455 recovers the
-#: peak in the turning balance. Not fitted to bed data. (Sessions 7-8 used 0.0863 and 0.488,
-#: from a table whose outlet windows were partly closed.)
-PORE_ONSET_SLOPE = 0.1250
-PORE_RECOVERY = 0.455
-
-#: The same pore body in a chain (law 'chain', the default of sessions 8-10): the loss a body
-#: causes is its own excess dissipation k_body plus the kinetic energy its jets carry out
-#: through the three outlet windows beyond what they carry at Re_w 5 (k_out - k_out(5); a
-#: do-nothing outlet does not charge it, the next body of a bed dissipates it). From the same
-#: mesh: k_chain(Re_w) = k_body + k_out - k_out(5) rises to k_peak = 0.899 at Re_w 200,
-#: Re_c = 18.20 from Re_w 5 and 10, c_1 = 0.899/(18.20 * 0.4536) = 0.1089, and f = 0.097 recovers
-#: k_peak in the turning balance (the mesh series agrees to about 2 % in c_1 and 0.01 in f;
-#: session 8's 0.0941 and 0.184 came from the partly closed outlets). Not fitted to bed data.
-CHAIN_ONSET_SLOPE = 0.1089
-CHAIN_RECOVERY = 0.097
-
-#: The chained body's two constants as functions of the window ratio: the same regular
-#: tetrahedron (edge 2) with sphere radii 0.97 / 0.95 / 0.90 / 0.85 / 0.80 / 0.75 / 0.70 / 0.60 /
-#: 0.50 (window ratio sigma below; the last two added in session 11), the same recipe on each
-#: pore's own sigma and h/a = 0.408/r, one run of each at h 0.10 with 8 / 6 / 4 elements across
-#: the gaps between spheres (r 0.90 / 0.80-0.85 / the others; r 0.60's finer h 0.07 check
-#: moved c_1 by 2.8 % and is not used): ``docs/data/pore_ns_series.json``;
-#: ``docs/inertial-flow.md``, "A window-ratio law".
-#: :func:`window_constants` interpolates it linearly in sigma and holds the end values outside.
-#: Not fitted to bed data.
+#: The chained pore body's two constants as functions of the window ratio sigma: onset slope
+#: :math:`c_1` (low-Re slope of the body's excess loss coefficient, :math:`dk/dRe_w = c_1 h/a`)
+#: and recovered share f of the jet's cross momentum. Steady 3-D Navier-Stokes through a regular
+#: tetrahedron of spheres (edge 2) with radii 0.97 / 0.95 / 0.90 / 0.85 / 0.80 / 0.75 / 0.70 /
+#: 0.60 / 0.50 (``docs/scripts/inertial_pore_ns.py``): the loss a body causes in a chain is its
+#: own excess dissipation k_body plus the kinetic energy its jets carry out through the three
+#: outlet windows beyond what they carry at Re_w 5; its k(Re_w) = k_peak t/sqrt(1+t^2),
+#: t = Re_w/Re_c, gives c_1 = k_peak/(Re_c h/a) (Re_c from Re_w 5 and 10), and f is the share
+#: whose turning balance gives k_peak. One run per radius at h 0.10 with 8 / 6 / 4 elements
+#: across the gaps between spheres (r 0.90 / 0.80-0.85 / the others):
+#: ``docs/data/pore_ns_series.json``. Not fitted to bed data.
 CHAIN_WINDOW_TABLE = {"sigma": (0.4925, 0.5457, 0.6371, 0.6952, 0.7352, 0.7642, 0.7861, 0.8167,
                                 0.8365),
                       "onset_slope": (0.0857, 0.0949, 0.1089, 0.1149, 0.1158, 0.1111, 0.1060,
@@ -90,47 +57,28 @@ CHAIN_WINDOW_TABLE = {"sigma": (0.4925, 0.5457, 0.6371, 0.6952, 0.7352, 0.7642, 
                                    0.429)}
 
 
-def contraction_coefficient(sigma):
-    r"""Loss coefficient of a sudden contraction, :math:`K_c = (1/C_c-1)^2`, dimensionless.
-
-    >>> float(contraction_coefficient(1.0)), round(float(contraction_coefficient(0.0)), 4)
-    (0.0, 0.3824)
-    """
-    s = np.clip(np.asarray(sigma, dtype=float), 0.0, 1.0)
-    cc = 1.0 - (1.0 - s) / (2.08 * (1.0 - s) + 0.5371)
-    return (1.0 / cc - 1.0) ** 2
-
-
-#: Kinetic-energy and momentum-flux coefficients (alpha, beta) of the velocity profile in the
-#: window and downstream: a flat profile, or the laminar (Poiseuille) one of a circular tube.
-PROFILES = {"uniform": (1.0, 1.0), "laminar": (2.0, 4.0 / 3.0)}
-
-
-def expansion_coefficient(sigma, *, profile: str = "uniform", cos_theta=1.0):
+def expansion_coefficient(sigma, *, cos_theta=1.0):
     r"""Loss coefficient of a sudden expansion from area ratio :math:`\sigma = A_1/A_2`.
 
-    Momentum and energy balances between the expansion plane and the reattached flow, with
-    profile coefficients :math:`(\alpha, \beta)` on both sides (:data:`PROFILES`):
-    :math:`K_e = \alpha - 2\beta\sigma + (2\beta - \alpha)\sigma^2` (per
-    :math:`\rho V_1^2/2`); Borda-Carnot :math:`(1-\sigma)^2` for a flat profile. A jet at angle
-    :math:`\theta` to the downstream flow recovers only its momentum component along it:
-    :math:`K_e = \alpha - 2\beta\sigma\cos\theta + (2\beta - \alpha)\sigma^2`.
+    Momentum and energy balances between the expansion plane and the reattached flow with a
+    flat profile on both sides give Borda-Carnot, :math:`K_e = (1-\sigma)^2` (per
+    :math:`\rho V_1^2/2`). A jet at angle :math:`\theta` to the downstream flow recovers only
+    its momentum component along it: :math:`K_e = 1 - 2\sigma\cos\theta + \sigma^2`.
 
-    >>> float(expansion_coefficient(0.25)), float(expansion_coefficient(0.0, profile="laminar"))
-    (0.5625, 2.0)
+    >>> float(expansion_coefficient(0.25)), float(expansion_coefficient(0.5, cos_theta=0.0))
+    (0.5625, 1.25)
     """
-    if profile not in PROFILES:
-        raise ValueError(f"profile must be one of {sorted(PROFILES)}, got {profile!r}")
-    a, b = PROFILES[profile]
     s = np.clip(np.asarray(sigma, dtype=float), 0.0, 1.0)
     c = np.clip(np.asarray(cos_theta, dtype=float), -1.0, 1.0)
-    return a - 2.0 * b * s * c + (2.0 * b - a) * s**2
+    return 1.0 - 2.0 * s * c + s**2
 
 
 def inertial_coefficients(tessellation, throats_idx, h_m, *, internal=None,
-                          density_kg_m3: float = RHO_AIR_KG_M3, profile: str = "uniform",
-                          cos_theta=None, contraction: str = "sharp"):
+                          density_kg_m3: float = RHO_AIR_KG_M3, cos_theta=None):
     r"""Inertial coefficients K of M conduits for both flow directions, Pa s² m⁻⁶.
+
+    :math:`K = \rho K_e / (2A_w^2)`, :math:`K_e` of the expansion into the body the flow enters
+    (:func:`expansion_coefficient`); a sphere-rounded window adds no contraction loss.
 
     Parameters
     ----------
@@ -143,12 +91,6 @@ def inertial_coefficients(tessellation, throats_idx, h_m, *, internal=None,
         Throats inside one merged pore body: K = 0 (one pressure node).
     density_kg_m3 : float, keyword-only
         ρ (default 1.20 kg/m³).
-    profile : {'uniform', 'laminar'}, keyword-only
-        Velocity profile of the expansion loss (:func:`expansion_coefficient`).
-    contraction : {'sharp', 'smooth'}, keyword-only
-        'sharp': :func:`contraction_coefficient` (vena contracta); 'smooth': no contraction
-        loss (a sphere-rounded window: single-constriction Navier-Stokes,
-        ``docs/inertial-flow.md``).
     cos_theta : (M, 2) array_like, optional
         Turning cosine of each flow direction in the body it expands into
         (:func:`turning_cosines`, same column order); None: 1 (straight expansion).
@@ -160,22 +102,18 @@ def inertial_coefficients(tessellation, throats_idx, h_m, *, internal=None,
         reverse; 0 for closed windows and internal throats.
     """
     return _coefficients(_window_and_ratios(tessellation, throats_idx, h_m), internal=internal,
-                         density_kg_m3=density_kg_m3, profile=profile, cos_theta=cos_theta,
-                         contraction=contraction)
+                         density_kg_m3=density_kg_m3, cos_theta=cos_theta)
 
 
-def _coefficients(window, *, internal, density_kg_m3, profile, cos_theta, contraction):
+def _coefficients(window, *, internal, density_kg_m3, cos_theta):
     """:func:`inertial_coefficients` from ``_window_and_ratios``'s (A_w, sigma, a)."""
     rho = check_density(density_kg_m3)
     a_w, sigma, _ = window
     ct = np.ones((sigma.shape[0], 2)) if cos_theta is None else np.asarray(cos_theta, float)
-    if contraction not in ("sharp", "smooth"):
-        raise ValueError(f"contraction must be 'sharp' or 'smooth', got {contraction!r}")
-    kc = contraction_coefficient(sigma) if contraction == "sharp" else np.zeros_like(sigma)
-    ke = expansion_coefficient(sigma[:, ::-1], profile=profile, cos_theta=ct)[:, ::-1]
+    ke = expansion_coefficient(sigma[:, ::-1], cos_theta=ct)[:, ::-1]
     with np.errstate(divide="ignore"):
         scale = np.where(a_w > 0, rho / (2.0 * a_w**2), 0.0)
-    K = np.column_stack([kc[:, 0] + ke[:, 1], kc[:, 1] + ke[:, 0]]) * scale[:, None]
+    K = np.column_stack([ke[:, 1], ke[:, 0]]) * scale[:, None]
     if internal is not None:
         K[np.asarray(internal, dtype=bool)] = 0.0
     return K
@@ -206,21 +144,19 @@ def _window_and_ratios(tessellation, throats_idx, h_m, pool=None):
     return a_w, sigma, radii.mean(axis=1)
 
 
-def onset_scales(tessellation, throats_idx, h_m, K, *,
-                 density_kg_m3: float = RHO_AIR_KG_M3, viscosity_pa_s: float = MU_AIR_PA_S,
-                 slope: float = ONSET_SLOPE):
+def onset_scales(tessellation, throats_idx, h_m, K, *, slope,
+                 density_kg_m3: float = RHO_AIR_KG_M3, viscosity_pa_s: float = MU_AIR_PA_S):
     r"""Onset scale c of M conduits for both flow directions, s/m³: :math:`c|q| = Re_w/Re_c`.
 
-    A single sphere-ring constriction (axisymmetric Navier-Stokes, ``docs/inertial-flow.md``)
-    loses :math:`k(Re_w)\,\rho u_w^2/2` over its Stokes drop with
+    A pore body loses :math:`k(Re_w)\,\rho u_w^2/2` over its Stokes drop with
     :math:`k = k_\infty\,t/\sqrt{1+t^2}`, :math:`t = Re_w/Re_c`,
     :math:`Re_c = k_\infty/(c_1 h/a)`: the low-Re slope :math:`dk/dRe_w = c_1 h/a`
-    (``slope``, default :data:`ONSET_SLOPE`; :data:`PORE_ONSET_SLOPE` for the 3-D pore body;
-    h the window-to-body height, a the sphere radius) and the
-    asymptote :math:`k_\infty`. Here :math:`k_\infty = 2A_w^2 K/\rho` is the conduit's own
-    loss coefficient (``K`` from :func:`inertial_coefficients`, same columns),
-    :math:`Re_w = \rho (|q|/A_w) D_w/\mu`, :math:`D_w = 2\sqrt{A_w/\pi}`, h of the side the
-    flow expands into, a the mean radius of the window's spheres. 0 where K = 0.
+    (``slope`` :math:`c_1`, one number or (M, 2) per conduit and flow direction; h the
+    window-to-body height, a the sphere radius) and the asymptote :math:`k_\infty`. Here
+    :math:`k_\infty = 2A_w^2 K/\rho` is the conduit's own loss coefficient (``K`` from
+    :func:`inertial_coefficients`, same columns), :math:`Re_w = \rho (|q|/A_w) D_w/\mu`,
+    :math:`D_w = 2\sqrt{A_w/\pi}`, h of the side the flow expands into, a the mean radius of
+    the window's spheres. 0 where K = 0.
 
     Returns
     -------
@@ -318,56 +254,40 @@ def turning_cosines(centers_m, throat_vertices, pore_xyz_m, conns, flow_m3_s, ax
     return np.clip(cos + f * (1.0 - cos), -1.0, 1.0)
 
 
-def conduit_law(tessellation, throats_idx, h_m, *, internal=None, pore_xyz_m=None, conns=None,
-                stokes_flow_m3_s=None, axis: int = 0, density_kg_m3: float = RHO_AIR_KG_M3,
-                viscosity_pa_s: float = MU_AIR_PA_S, profile: str = "uniform",
-                contraction: str = "sharp", turning: bool = False, recovery: float | str = 0.0,
-                onset=None, onset_slope: float | str = ONSET_SLOPE,
-                crossover=None, threads: int = 1):
-    r"""The per-conduit inertial law of a sample's conduits: ``(K, onset_scale, crossover)``.
+def conduit_law(tessellation, throats_idx, h_m, *, pore_xyz_m, conns, stokes_flow_m3_s,
+                axis: int, internal=None, density_kg_m3: float = RHO_AIR_KG_M3,
+                viscosity_pa_s: float = MU_AIR_PA_S, table=None, threads: int = 1):
+    r"""The window law of a sample's conduits: ``(K, onset_scale)``, both (M, 2).
 
-    ``K`` (M, 2), Pa s² m⁻⁶, from :func:`inertial_coefficients` (``profile``,
-    ``contraction``; with ``turning`` the expansion against each body's outflow direction of
-    the Stokes flows ``stokes_flow_m3_s`` through :func:`turning_cosines` with ``recovery``,
-    which needs ``pore_xyz_m``, ``conns`` and ``axis``). ``onset='throat'``: the
-    window-Reynolds onset scales of :func:`onset_scales` (slope ``onset_slope``), else None;
-    ``crossover`` is passed through (the X/(X_c+X) onset of
-    :func:`network.flow.conduit_flow`). The law of a conduit is then
-    :math:`\Delta p = q/g + K q|q|\,\phi`, φ the onset factor. ``recovery='window'`` and
-    ``onset_slope='window'`` take each from the window ratio sigma of the body the flow
-    expands into (:func:`window_constants`) instead of one number for every conduit.
-    ``threads`` > 1: the body sections' open areas and the turning cosines run on two more
-    threads beside the window's (the same bits).
+    ``K`` (Pa s² m⁻⁶, :func:`inertial_coefficients`) with the expansion against each body's
+    outflow direction of the Stokes flows ``stokes_flow_m3_s`` (:func:`turning_cosines`, which
+    needs ``pore_xyz_m``, ``conns`` and the flow ``axis``); ``onset_scale`` (s/m³,
+    :func:`onset_scales`). The onset slope :math:`c_1` and the recovered share f of each
+    conduit and flow direction come from the window ratio sigma of the body the flow expands
+    into (:func:`window_constants` on ``table``, default :data:`CHAIN_WINDOW_TABLE`). The law
+    of a conduit is then :math:`\Delta p = q/g + K q|q|\,t/\sqrt{1+t^2}`, :math:`t = c|q|`
+    (:func:`network.flow.conduit_flow`). ``threads`` > 1: the body sections' open areas and
+    the turning cosines run on two more threads beside the window's (the same bits).
     """
-    if onset not in (None, "throat"):
-        raise ValueError(f"onset must be None or 'throat', got {onset!r}")
-    for name, value in (("recovery", recovery), ("onset_slope", onset_slope)):
-        if isinstance(value, str) and value != "window":
-            raise ValueError(f"{name} must be a number or 'window', got {value!r}")
-    if turning and (stokes_flow_m3_s is None or pore_xyz_m is None or conns is None):
-        raise ValueError("turning needs the Stokes flows, pore positions and conns")
+    if stokes_flow_m3_s is None or pore_xyz_m is None or conns is None:
+        raise ValueError("the window law needs the Stokes flows, pore positions and conns")
     pool = ThreadPoolExecutor(2) if int(threads) > 1 else None
     try:
-        # the cosines without recovery (which may come from the window ratios below): the
-        # same bits as with it, cos + f (1 - cos) being applied to them last either way
+        # the cosines without recovery (which comes from the window ratios below): the same
+        # bits as with it, cos + f (1 - cos) being applied to them last either way
         bare = (pool.submit if pool else _now)(
             turning_cosines, tessellation.packing.centers,
             np.asarray(tessellation.throat_vertices)[throats_idx], pore_xyz_m, conns,
-            stokes_flow_m3_s, axis) if turning else None
+            stokes_flow_m3_s, axis)
         win = _window_and_ratios(tessellation, throats_idx, h_m, pool)  # for K and the onset
-        cos = None if bare is None else bare.result()
+        cos = bare.result()
     finally:
         if pool:
             pool.shutdown()
-    if isinstance(recovery, str) or isinstance(onset_slope, str):
-        c1_w, f_w = window_constants(win[1][:, ::-1])     # column 0: flow 0 -> 1 expands into 1
-        recovery = f_w if isinstance(recovery, str) else recovery
-        onset_slope = c1_w if isinstance(onset_slope, str) else onset_slope
-    if cos is not None:
-        f = _recovery(recovery)
-        cos = np.clip(cos + f * (1.0 - cos), -1.0, 1.0)
-    K = _coefficients(win, internal=internal, density_kg_m3=density_kg_m3, profile=profile,
-                      cos_theta=cos, contraction=contraction)
-    c = None if onset is None else _onset(win, h_m, K, density_kg_m3=density_kg_m3,
-                                          viscosity_pa_s=viscosity_pa_s, slope=onset_slope)
-    return K, c, crossover
+    # column 0: flow 0 -> 1 expands into side 1
+    onset_slope, recovery = window_constants(win[1][:, ::-1], table)
+    cos = np.clip(cos + _recovery(recovery) * (1.0 - cos), -1.0, 1.0)
+    K = _coefficients(win, internal=internal, density_kg_m3=density_kg_m3, cos_theta=cos)
+    c = _onset(win, h_m, K, density_kg_m3=density_kg_m3, viscosity_pa_s=viscosity_pa_s,
+               slope=onset_slope)
+    return K, c

@@ -15,15 +15,13 @@ from ._inertial import InertialPoint, solve_inertial
 from ._linear import (SolveInfo, apply_pressure_bc, assemble_laplacian, boundary_flows,
                       solve_fixed_pressure, solve_pressure, verify_solution)
 from ._pipeline import (CORE_MARGIN_DIAMETERS, CORE_MIN_DIAMETERS, DEFAULT_DEPTH_M,
-                        DEFAULT_INERTIAL_LAW, DEFAULT_VELOCITY_M_S, DERIVED_LAW, INERTIAL_LAWS,
-                        solve_axes, solve_network)
+                        DEFAULT_VELOCITY_M_S, INERTIAL_LAW, solve_axes, solve_network)
 from ._result import FlowResult, combined_summary
 from ._vtk import read_vtu_arrays, write_network_vtu
 
 __all__ = ["AMGSolver", "ASABE_SOYBEAN_A", "ASABE_SOYBEAN_B", "CORE_MARGIN_DIAMETERS",
-           "CORE_MIN_DIAMETERS", "DEFAULT_DEPTH_M", "DEFAULT_INERTIAL_LAW", "DERIVED_LAW",
-           "DEFAULT_VELOCITY_M_S", "FlowResult",
-           "GRAINS", "INERTIAL_LAWS", "InertialPoint", "SolveInfo", "apply_pressure_bc",
+           "CORE_MIN_DIAMETERS", "DEFAULT_DEPTH_M", "DEFAULT_VELOCITY_M_S", "FlowResult",
+           "GRAINS", "INERTIAL_LAW", "InertialPoint", "SolveInfo", "apply_pressure_bc",
            "asabe_d272_gradient", "assemble_laplacian", "boundary_flows", "combined_summary",
            "conduit_flow", "core_permeability", "darcy_permeability", "ergun_gradient",
            "fit_curve", "kozeny_carman_gradient", "read_vtu_arrays", "solve_axes",

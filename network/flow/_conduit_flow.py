@@ -1,7 +1,7 @@
 r"""The signed flow of one conduit under its nonlinear law, vectorised over conduits.
 
 A conduit obeys :math:`\Delta p = q/g + K_\pm\, q|q|\,\phi` (:mod:`network.conductance._inertial`;
-φ = 1, or the weak-inertia onset factor): :func:`conduit_flow` inverts it for q and its slope
+φ = 1, or the window-Reynolds onset factor): :func:`conduit_flow` inverts it for q and its slope
 w = dq/dΔp, the weights of :func:`network.flow.solve_inertial`'s Jacobian.
 """
 
@@ -12,18 +12,16 @@ import numpy as np
 __all__ = ["conduit_flow"]
 
 
-def conduit_flow(dp, g, K, *, crossover: float | None = None, onset_scale=None, q_start=None):
+def conduit_flow(dp, g, K, *, onset_scale=None, q_start=None):
     r"""Signed conduit flows q and slopes w = dq/dΔp for pressure drops ``dp`` (module formula).
 
     ``K`` is (Nt, 2) (direction-dependent) or (Nt,). K = 0 gives q = g Δp exactly. With
-    ``crossover`` :math:`X_c` the inertial loss has a weak-inertia onset,
-    :math:`\Delta p = q/g + K q|q|\,X/(X_c + X)`, :math:`X = Kg|q|` (the ratio of the
-    high-Re loss to the viscous one; ``docs/inertial-flow.md``); q is found by Newton from
-    an upper bound, monotone onto the root. With ``onset_scale`` c (per conduit, s/m³; exclusive
-    with ``crossover``) the onset follows the window Reynolds number instead:
-    :math:`\Delta p = q/g + K q|q|\,t/\sqrt{1+t^2}`, :math:`t = c|q| = Re_w/Re_c`
-    (:func:`network.conductance.onset_scales`), solved the same way; ``q_start`` (signed
-    flows of a nearby state) starts that Newton where the sign is kept (same root).
+    ``onset_scale`` c (per conduit, s/m³) the inertial loss sets in with the window Reynolds
+    number: :math:`\Delta p = q/g + K q|q|\,t/\sqrt{1+t^2}`, :math:`t = c|q| = Re_w/Re_c`
+    (:func:`network.conductance.onset_scales`); q is found by Newton from an upper bound,
+    monotone onto the root, and ``q_start`` (signed flows of a nearby state) starts that Newton
+    where the sign is kept (same root). Without it the loss is :math:`K q|q|` from the start
+    (the limit c → ∞), solved in closed form.
 
     >>> q, w = conduit_flow(np.array([1.5, -1.5]), np.array([1.0, 1.0]), np.array([0.5, 0.5]))
     >>> q.tolist(), w.tolist()
@@ -34,30 +32,11 @@ def conduit_flow(dp, g, K, *, crossover: float | None = None, onset_scale=None, 
     a = np.abs(dp)
     inv_g = 1.0 / g
     if onset_scale is not None:
-        if crossover is not None:
-            raise ValueError("give crossover or onset_scale, not both")
         c = np.asarray(onset_scale, dtype=float)
         c = np.where(dp >= 0, c[:, 0], c[:, 1]) if c.ndim == 2 else c
         return _throat_onset_flow(dp, a, g, inv_g, k, c, q_start)
-    if crossover is None:
-        q = 2.0 * a / (inv_g + np.sqrt(inv_g**2 + 4.0 * k * a))
-        w = 1.0 / (inv_g + 2.0 * k * q)
-        return np.sign(dp) * q, w
-    c = k * g / float(crossover)            # X / X_c = c |q|
-    # start above the root: X/(X_c+X) >= 1 - X_c/X bounds it by the root of
-    # K q^2 + (1 - X_c) q/g = |dp|; Newton on the convex increasing residual then descends
-    # monotonically onto the root
-    q = _upper_bound(a, g, k, (1.0 - float(crossover)) * inv_g, k > 0)
-    for _ in range(50):
-        x = c * q
-        f = q * inv_g + k * q * q * x / (1.0 + x) - a
-        df = inv_g + k * q * q * c * (3.0 + 2.0 * x) / (1.0 + x) ** 2
-        step = f / df
-        q = np.maximum(q - step, 0.0)
-        if np.all(np.abs(step) <= 1e-14 * q):
-            break
-    x = c * q
-    w = 1.0 / (inv_g + k * q * q * c * (3.0 + 2.0 * x) / (1.0 + x) ** 2)
+    q = 2.0 * a / (inv_g + np.sqrt(inv_g**2 + 4.0 * k * a))
+    w = 1.0 / (inv_g + 2.0 * k * q)
     return np.sign(dp) * q, w
 
 

@@ -7,12 +7,10 @@ signed flow is the monotone function
 .. math:: q(\Delta p) = \frac{2\,\Delta p}{1/g + \sqrt{1/g^2 + 4K|\Delta p|}},\qquad
           \frac{dq}{d\Delta p} = w = \frac{1}{1/g + 2K|q|} \in (0, g].
 
-With ``crossover`` :math:`X_c` the inertial term has a weak-inertia onset,
-:math:`K q|q|\,X/(X_c+X)`, :math:`X = Kg|q|`: its excess over the viscous drop starts as
-:math:`X^2/X_c` (Re² per conduit, the minimum-dissipation argument of
-``docs/inertial-flow.md``) and tends to :math:`Kq|q|` at high Re. With ``onset_scale`` c the
-onset follows the window Reynolds number instead, :math:`K q|q|\,t/\sqrt{1+t^2}`,
-:math:`t = c|q|` (single-constriction Navier-Stokes, :func:`network.conductance.onset_scales`).
+With ``onset_scale`` c the inertial term sets in with the window Reynolds number,
+:math:`K q|q|\,t/\sqrt{1+t^2}`, :math:`t = c|q|` (:func:`network.conductance.onset_scales`):
+its excess over the viscous drop starts as Re² per conduit and tends to :math:`Kq|q|` at high
+Re (``docs/inertial-flow.md``).
 
 The unknowns are the free pore pressures and the common inlet pressure P (outlet pores at 0);
 the equations are mass balance in every free pore and a total inlet flow :math:`Q = UA`. The
@@ -77,7 +75,7 @@ class InertialPoint:
 
 def solve_inertial(n_pores, conns, g, K, inlet, outlet, flows_m3_s, *, tol: float = 1e-10,
                    maxiter: int = 30, amg: AMGSolver | None = None,
-                   crossover: float | None = None, onset_scale=None, workers: int = 1,
+                   onset_scale=None, workers: int = 1,
                    stokes=None) -> list[InertialPoint]:
     """Solve the nonlinear network at every total flow (ascending), reusing one hierarchy.
 
@@ -99,10 +97,8 @@ def solve_inertial(n_pores, conns, g, K, inlet, outlet, flows_m3_s, *, tol: floa
         Newton iterations per flow (default 30).
     amg : AMGSolver, optional
         Hierarchy of the condensed Stokes matrix (built here when not given).
-    crossover : float, optional
-        :math:`X_c` of the weak-inertia onset (:func:`conduit_flow`); None: purely quadratic.
     onset_scale : (Nt, 2) or (Nt,) array_like, optional, s/m³
-        Window-Reynolds onset of :func:`conduit_flow` instead (exclusive with ``crossover``).
+        Window-Reynolds onset of :func:`conduit_flow`; None: the loss is K q|q| from the start.
     workers : int, keyword-only
         Processes (default 1): the sorted flows are cut into ``workers`` contiguous
         continuation chains (:func:`_chain_sizes`; at least 4 flows per chain on average),
@@ -130,8 +126,6 @@ def solve_inertial(n_pores, conns, g, K, inlet, outlet, flows_m3_s, *, tol: floa
     if np.any(K < 0) or np.any(~np.isfinite(K)):
         raise ValueError("inertial coefficients must be finite and >= 0")
     c_on = None if onset_scale is None else np.asarray(onset_scale, dtype=float)
-    if c_on is not None and crossover is not None:
-        raise ValueError("give crossover or onset_scale, not both")
     if c_on is not None and (c_on.shape[0] != g.size or np.any(c_on < 0)
                              or np.any(~np.isfinite(c_on))):
         raise ValueError(f"onset_scale must have {g.size} rows, finite and >= 0")
@@ -165,7 +159,7 @@ def solve_inertial(n_pores, conns, g, K, inlet, outlet, flows_m3_s, *, tol: floa
         d = p[i[edge]] - p[j[edge]]
         s = 1.0
         for _ in range(8):
-            q, w = conduit_flow(s * d, g[edge], e_K, crossover=crossover, onset_scale=e_c)
+            q, w = conduit_flow(s * d, g[edge], e_K, onset_scale=e_c)
             f = e_sgn @ q - Q
             df = e_sgn @ (w * d)
             if not df > 0:
@@ -177,7 +171,7 @@ def solve_inertial(n_pores, conns, g, K, inlet, outlet, flows_m3_s, *, tol: floa
         return s * p
 
     def residual(p, Q, q_start=None):
-        q, w = conduit_flow(p[i] - p[j], g, K, crossover=crossover, onset_scale=c_on,
+        q, w = conduit_flow(p[i] - p[j], g, K, onset_scale=c_on,
                             q_start=q_start)
         net = np.bincount(i, q, n_pores) - np.bincount(j, q, n_pores)
         return np.append(net[free], net[inlet].sum() - Q), q, w

@@ -23,8 +23,7 @@ import numpy as np
 
 from .._air import MU_AIR_PA_S, RHO_AIR_KG_M3, check_density, check_positive, check_viscosity
 from .._deferred import beside
-from ..conductance import (CHAIN_ONSET_SLOPE, CHAIN_RECOVERY, KERNEL_MIN_THROATS, PORE_ONSET_SLOPE,
-                           PORE_RECOVERY, check_model, check_policy, conduit_law, has_grid,
+from ..conductance import (KERNEL_MIN_THROATS, check_model, check_policy, conduit_law, has_grid,
                            load_conduit_kernel, throat_conductance)
 from ..packing import Packing
 from ..pores import (Region, Tessellation, axis_index, default_region, merge_pores,
@@ -36,7 +35,7 @@ from ._linear import solve_fixed_pressure
 from ._result import FlowResult
 
 __all__ = ["solve_network", "solve_axes", "DEFAULT_VELOCITY_M_S", "DEFAULT_DEPTH_M",
-           "CORE_MARGIN_DIAMETERS", "CORE_MIN_DIAMETERS", "INERTIAL_LAWS", "INSET_DIAMETERS",
+           "CORE_MARGIN_DIAMETERS", "CORE_MIN_DIAMETERS", "INERTIAL_LAW", "INSET_DIAMETERS",
            "INSET_MIN_DIAMETERS"]
 
 log = logging.getLogger(__name__)
@@ -46,23 +45,9 @@ DEFAULT_VELOCITY_M_S = 0.013
 #: Bed depth of the thesis's comparison, m.
 DEFAULT_DEPTH_M = 0.25
 
-#: Per-conduit inertial laws: options of :func:`network.conductance.conduit_law`
-#: (``docs/inertial-flow.md``). 'pore': smooth contraction, flat-profile expansion against the
-#: body's Stokes outflow direction with the 3-D pore's recovery and window-Re onset slope;
-#: 'chain': the same with the chained pore's; 'window' (the default since session 11,
-#: :data:`DEFAULT_INERTIAL_LAW`): the chained pore's two constants per conduit from its window
-#: ratio (:func:`network.conductance.window_constants`).
-#: :data:`DERIVED_LAW` is that form with the single-constriction slope and no recovery
-#: (``network.validation`` and the bench compare it; not a CLI choice).
-DERIVED_LAW = {"profile": "uniform", "contraction": "smooth", "turning": True, "onset": "throat"}
-INERTIAL_LAWS = {"onset": {"profile": "laminar", "crossover": 1.0},
-                 "quadratic": {"profile": "uniform"},
-                 "pore": {**DERIVED_LAW, "recovery": PORE_RECOVERY,
-                          "onset_slope": PORE_ONSET_SLOPE},
-                 "chain": {**DERIVED_LAW, "recovery": CHAIN_RECOVERY,
-                           "onset_slope": CHAIN_ONSET_SLOPE},
-                 "window": {**DERIVED_LAW, "recovery": "window", "onset_slope": "window"}}
-DEFAULT_INERTIAL_LAW = "window"
+#: Name of the per-conduit inertial law in the JSON (``inertial_law``): the conduit window law
+#: of :func:`network.conductance.conduit_law` (``docs/inertial-flow.md``).
+INERTIAL_LAW = "window"
 
 
 def solve_network(packing: Packing, *, axis="z", region: Region | None = None,
@@ -78,7 +63,7 @@ def solve_network(packing: Packing, *, axis="z", region: Region | None = None,
                   qstar_fn: Callable | None = None, model_options: dict | None = None,
                   core_margin_m: float | None = None, inertia: bool = False,
                   density_kg_m3: float = RHO_AIR_KG_M3,
-                  curve_velocities_m_s=None, inertial_law: str = DEFAULT_INERTIAL_LAW,
+                  curve_velocities_m_s=None,
                   inertial_workers: int = 1, threads: int = 1) -> FlowResult:
     """Permeability and pressure drop of a packing by the Delaunay network model.
 
@@ -134,21 +119,11 @@ def solve_network(packing: Packing, *, axis="z", region: Region | None = None,
     inertia : bool
         Also solve the nonlinear network (:mod:`network.flow._inertial`, conduit model only)
         at ``velocity_m_s`` and at ``curve_velocities_m_s``; the result's ``inertial`` holds
-        the points (default False: Stokes only, as before).
+        the points (default False: Stokes only).
     density_kg_m3 : float
         ρ of the inertial loss (default 1.20 kg/m³).
     curve_velocities_m_s : sequence of float, optional
         More superficial velocities (m/s, > 0) for the resistance curve.
-    inertial_law : {'window', 'chain', 'pore', 'onset', 'quadratic'}
-        Per-conduit inertial loss (:data:`INERTIAL_LAWS`): 'chain' the law from a resolved
-        3-D pore body whose jets' kinetic energy the next body dissipates (+0.8 to +3.3 % of
-        lattice-Boltzmann solutions of the same packings at Re_p 10, -0.8 to +6.4 % at 50);
-        'window' (default) the chained body's slope and recovery per conduit from its window
-        ratio (+0.3 to +1.7 % at Re_p 10, +1.0 to +5.0 % at 50, 15 packings of solid
-        fraction 0.55-0.64, five of them blind); 'pore' the same body alone;
-        'onset' the expansion with the laminar jet profile and the X/(1+X) onset;
-        'quadratic' the flat-profile loss K q|q| from the start
-        (``docs/inertial-flow.md``).
     inertial_workers : int
         Processes for the nonlinear solves (``workers`` of
         :func:`network.flow.solve_inertial`: parallel continuation chains of at least 4
@@ -173,9 +148,6 @@ def solve_network(packing: Packing, *, axis="z", region: Region | None = None,
         check_policy(policy)
     if core_margin_m is not None:
         core_margin_m = check_positive("core_margin_m", core_margin_m)
-    if inertial_law not in INERTIAL_LAWS:
-        raise ValueError(f"unknown inertial law {inertial_law!r}; choose one of "
-                         f"{', '.join(INERTIAL_LAWS)}")
     density_kg_m3 = check_density(density_kg_m3)
     curve_u = [check_positive("velocity_m_s", u) for u in (curve_velocities_m_s or [])]
     if inertia and (conductance is not None or conductance_model != "conduit"):
@@ -247,18 +219,18 @@ def solve_network(packing: Packing, *, axis="z", region: Region | None = None,
     if inertia:
         with stage("inertial"):
             keep = np.searchsorted(throats_before, sample.throats)
-            K, c_on, crossover = conduit_law(
+            K, c_on = conduit_law(
                 tess, sample.throats, cres.h_m[keep], internal=np.asarray(cres.internal)[keep],
                 pore_xyz_m=sample.pore_xyz, conns=sample.conns,
                 stokes_flow_m3_s=check["throat_flow"], axis=ax, density_kg_m3=density_kg_m3,
-                viscosity_pa_s=viscosity_pa_s, threads=threads, **INERTIAL_LAWS[inertial_law])
+                viscosity_pa_s=viscosity_pa_s, threads=threads)
             us = [velocity_m_s] + curve_u
             pts = solve_inertial(sample.n_pores, sample.conns, g, K, sample.inlet,
                                  sample.outlet, np.asarray(us) * sample.area_m2,
-                                 crossover=crossover, onset_scale=c_on, amg=info.amg,
+                                 onset_scale=c_on, amg=info.amg,
                                  workers=inertial_workers, stokes=(p, check["q_in"]))
             inertial = {"density_kg_m3": density_kg_m3, "velocities_m_s": us, "points": pts,
-                        "law": inertial_law}
+                        "law": INERTIAL_LAW}
     times["assemble"] = info.assemble_s
     times["solve"] -= info.assemble_s
     if not check["ok"]:

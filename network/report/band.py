@@ -24,7 +24,7 @@ from pathlib import Path
 
 import numpy as np
 
-from ..flow import DEFAULT_INERTIAL_LAW, solve_network
+from ..flow import solve_network
 from ..packing import Packing, random_packing
 
 __all__ = ["BAND_OFFSETS", "fit_log_slope", "band_gradients", "slope_at", "pack_band",
@@ -108,7 +108,7 @@ def slope_at(velocity_m_s, velocities_m_s, slopes) -> float:
 
 def pack_band(packing: Packing, porosity: float, *, velocities_m_s, axis: str = "z",
               seeds=(1, 2), viscosity_pa_s: float, density_kg_m3: float,
-              inertial_law: str = DEFAULT_INERTIAL_LAW, db=None) -> dict:
+              db=None) -> dict:
     """Pack and solve the band's beds; the fitted slope at each velocity (see the module).
 
     The packings have ``packing``'s grain count, its (volume-equivalent) diameter range and its
@@ -132,7 +132,7 @@ def pack_band(packing: Packing, porosity: float, *, velocities_m_s, axis: str = 
                                aspect=aspect, rng=int(seed))
             r = solve_network(p, axis=axis, viscosity_pa_s=viscosity_pa_s, velocity_m_s=us[0],
                               inertia=True, density_kg_m3=density_kg_m3, db=db,
-                              curve_velocities_m_s=us[1:], inertial_law=inertial_law)
+                              curve_velocities_m_s=us[1:])
             pts = r.curve_points()
             if not all(q["converged"] for q in pts):
                 raise RuntimeError(f"band packing seed {seed}, solid fraction {sf:.3f}: the "

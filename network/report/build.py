@@ -14,7 +14,7 @@ import numpy as np
 
 from .._cli import available_cores
 from .._grains import D272, d272_velocity_range
-from ..flow import asabe_d272_gradient, ergun_gradient, fit_curve, solve_network
+from ..flow import INERTIAL_LAW, asabe_d272_gradient, ergun_gradient, fit_curve, solve_network
 from ..packing import read_container
 from ..pores import region_porosity, sample_region
 from .band import BAND_OFFSETS, band_gradients, measured_band, pack_band, slope_at
@@ -38,7 +38,7 @@ def _solve(o: ReportOptions, packing, container, axis, us, porosity=None):
     return solve_network(packing, axis=axis, region=region, viscosity_pa_s=o.viscosity_pa_s,
                          velocity_m_s=us[0], depth_m=o.depth_m, inertia=True,
                          density_kg_m3=o.density_kg_m3, curve_velocities_m_s=us[1:],
-                         inertial_law=o.inertial_law, porosity=porosity,
+                         porosity=porosity,
                          inertial_workers=available_cores(), threads=available_cores())
 
 
@@ -109,7 +109,7 @@ def build_report(packing, path, options: ReportOptions) -> dict:
                                                      ub[-1]],
                          seeds=(o.band_seed, o.band_seed + 1),
                          viscosity_pa_s=o.viscosity_pa_s,
-                         density_kg_m3=o.density_kg_m3, inertial_law=o.inertial_law)
+                         density_kg_m3=o.density_kg_m3)
     c = D272[o.grain]
     d272_range, d272_range_source = d272_velocity_range(o.grain)
     for p, px in zip(pts, pts_x):
@@ -145,7 +145,7 @@ def build_report(packing, path, options: ReportOptions) -> dict:
     sg = [p["pressure_gradient_pa_per_m"] for p in ok]
     system = system_rows(su, sg, depth_m=o.depth_m, area_m2=area, bulk_density_kg_m3=rho_b)
     out = {"grain": o.grain, "packing": str(path), "n_spheres": packing.n,
-           "n_grains": packing.n_grains, "porosity": e, "inertial_law": o.inertial_law,
+           "n_grains": packing.n_grains, "porosity": e, "inertial_law": INERTIAL_LAW,
            "porosity_source": f"{o.bed_label}; {why}",
            "bed": dict(o.bed_record) if o.bed_record is not None else user_bed_json(path),
            "porosity_packing": e_p, "porosity_packing_std": rz.porosity_std,

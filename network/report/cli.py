@@ -286,7 +286,7 @@ def report_options(args, checked: dict, path) -> ReportOptions:
         fan_static_pressure_pa=None if fan is None else tuple(fan[1].tolist()),
         fan_file=args.fan, band=not args.no_band, sphere_band=args.sphere_band,
         band_seed=args.band_seed, viscosity_pa_s=args.viscosity, density_kg_m3=args.density,
-        inertial_law=args.inertial_law, sample_box_m=None if box is None else tuple(box),
+        sample_box_m=None if box is None else tuple(box),
         margin_m=margin, bed_label=checked["bed"]["label"],
         bed_record=bed_json(checked["bed"], path))
 

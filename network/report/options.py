@@ -13,7 +13,7 @@ from dataclasses import dataclass, field
 from .._air import MU_AIR_PA_S, RHO_AIR_KG_M3
 from .._grains import BED, grain_key
 from ..curve import DEFAULT_VELOCITIES, parse_velocities
-from ..flow import DEFAULT_DEPTH_M, DEFAULT_INERTIAL_LAW, INERTIAL_LAWS
+from ..flow import DEFAULT_DEPTH_M
 from .system import AIRFLOW_UNITS, check_fan_shape
 
 __all__ = ["ReportOptions", "grain_key"]
@@ -70,8 +70,6 @@ class ReportOptions:
         First seed of the band's sphere packings, ≥ 0 (default 1).
     viscosity_pa_s, density_kg_m3 : float
         Air, Pa s and kg/m³, > 0 (defaults the thesis air's, 1.932e-5 and 1.20).
-    inertial_law : str
-        Per-conduit inertial law, a key of ``INERTIAL_LAWS`` (default ``"window"``).
     sample_box_m : tuple of 6 float or None
         Sample box (xmin, xmax, ymin, ymax, zmin, zmax), m; None (default): the interior box.
     margin_m : float or None
@@ -103,7 +101,6 @@ class ReportOptions:
     band_seed: int = 1
     viscosity_pa_s: float = MU_AIR_PA_S
     density_kg_m3: float = RHO_AIR_KG_M3
-    inertial_law: str = DEFAULT_INERTIAL_LAW
     sample_box_m: tuple | None = None
     margin_m: float | None = None
     bed_label: str = "the user's packing"
@@ -156,9 +153,6 @@ class ReportOptions:
         if isinstance(self.band_seed, bool) or not isinstance(self.band_seed, int) \
                 or self.band_seed < 0:
             raise ValueError(f"band_seed must be an integer >= 0, got {self.band_seed!r}")
-        if self.inertial_law not in INERTIAL_LAWS:
-            raise ValueError(f"inertial_law {self.inertial_law!r}: use one of "
-                             f"{', '.join(INERTIAL_LAWS)}")
         if self.sample_box_m is not None:
             box = tuple(float(v) for v in self.sample_box_m)
             if len(box) != 6 or not all(math.isfinite(v) for v in box) \

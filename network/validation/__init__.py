@@ -1,8 +1,7 @@
 """Validation: reference permeabilities and the cases that run the one pipeline against them."""
 
 from ._drag_laws import DRAG_LAWS, beetstra_drag, drag_ratio, hill_koch_ladd_drag
-from ._inertial_cases import (CHAIN_LAW, DERIVED_LAW, FINNEY_PATH, PORE_LAW, WINDOW_LAW,
-                              InertialCase, bed_inertial_case, finney_inertial_case,
+from ._inertial_cases import (FINNEY_PATH, InertialCase, bed_inertial_case, finney_inertial_case,
                               lattice_inertial_case, periodic_inertial_case, random_inertial_case,
                               solve_sample_curve)
 from ._cases import ESTIMATORS, lattice_sample_permeability, random_sample_permeability
@@ -13,7 +12,7 @@ from ._references import (STOKES_CELL_BCC, STOKES_CELL_FCC, ZICK_HOMSY_SC, beets
                           kozeny_carman_permeability, lattice_permeability,
                           sangani_acrivos_sc_drag, zick_homsy_sc_drag)
 
-__all__ = ["CHAIN_LAW", "DERIVED_LAW", "DRAG_LAWS", "ESTIMATORS", "FINNEY_PATH", "InertialCase",
+__all__ = ["DRAG_LAWS", "ESTIMATORS", "FINNEY_PATH", "InertialCase",
            "STOKES_CELL_BCC", "STOKES_CELL_FCC", "ZICK_HOMSY_SC", "beetstra_drag",
            "beetstra_permeability", "beetstra_stokes_drag", "computed_lattice_permeability",
            "drag_ratio", "drag_to_permeability", "ergun_viscous_permeability",
@@ -21,5 +20,5 @@ __all__ = ["CHAIN_LAW", "DERIVED_LAW", "DRAG_LAWS", "ESTIMATORS", "FINNEY_PATH",
            "hill_koch_ladd_drag", "kozeny_carman_permeability", "lattice_inertial_case",
            "lattice_permeability", "lattice_sample_permeability", "periodic_inertial_case",
            "periodic_permeability",
-           "PORE_LAW", "random_inertial_case", "random_sample_permeability",
-           "sangani_acrivos_sc_drag", "solve_sample_curve", "WINDOW_LAW", "zick_homsy_sc_drag"]
+           "random_inertial_case", "random_sample_permeability",
+           "sangani_acrivos_sc_drag", "solve_sample_curve", "zick_homsy_sc_drag"]

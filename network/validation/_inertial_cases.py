@@ -8,9 +8,10 @@ viscosity 1 and density 1 with the superficial velocities :math:`U = Re/d`, so t
 k the sample's Stokes permeability) beside the laws'
 :math:`F(\phi, Re)/F(\phi, 0)` (:mod:`._drag_laws`).
 
-The cases pass their keyword law options (``crossover``, ``profile``, ``contraction``,
-``turning``, ``onset``) to :func:`solve_sample_curve`; none given: the flat-profile quadratic
-law; :data:`DERIVED_LAW`: the law derived from single-constriction Navier-Stokes.
+The conduit law is the window law of :func:`network.conductance.conduit_law`; a case's
+``table`` (default :data:`network.conductance.CHAIN_WINDOW_TABLE`) gives its constants per
+window ratio, so a comparison may solve the same form with other measured constants (a one-row
+table holds one pair for every conduit).
 
 * :func:`random_inertial_case`: periodic random packing (:func:`network.random_packing`),
   copied 3 x 3 x 3, the middle two periods as the sample, as
@@ -34,39 +35,16 @@ from pathlib import Path
 
 import numpy as np
 
-from ..conductance import ONSET_SLOPE, conduit_law, throat_conductance
-from ..flow import DERIVED_LAW as FLOW_DERIVED_LAW
-from ..flow import (INERTIAL_LAWS, AMGSolver, darcy_permeability, solve_fixed_pressure,
-                    solve_inertial)
+from ..conductance import conduit_law, throat_conductance
+from ..flow import AMGSolver, darcy_permeability, solve_fixed_pressure, solve_inertial
 from ..packing import Packing, lattice_packing, periodic_copies, random_packing, read_packing
 from ..pores import (Region, merge_pores, prune_disconnected, region_porosity, select_sample,
                      tessellate)
 from ._drag_laws import DRAG_LAWS, drag_ratio
 
-__all__ = ["CHAIN_LAW", "DERIVED_LAW", "FINNEY_PATH", "PORE_LAW", "WINDOW_LAW", "InertialCase",
+__all__ = ["FINNEY_PATH", "InertialCase",
            "bed_inertial_case", "finney_inertial_case", "lattice_inertial_case",
            "periodic_inertial_case", "random_inertial_case", "solve_sample_curve"]
-
-#: Conduit law from single-constriction Navier-Stokes + the turning momentum balance
-#: (``docs/inertial-flow.md``): keyword options of :func:`solve_sample_curve` and the cases;
-#: the form of the CLI's 'pore' and 'chain' laws (:data:`network.flow.DERIVED_LAW`).
-DERIVED_LAW = dict(FLOW_DERIVED_LAW)
-
-#: The same form with the onset slope and the cross-momentum recovery of a resolved 3-D pore
-#: body (regular tetrahedral pore, steady Navier-Stokes; ``docs/inertial-flow.md``, "A law
-#: from the 3-D pore") instead of the axisymmetric constriction's slope and no recovery:
-#: ``network.solve``'s default law in session 7.
-PORE_LAW = dict(INERTIAL_LAWS["pore"])
-
-#: The same form with the slope and recovery of that pore body in a chain (the kinetic energy
-#: its jets carry out is the next body's loss; ``docs/inertial-flow.md``, "The chained pore"):
-#: ``network.solve``'s default law in sessions 8-10.
-CHAIN_LAW = dict(INERTIAL_LAWS["chain"])
-
-#: The chained body's slope and recovery taken per conduit from its own window ratio
-#: (:data:`network.conductance.CHAIN_WINDOW_TABLE`: the chained pore at nine window ratios):
-#: ``network.solve``'s default law since session 11.
-WINDOW_LAW = dict(INERTIAL_LAWS["window"])
 
 #: Finney's packing, central subset (radius 1, lengths in sphere radii): in the ``shared/``
 #: folder beside the checkout (``../shared`` of the repository root, as a fresh clone has it),
@@ -110,26 +88,15 @@ class InertialCase:
 
 
 def solve_sample_curve(packing, region, velocities_m_s, *, axis=0, policy="table-only",
-                       db=None, viscosity_pa_s=1.0, density_kg_m3=1.0, crossover=None,
-                       profile="uniform", onset=None, turning=False,
-                       contraction="sharp", recovery=0.0, onset_slope=ONSET_SLOPE,
+                       db=None, viscosity_pa_s=1.0, density_kg_m3=1.0, table=None,
                        workers: int = 1):
     """The inertial pipeline of :func:`network.solve_network` (conduit model, bodies merged;
     one AMG hierarchy, built for the Stokes solve and reused by every Newton step):
     ``(permeability_m2, length_m, points, seconds)``, ``seconds`` a dict by stage.
 
-    The conduit law is selectable: ``crossover`` (X_c onset of
-    :func:`network.flow.solve_inertial`) or ``onset="throat"`` (window-Reynolds onset,
-    :func:`network.conductance.onset_scales`); the expansion ``profile``, ``contraction``
-    ('sharp' | 'smooth') and ``turning`` (expansion against each body's Stokes outflow
-    direction, :func:`network.conductance.turning_cosines`, with ``recovery``) of
-    :func:`network.conductance.inertial_coefficients`; ``workers`` continuation chains
-    (:func:`network.flow.solve_inertial`); ``onset_slope`` the c_1 of
-    :func:`network.conductance.onset_scales`. :data:`DERIVED_LAW` is the law derived from
-    single-constriction Navier-Stokes, :data:`PORE_LAW` the one from the 3-D pore body
-    (``docs/inertial-flow.md``)."""
-    if onset not in (None, "throat"):
-        raise ValueError(f"onset must be None or 'throat', got {onset!r}")
+    The conduit law is :func:`network.conductance.conduit_law` with the window ``table``
+    (default :data:`network.conductance.CHAIN_WINDOW_TABLE`); ``workers`` continuation chains
+    (:func:`network.flow.solve_inertial`)."""
     t = {}
     t0 = time.perf_counter()
     tess = tessellate(packing)
@@ -156,29 +123,27 @@ def solve_sample_curve(packing, region, velocities_m_s, *, axis=0, policy="table
                            viscosity_pa_s=viscosity_pa_s)
     t["stokes"] = time.perf_counter() - t0
     t0 = time.perf_counter()
-    K, c_on, crossover = conduit_law(
+    K, c_on = conduit_law(
         tess, sample.throats, cres.h_m[keep], internal=np.asarray(cres.internal)[keep],
         pore_xyz_m=sample.pore_xyz, conns=sample.conns, stokes_flow_m3_s=check["throat_flow"],
-        axis=axis, density_kg_m3=density_kg_m3, viscosity_pa_s=viscosity_pa_s,
-        profile=profile, contraction=contraction, turning=turning, recovery=recovery,
-        onset=onset, onset_slope=onset_slope, crossover=crossover)
+        axis=axis, density_kg_m3=density_kg_m3, viscosity_pa_s=viscosity_pa_s, table=table)
     pts = solve_inertial(sample.n_pores, sample.conns, g, K, sample.inlet, sample.outlet,
                          np.asarray(velocities_m_s, dtype=float) * sample.area_m2,
-                         crossover=crossover, onset_scale=c_on, amg=held.get("amg"),
+                         onset_scale=c_on, amg=held.get("amg"),
                          workers=workers, stokes=(p0, check["q_in"]))
     t["inertial"] = time.perf_counter() - t0
     return k, sample.length_m, pts, t
 
 
 def _run(name, packing, region, diameter, solid_fraction, reynolds, *, axis, policy, db,
-         laws, law):
+         laws, table):
     re = np.asarray(reynolds, dtype=float)
     if re.ndim != 1 or not re.size or np.any(~np.isfinite(re)) or np.any(re <= 0):
         raise ValueError(f"reynolds must be a non-empty list of values > 0, got {reynolds!r}")
     t0 = time.perf_counter()
     us = re / diameter                      # mu = rho = 1: Re = U d
     k, length, pts, _ = solve_sample_curve(packing, region, us, axis=axis, policy=policy,
-                                           db=db, **law)
+                                           db=db, table=table)
     grad = np.array([p.dp_pa for p in pts]) / length
     k_ratio = grad * k / us                 # (dP/L) / (mu U / k)
     law_ratio = {}
@@ -195,7 +160,7 @@ def _run(name, packing, region, diameter, solid_fraction, reynolds, *, axis, pol
 
 def random_inertial_case(solid_fraction: float, reynolds, *, n_spheres: int = 800, rng=1,
                          copies: int = 3, axis: int = 0, policy: str = "table-only",
-                         db=None, laws=tuple(DRAG_LAWS), **law) -> InertialCase:
+                         db=None, laws=tuple(DRAG_LAWS), table=None) -> InertialCase:
     """Periodic random packing of unit spheres at ``solid_fraction`` (<= 0.64), copied
     ``copies``³ times; sample = all but half a period at every face (module notes)."""
     phi = float(solid_fraction)
@@ -205,12 +170,12 @@ def random_inertial_case(solid_fraction: float, reynolds, *, n_spheres: int = 80
                           periodic=True, rng=rng)
     return periodic_inertial_case(base, phi, reynolds, name=f"random phi={phi:.3f} "
                                   f"n={n_spheres} seed={rng}", copies=copies, axis=axis,
-                                  policy=policy, db=db, laws=laws, **law)
+                                  policy=policy, db=db, laws=laws, table=table)
 
 
 def periodic_inertial_case(base: Packing, solid_fraction: float, reynolds, *, name: str = "",
                            copies: int = 3, axis: int = 0, policy: str = "table-only",
-                           db=None, laws=tuple(DRAG_LAWS), **law) -> InertialCase:
+                           db=None, laws=tuple(DRAG_LAWS), table=None) -> InertialCase:
     """A periodic packing of unit spheres in the cube of side L = (pi n / (6 phi))^(1/3),
     copied ``copies``³ times; sample = all but half a period at every face (module notes)."""
     phi = float(solid_fraction)
@@ -218,12 +183,12 @@ def periodic_inertial_case(base: Packing, solid_fraction: float, reynolds, *, na
     packing = periodic_copies(base, side, int(copies))
     region = Region(np.full(3, 0.5 * side), np.full(3, (copies - 0.5) * side))
     return _run(name or f"periodic phi={phi:.3f} n={base.n}", packing, region, 1.0, phi,
-                reynolds, axis=axis, policy=policy, db=db, laws=laws, law=law)
+                reynolds, axis=axis, policy=policy, db=db, laws=laws, table=table)
 
 
 def finney_inertial_case(reynolds, *, half_side: float = 8.0, axis: int = 0,
                          policy: str = "table-only", db=None, path=FINNEY_PATH,
-                         laws=tuple(DRAG_LAWS), **law) -> InertialCase:
+                         laws=tuple(DRAG_LAWS), table=None) -> InertialCase:
     """A cube of half-side ``half_side`` (sphere radii) at the centroid of Finney's packing;
     the law is evaluated at the cube's solid fraction (exact sphere-region volumes,
     :func:`network.pores.region_porosity`)."""
@@ -234,12 +199,12 @@ def finney_inertial_case(reynolds, *, half_side: float = 8.0, axis: int = 0,
     phi = _box_solid_fraction(packing, region)
     return _run(f"finney cube {2 * h:g} r, phi={phi:.3f}", packing, region,
                 float(2 * packing.radii.mean()), phi, reynolds, axis=axis, policy=policy,
-                db=db, laws=laws, law=law)
+                db=db, laws=laws, table=table)
 
 
 def bed_inertial_case(path, reynolds, *, axis: int = 2, margin: float = 2.5,
                       top_margin: float = 3.0, policy: str = "table-only", db=None,
-                      laws=tuple(DRAG_LAWS), **law) -> InertialCase:
+                      laws=tuple(DRAG_LAWS), table=None) -> InertialCase:
     """A settled bed (a ``dem.pack`` CSV, walls and a free surface): the box ``margin``
     Sauter diameters d32 inside the spheres' extent at the walls and the floor and
     ``top_margin`` d32 below the surface (the lowest of the highest centres of 2 d32 wide
@@ -262,7 +227,7 @@ def bed_inertial_case(path, reynolds, *, axis: int = 2, margin: float = 2.5,
     phi = _box_solid_fraction(packing, region)
     size = "x".join(f"{v:.1f}" for v in (hi - lo) / d32)
     return _run(f"bed {Path(path).stem} {size} d, phi={phi:.3f}, axis {'xyz'[axis]}", packing,
-                region, d32, phi, reynolds, axis=axis, policy=policy, db=db, laws=laws, law=law)
+                region, d32, phi, reynolds, axis=axis, policy=policy, db=db, laws=laws, table=table)
 
 
 def _box_solid_fraction(packing: Packing, region: Region) -> float:
@@ -273,7 +238,7 @@ def _box_solid_fraction(packing: Packing, region: Region) -> float:
 
 def lattice_inertial_case(kind: str, solid_fraction: float, reynolds, *, n_cells: int = 7,
                           axis: int = 0, policy: str = "table-only", db=None,
-                          offset: float = 0.137, **law) -> InertialCase:
+                          offset: float = 0.137, table=None) -> InertialCase:
     """Simple-cubic / BCC / FCC array, lattice constant 1, sample box as
     :func:`lattice_sample_permeability`; ``law_ratio`` holds the random-packing laws for
     information only (an ordered array is not a random bed)."""
@@ -281,4 +246,4 @@ def lattice_inertial_case(kind: str, solid_fraction: float, reynolds, *, n_cells
     region = Region(np.full(3, 1.0 + offset), np.full(3, n_cells - 2 + offset))
     return _run(f"{kind} phi={float(solid_fraction):.3f}", Packing(c, r), region,
                 float(2 * r[0]), float(solid_fraction), reynolds, axis=axis, policy=policy,
-                db=db, laws=("beetstra",), law=law)
+                db=db, laws=("beetstra",), table=table)
