@@ -213,3 +213,23 @@ def test_a_fan_that_never_crosses_the_bin_is_exit_1_with_both_ranges(tmp_path, c
     err = capsys.readouterr().err
     assert code == 1
     assert "system curve: airflow" in err and "fan: airflow" in err
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("shape", ["half-round", "round"])
+def test_d_a_floor_duct_in_3d_balances_and_keeps_its_keys(shape, tmp_path):
+    """(d) in 3-D: a duct bin (tetrahedra, pyamg-preconditioned CG) balances to 1e-8; the JSON
+    has the contract's keys."""
+    out = tmp_path / "d.json"
+    code = main(["--diameter", "6", "--depth", "3", "--floor", "duct", "--duct", "0.5", "4.5",
+                 "1", "--duct-shape", shape, "--pressure", "100", "--elements", "12000",
+                 "--json", str(out), "--no-figure", "--no-refinement-check", "-q"])
+    assert code == 0
+    r = json.loads(out.read_text())
+    for key in ("static_pressure_pa", "airflow_m3_s", "airflow_m3_per_min_t",
+                "underaerated_fraction", "system_curve", "law", "geometry", "mesh", "converged"):
+        assert key in r
+    assert r["mesh"]["axisymmetric"] is False and r["mesh"]["elements"] > 8000
+    assert r["mass_balance"]["relative_difference"] < 1e-8
+    assert r["static_pressure_pa"] == 100.0
+    assert r["geometry"]["ducts"][0]["shape"] == shape

@@ -289,7 +289,7 @@ def _mesh_3d(geom: BinGeometry, size_m: float) -> Mesh:
                 duct_faces.append(tag)
         if duct_faces:
             dmin = min(du.diameter_m for du in geom.ducts)
-            near = min(size_m, dmin / 8)
+            near = min(size_m, dmin / 5)
             f = gmsh.model.mesh.field
             fd = f.add("Distance")
             f.setNumbers(fd, "SurfacesList", duct_faces)
@@ -297,8 +297,8 @@ def _mesh_3d(geom: BinGeometry, size_m: float) -> Mesh:
             f.setNumber(ft, "InField", fd)
             f.setNumber(ft, "SizeMin", near)
             f.setNumber(ft, "SizeMax", size_m)
-            f.setNumber(ft, "DistMin", 0.25 * dmin)
-            f.setNumber(ft, "DistMax", 2.5 * dmin + 6 * size_m)
+            f.setNumber(ft, "DistMin", 0.1 * dmin)
+            f.setNumber(ft, "DistMax", dmin + 4 * size_m)
             f.setAsBackgroundMesh(ft)
             fields.append(ft)
             gmsh.option.setNumber("Mesh.MeshSizeExtendFromBoundary", 0)

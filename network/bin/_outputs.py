@@ -93,16 +93,28 @@ def write_vtk(path, problem, sol, local, under) -> None:
             np.savetxt(f, arr, fmt=fmt)
 
 
-def _find(finder, pts):
-    """Element of each point (-1 outside): skfem's finder refuses a batch holding a point
-    outside the mesh, so a refused batch is halved until the outside points are alone."""
-    try:
-        return np.asarray(finder(*pts))
-    except ValueError:
-        if pts.shape[1] == 1:
-            return np.array([-1])
-        h = pts.shape[1] // 2
-        return np.concatenate([_find(finder, pts[:, :h]), _find(finder, pts[:, h:])])
+def _locate_tets(points, cells, xyz, k=24):
+    """Tetrahedron holding each point (-1 outside): the k elements with the nearest
+    centroids (scipy's cKDTree), tested by barycentric coordinates, vectorised."""
+    from scipy.spatial import cKDTree
+
+    cen = points[:, cells].mean(axis=1).T
+    _, cand = cKDTree(cen).query(xyz.T, k=k)
+    v = points[:, cells]                                    # (3, 4, Ne)
+    out = np.full(xyz.shape[1], -1)
+    for j in range(k):
+        e = cand[:, j]
+        todo = out < 0
+        if not np.any(todo):
+            break
+        e, x = e[todo], xyz[:, todo]
+        T = np.stack([v[:, 1, e] - v[:, 0, e], v[:, 2, e] - v[:, 0, e],
+                      v[:, 3, e] - v[:, 0, e]], axis=-1)      # (3, n, 3)
+        lam = np.linalg.solve(np.moveaxis(T, 0, 1), (x - v[:, 0, e]).T[:, :, None])[:, :, 0]
+        hit = (lam >= -1e-9).all(axis=1) & (lam.sum(axis=1) <= 1 + 1e-9)
+        idx = np.flatnonzero(todo)[hit]
+        out[idx] = e[hit]
+    return out
 
 
 def _section(problem, sol, local, under, geom, n=140):
@@ -128,7 +140,7 @@ def _section(problem, sol, local, under, geom, n=140):
                                  problem.mesh.cells.T)
         el[inside] = tri.get_trifinder()(pts[0, inside], pts[1, inside])
     else:
-        el[inside] = _find(problem.skmesh.element_finder(), pts[:, inside])
+        el[inside] = _locate_tets(problem.mesh.points, problem.mesh.cells, pts[:, inside])
     ok = el >= 0
     out = []
     vh = sol.velocity[1] if not problem.axisymmetric else sol.velocity[0]
@@ -150,7 +162,9 @@ def write_figure(path, problem, sol, info, geom, title) -> None:
 
     H, Z, speed, uh, uz, local, under = _section(problem, sol, info["local_airflow_m3_per_min_t"],
                                                  info["underaerated_mask"], geom)
-    fig, ax = plt.subplots(figsize=(7.5, 5.2) if problem.axisymmetric else (9.5, 4.8))
+    width = (1 if problem.axisymmetric else 2) * geom.radius_m
+    height = float(max(geom.surface_height(0.0), geom.depth_m))
+    fig, ax = plt.subplots(figsize=(min(2.5 + 4.2 * width / height, 12.0), 5.0))
     q_t = info["airflow_m3_per_min_t"]
     im = ax.pcolormesh(H, Z, local, shading="auto", cmap="viridis",
                        vmin=0, vmax=np.nanpercentile(local, 98))
@@ -161,7 +175,8 @@ def write_figure(path, problem, sol, info, geom, title) -> None:
         ax.contour(H, Z, np.nan_to_num(under), levels=[0.5], colors="r", linewidths=1.5)
     la = info["least_aerated"]
     ax.plot(la["r_m"] if problem.axisymmetric else la["y_m"], la["z_m"], "r*", ms=12,
-            label=f"least aerated: {la['airflow_m3_per_min_t']:.3g} m$^3$/(min t)")
+            label=f"least aerated: {la['airflow_m3_per_min_t']:.3g} m$^3$/(min t)"
+                  + ("" if problem.axisymmetric else f" (at x = {la['x_m']:.2f} m)"))
     rr = np.linspace(0 if problem.axisymmetric else -geom.radius_m, geom.radius_m, 200)
     ax.plot(rr, geom.surface_height(np.abs(rr)), "k-", lw=1)
     ax.set_xlabel("r, m" if problem.axisymmetric else "y, m (section x = 0)")
@@ -169,7 +184,7 @@ def write_figure(path, problem, sol, info, geom, title) -> None:
     ax.set_aspect("equal")
     ax.set_title(f"{title}\nmean {q_t:.3g} m$^3$/(min t); red: below half the mean "
                  f"({100 * info['underaerated_fraction']:.1f} % of the grain)", fontsize=9)
-    ax.legend(loc="upper right", fontsize=8)
+    ax.legend(loc="lower center", bbox_to_anchor=(0.5, 1.13), fontsize=8, frameon=False)
     fig.tight_layout()
     fig.savefig(path, dpi=120)
     plt.close(fig)

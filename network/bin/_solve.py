@@ -92,15 +92,21 @@ class BinProblem:
                        if self.axisymmetric else np.ones((m.t.shape[1], 1)))
         self.volumes = np.asarray(self.basis.dx).sum(axis=1) * (
             self.weight[:, 0] if self.axisymmetric else 1.0)
+        # element gradients of the basis functions, (dim, nodes per element, Ne): ∇p per
+        # element is one contraction, without skfem's interpolate (its index bookkeeping
+        # costs more than the sum)
+        self.grads = np.stack([np.asarray(self.basis.basis[i][0].grad)[:, :, 0]
+                               for i in range(m.t.shape[0])], axis=1)
         n = m.p.shape[1]
         self.fixed = np.union1d(mesh.plenum, mesh.surface)
         self.free = np.setdiff1d(np.arange(n), self.fixed)
-        self._ml = None
+        self._ml = None                 # pyamg hierarchy of an earlier Newton matrix, reused
+        self._cg_iterations = 0         # while CG needs at most 40 iterations with it
 
     # ---------------------------------------------------------------- fields
     def _fields(self, p):
         """Per element (one quadrature point): g, G, W, W', M, n."""
-        g = self.basis.interpolate(p).grad            # (dim, Ne, 1)
+        g = np.einsum("dve,ve->de", self.grads, p[self.skmesh.t])[:, :, None]  # (dim, Ne, 1)
         ag = self.adiag[:, None, None] * g
         G = np.sqrt(np.sum(g * ag, axis=0))           # (Ne, 1)
         w, dw = self.law.speed(G[:, 0])
@@ -142,13 +148,26 @@ class BinProblem:
     # ---------------------------------------------------------------- solve
     def _linear(self, J, rhs):
         Jii = J[self.free][:, self.free]
-        if self.axisymmetric or Jii.shape[0] < 30_000:
+        if self.axisymmetric:
             return spla.spsolve(Jii.tocsc(), rhs)
         import pyamg
 
-        ml = pyamg.smoothed_aggregation_solver(Jii, symmetry="symmetric", max_coarse=500)
-        x, info = spla.cg(Jii, rhs, rtol=1e-10, maxiter=400, M=ml.aspreconditioner())
+        from ..flow._amg import _seeded_numpy_random, one_blas_thread
+
+        with one_blas_thread(), _seeded_numpy_random():
+            if self._ml is None or self._cg_iterations > 40:
+                self._ml = pyamg.smoothed_aggregation_solver(
+                    Jii, symmetry="symmetric", max_coarse=500,
+                    coarse_solver="splu").aspreconditioner()
+            count = [0]
+
+            def step(_):
+                count[0] += 1
+
+            x, info = spla.cg(Jii, rhs, rtol=1e-11, maxiter=500, M=self._ml, callback=step)
+        self._cg_iterations = count[0]
         if info != 0:
+            log.warning("CG with pyamg did not reach 1e-11 in 500 iterations: sparse LU")
             x = spla.spsolve(Jii.tocsc(), rhs)
         return x
 
