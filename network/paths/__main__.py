@@ -297,7 +297,7 @@ def _main(args) -> int:
               + (f" (thesis {refw[0]}-{refw[1]})" if refw else "")
               + f", turns < 30 deg "
                 f"{np.mean(np.concatenate([p.turning_angles_deg for p in ok]) < 30):.2f}"
-              + (" (thesis > 0.5)" if ref else ""))
+              + (" (thesis > 0.5, turns drawn in 2-D: docs/airpaths.md)" if ref else ""))
 
     branched, table45 = [], {}
     if not args.no_branched:
