@@ -43,8 +43,8 @@ from ._build import PrecomputeSummary, precompute_grid, precompute_throats
 from ._dask import DaskConnectError, dask_executor
 from ._kernel import point_kernel
 from ._interp import CALIBRATED_SAFETY, ERROR_SAFETY, GRIDS, GridSpec, GridTable, grid_coordinates
-from ._lookup import (POLICIES, SOURCES, Lookup, default_db_path, export_grid, load_grid_table,
-                      lookup_qstar, read_grid_file, shipped_grid_path)
+from ._lookup import (POLICIES, SOURCES, Lookup, cold_tables, default_db_path, export_grid,
+                      load_grid_table, lookup_qstar, read_grid_file, shipped_grid_path)
 from ._orbits import EXTENSION_GRIDS, table_coverage
 from ._routes import table_routes
 from ._signature import QUANTUM, shape_keys, signature
@@ -56,4 +56,4 @@ __all__ = ["signature", "shape_keys", "QUANTUM", "lookup_qstar", "Lookup", "POLI
            "grid_coordinates", "load_grid_table", "export_grid", "shipped_grid_path",
            "dask_executor", "DaskConnectError", "CALIBRATED_SAFETY", "ERROR_SAFETY",
            "point_kernel", "read_grid_file", "EXTENSION_GRIDS",
-           "table_coverage", "table_routes"]
+           "table_coverage", "table_routes", "cold_tables"]

@@ -39,6 +39,8 @@ from ._build import precompute_throats, resolve_solver
 from ._derived import derived_path, load_derived, save_derived
 from ._interp import GridSpec, GridTable
 from ._orbits import DEFAULT_GRID, EXTENSION_GRIDS, compact, expand
+from ._exact import (CLOSED, EXACT, FAILED, FE, INTERP, SHAPE_FACTOR, SOURCES, assign_exact,
+                     exact_rows, stored_first)
 from ._signature import as_throats, match_keys, shape_keys, signature
 from ._store import open_store
 
@@ -48,9 +50,6 @@ __all__ = ["Lookup", "lookup_qstar", "default_db_path", "load_grid_table", "POLI
            "export_grid", "grid_from_store", "shipped_grid_path"]
 
 POLICIES = ("table-only", "table+fe", "fe-only", "shape-factor")
-#: where a row's Q* came from (:attr:`Lookup.source`), in the order of their internal codes
-SOURCES = ("exact", "interp", "fe", "shape-factor", "closed", "failed")
-EXACT, INTERP, FE, SHAPE_FACTOR, CLOSED, FAILED = range(len(SOURCES))
 _DATA = Path(__file__).resolve().parent / "data"
 
 
@@ -192,6 +191,31 @@ def _load_grid_table(db, grid, solver_version):
 
 
 def _shipped_table(name, solver_version):
+    with _TABLES_LOCK:               # threads asking at once: one builds, the others wait
+        return _load_shipped(name, solver_version)
+
+
+def cold_tables(solver_version=None) -> list[str]:
+    """Names of the shipped grid tables whose derived arrays are not saved yet in the default
+    folder (:func:`default_db_path`'s): the first lookup that needs one derives and saves them,
+    once, several seconds per table (``grid_g1`` 28 MB, ``grid_x1`` 127 MB, ``grid_d1``
+    71 MB); an empty list when every one is ready or in memory already."""
+    if solver_version is None:
+        solver_version = _build.default_solver()[1]
+    cold = []
+    for name in (DEFAULT_GRID, *EXTENSION_GRIDS):
+        path = shipped_grid_path(name)
+        if not path.exists():
+            continue
+        if (str(path), name, solver_version, path.stat().st_mtime_ns) in _TABLES:
+            continue
+        saved = derived_path(path, default_db_path().parent)
+        if saved is not None and not saved.exists():
+            cold.append(name)
+    return cold
+
+
+def _load_shipped(name, solver_version):
     path = shipped_grid_path(name)
     if not path.exists():
         return None
@@ -304,7 +328,8 @@ def lookup_qstar(radii, sides, *, db=None, policy="table+fe", rtol=1e-3, workers
             solver_version = _build.default_solver()[1]
         if policy in ("table-only", "table+fe"):
             # FE values already stored in the table beat interpolation
-            pending = _stored_first(r, s, pending, q, err, src, msg, db=db, rtol=rtol,
+            pending = stored_first(r, s, pending, q, err, src, msg,
+                                   db=db if db is not None else default_db_path(), rtol=rtol,
                                     solver_version=solver_version)
             injected = table is not None
             if table is None:
@@ -368,23 +393,6 @@ def _extension_rows(r, s, rows, q, err, src, stats, *, policy, rtol, errors, ver
     return np.setdiff1d(rows, np.concatenate([rows[:0], *done]), assume_unique=True)
 
 
-def _stored_first(r, s, rows, q, err, src, msg, *, db, rtol, solver_version):
-    """Answer ``rows`` stored in ``db`` (tolerance <= rtol) exactly, in place; returns the rest.
-
-    Costs a signature per row and one indexed join, only when ``db`` exists and is not empty.
-    """
-    path = Path(db) if db is not None else default_db_path()
-    if not len(rows) or not path.exists() or path.stat().st_size == 0:
-        return rows
-    with open_store(path, create=False, check=False) as store:
-        if store.count() == 0:
-            return rows
-        found = _exact(store, shape_keys(signature(r[rows], s[rows])), rtol, solver_version)
-    hit = found["found"]
-    _assign_exact(rows[hit], found, hit, q, err, src, msg, EXACT)
-    return rows[~hit]
-
-
 def _settle(r, s, rows, q, err, src, msg, stats, *, db, policy, rtol, workers, progress, solver,
             solver_version):
     """Exact hits / FE / shape-factor for ``rows`` (in place)."""
@@ -402,9 +410,9 @@ def _settle(r, s, rows, q, err, src, msg, stats, *, db, policy, rtol, workers, p
         return
     keys = shape_keys(signature(r[rows], s[rows]))
     with open_store(path, create=policy != "table-only") as store:
-        found = _exact(store, keys, rtol, solver_version)
+        found = exact_rows(store, keys, rtol, solver_version)
         hit = found["found"]
-        _assign_exact(rows[hit], found, hit, q, err, src, msg, EXACT)
+        assign_exact(rows[hit], found, hit, q, err, src, msg, EXACT)
         miss, mkeys = rows[~hit], keys[~hit]
         if not len(miss):
             return
@@ -417,25 +425,12 @@ def _settle(r, s, rows, q, err, src, msg, stats, *, db, policy, rtol, workers, p
                                   progress=progress, retry_failed=True)
         stats["n_fe"] += summ.solved + summ.failed
         stats["fe_seconds"] = stats.get("fe_seconds", 0.0) + summ.seconds
-        found = _exact(store, mkeys, rtol, solver_version, statuses=None)
+        found = exact_rows(store, mkeys, rtol, solver_version, statuses=None)
         hit = found["found"]
-        _assign_exact(miss[hit], found, hit, q, err, src, msg, FE)
+        assign_exact(miss[hit], found, hit, q, err, src, msg, FE)
         lost = miss[~hit]
         q[lost], err[lost], src[lost] = np.nan, np.nan, FAILED
         msg[lost] = "no stored result after the FE solve"
-
-
-def _exact(store, keys, rtol, solver_version, statuses=("ok", "closed")):
-    """Stored rows for ``keys`` with tolerance <= rtol (the most accurate one per shape)."""
-    return store.lookup_keys(keys, solver_version=solver_version, max_rtol=rtol, statuses=statuses)
-
-
-def _assign_exact(dest, rows, sel, q, err, src, msg, label):
-    st = rows["status"][sel]
-    q[dest] = np.where(st == "closed", 0.0, rows["qstar"][sel])
-    err[dest] = np.where(st == "closed", 0.0, rows["error_estimate"][sel])
-    src[dest] = np.where(st == "closed", CLOSED, np.where(st == "ok", label, FAILED))
-    msg[dest] = np.where(st == "ok", "", rows["message"][sel])
 
 
 def _shape_factor_rows(r, s, rows, q, err, src):

@@ -56,6 +56,38 @@ def signature(radii, sides):
     return np.concatenate([rs[:, :2], ss], axis=1)
 
 
+#: Largest gap, in quanta, between a throat's side sum :func:`side_sum` and the sum of its
+#: three side keys: each key is its side rounded to the nearest quantum (1.5 quanta at most
+#: together) and float rounding adds far less than one
+SIDE_SUM_SLACK = 2.0
+
+
+def side_sum(radii, sides):
+    r"""(N,) :math:`(l_{12} + l_{13} + l_{23}) / \bar r` in quanta, the sum of a throat's side keys
+    (``k3 + k4 + k5`` of :func:`shape_keys`) to within :data:`SIDE_SUM_SLACK`, for a sixth of
+    the signature's cost: no canonical form (a sum is the same in every vertex order).
+
+    >>> sig = signature([[1.0, 2.0, 3.0]], [[3.5, 4.5, 5.0]])
+    >>> k = shape_keys(sig)
+    >>> bool(abs(side_sum([[1.0, 2.0, 3.0]], [[3.5, 4.5, 5.0]])[0] - k[0, 2:].sum()) <= 2)
+    True
+    """
+    r, s = as_throats(radii, sides)
+    return (s[:, 0] + s[:, 1] + s[:, 2]) / ((r[:, 0] + r[:, 1] + r[:, 2]) / 3.0) / QUANTUM
+
+
+def near_side_sums(radii, sides, stored_sums):
+    """(N,) bool: throats whose :func:`side_sum` lies within :data:`SIDE_SUM_SLACK` of one of
+    ``stored_sums`` (the ``k3 + k4 + k5`` of stored keys): the only ones whose key can be
+    stored. A conservative filter: a throat it drops has no stored key."""
+    x = side_sum(radii, sides)
+    table = np.sort(np.asarray(stored_sums, dtype=float))
+    if not len(table):
+        return np.zeros(len(x), dtype=bool)
+    pos = np.minimum(np.searchsorted(table, x - SIDE_SUM_SLACK), len(table) - 1)
+    return np.abs(table[pos] - x) <= SIDE_SUM_SLACK
+
+
 def shape_keys(sig):
     """Integer keys (N, 5) int64 of signatures: ``rint(sig / QUANTUM)``; NaN rows give -2**62."""
     sig = np.asarray(sig, dtype=float)

@@ -46,6 +46,8 @@ from pathlib import Path
 
 import numpy as np
 
+from ._signature import match_keys
+
 logger = logging.getLogger(__name__)
 
 __all__ = ["CacheFileError", "ThroatStore", "open_store", "FORMAT", "FORMAT_VERSION"]
@@ -212,13 +214,17 @@ class ThroatStore:
         }
 
     def lookup_keys(self, keys, *, solver_version, rtol=None, max_rtol=None, statuses=None):
-        """Stored rows for M given keys, through the unique index (O(M log N), not O(N)).
+        """Stored rows for M given keys: a lookup per stored key asked for, not per key.
 
         Returns a dict of (M,) arrays aligned with ``keys``: ``found`` (bool), ``rtol``,
         ``qstar``, ``open_area``, ``contact_type``, ``error_estimate``, ``status``,
         ``message``.  ``rtol`` selects exactly that tolerance; ``max_rtol`` any tolerance up to
         it, the smallest winning.
-        """
+
+        A store of at most :data:`KEYS_LOADED_PER_QUERY` times M rows hands over its keys
+        in one query, matched in NumPy (:func:`~cache._signature.match_keys`); only the hits
+        go to SQLite. A larger store is asked through the unique index for every distinct
+        key (O(M log N), not O(N))."""
         keys = np.asarray(keys, dtype=np.int64).reshape(-1, 5)
         m = len(keys)
         out = {"found": np.zeros(m, bool), "rtol": np.full(m, np.nan), "qstar": np.full(m, np.nan),
@@ -231,11 +237,24 @@ class ThroatStore:
                                    max_rtol=max_rtol, statuses=statuses)
         try:
             c = self.conn
+            if self.count() <= KEYS_LOADED_PER_QUERY * m:
+                stored = np.array(c.execute(
+                    "SELECT DISTINCT t.k1, t.k2, t.k3, t.k4, t.k5 FROM throats t WHERE "
+                    + " AND ".join(where), args).fetchall(), dtype=np.int64).reshape(-1, 5)
+                rows = np.flatnonzero(match_keys(keys, stored) >= 0)
+            else:
+                rows = np.arange(m)
+            if not len(rows):
+                return out
+            # one row per distinct key asked for: a section's keys repeat
+            uniq, back = np.unique(keys[rows], axis=0, return_inverse=True)
+            back = back.ravel()
+            ask = np.arange(len(uniq))
             c.execute("CREATE TEMP TABLE IF NOT EXISTS _q "
                       "(i INTEGER, k1 INTEGER, k2 INTEGER, k3 INTEGER, k4 INTEGER, k5 INTEGER)")
             c.execute("DELETE FROM _q")
             c.executemany("INSERT INTO _q VALUES (?, ?, ?, ?, ?, ?)",
-                          ((i, *map(int, k)) for i, k in enumerate(keys)))
+                          np.column_stack([ask, uniq[ask]]).tolist())
             res = c.execute(
                 "SELECT q.i, t.rtol, t.qstar, t.open_area, t.contact_type, t.error_estimate, "
                 "t.status, t.message FROM _q q JOIN throats t ON t.k1 = q.k1 AND t.k2 = q.k2 "
@@ -246,16 +265,33 @@ class ThroatStore:
             if isinstance(e, sqlite3.OperationalError) and "locked" in str(e):
                 raise
             raise CacheFileError(f"{self.path}: cannot read the throat table ({e})") from e
+        got = {k: v[:len(uniq)].copy() for k, v in out.items()}      # per distinct key
         for i, rt, q, a, ct, ee, st, msg in res:  # smallest rtol last: it wins
-            out["found"][i] = True
-            out["rtol"][i] = rt
-            out["qstar"][i] = np.nan if q is None else q
-            out["open_area"][i] = np.nan if a is None else a
-            out["contact_type"][i] = ct or ""
-            out["error_estimate"][i] = np.nan if ee is None else ee
-            out["status"][i] = st
-            out["message"][i] = msg or ""
+            got["found"][i] = True
+            got["rtol"][i] = rt
+            got["qstar"][i] = np.nan if q is None else q
+            got["open_area"][i] = np.nan if a is None else a
+            got["contact_type"][i] = ct or ""
+            got["error_estimate"][i] = np.nan if ee is None else ee
+            got["status"][i] = st
+            got["message"][i] = msg or ""
+        for k, v in got.items():
+            out[k][rows] = v[back]
         return out
+
+    def side_sums(self, *, solver_version, max_rtol=None, statuses=None, limit=None):
+        """(K,) distinct ``k3 + k4 + k5`` of the rows the filters select (for
+        :func:`~cache._signature.near_side_sums`), or None where the store holds more than
+        ``limit`` rows (a scan of them would cost more than it saves)."""
+        if limit is not None and self.count() > limit:
+            return None
+        where, args = _row_filters("", solver_version=solver_version, max_rtol=max_rtol,
+                                   statuses=statuses)
+        sql = "SELECT DISTINCT k3 + k4 + k5 FROM throats WHERE " + " AND ".join(where or ["1"])
+        try:
+            return np.array(self.conn.execute(sql, args).fetchall(), dtype=float).ravel()
+        except sqlite3.DatabaseError as e:
+            raise CacheFileError(f"{self.path}: cannot read the throat table ({e})") from e
 
     def count(self, **filters):
         """Number of rows (optionally ``status='ok'`` etc.)."""
@@ -298,6 +334,11 @@ class _Transaction:
             if isinstance(exc, sqlite3.DatabaseError) and not isinstance(exc, sqlite3.OperationalError):
                 raise CacheFileError(f"{self.path}: write failed ({exc})") from exc
         return False
+
+
+#: :meth:`ThroatStore.lookup_keys` loads the store's keys when it holds at most this many rows
+#: per distinct key asked for (one scan of the keys beats a B-tree search per key up to here)
+KEYS_LOADED_PER_QUERY = 4
 
 
 def open_store(path, *, create=True, timeout=60.0, check=True):

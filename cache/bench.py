@@ -47,6 +47,7 @@ from ._lookup import (default_db_path, grid_from_store, load_grid_table, lookup_
                       read_grid_file, shipped_grid_path)
 from ._orbits import EXTENSION_GRIDS
 from ._routes import table_routes
+from ._signature import shape_keys, signature
 from ._store import CacheFileError, open_store
 from .lookup import OneLineParser, check_output
 
@@ -283,6 +284,20 @@ def _bench(args, db, rtols, loaded):
         res["throughput_table_only"] = {"n": args.n_batch, "wall_s": walls, "cpu_s": cpus,
                                         "rows_per_s_wall_best": args.n_batch / min(walls),
                                         "rows_per_s_cpu_best": args.n_batch / min(cpus)}
+        # the same batch with no throat store, and with a small default store of other
+        # shapes (what any cache.lookup run without --db leaves: 28 rows, none in the batch):
+        # a small store costs nothing; every row it holds costs one lookup (a hit)
+        with tempfile.TemporaryDirectory() as tmp:
+            for key, k in (("throughput_no_store", 0), ("throughput_small_store", 28)):
+                path = Path(tmp) / f"{key}.sqlite"
+                if k:
+                    other = np.resize(np.arange(n), k)
+                    _small_store(path, r[other], s[other] * 1.01, q_fe[other], version)
+                _, walls, cpus = _timed(lambda: lookup_qstar(rb, sb, db=path,
+                                                             policy="table-only", table=t),
+                                        args.repeat)
+                res[key] = {"n": args.n_batch, "store_rows": k, "wall_s": walls, "cpu_s": cpus,
+                            "rows_per_s_cpu_best": args.n_batch / min(cpus)}
         xb = grid_coordinates(rb, sb)
         _, walls, cpus = _timed(lambda: t(xb), args.repeat)
         res["throughput_interp_kernel"] = {"n": args.n_batch, "wall_s": walls, "cpu_s": cpus,
@@ -309,7 +324,8 @@ def _bench(args, db, rtols, loaded):
     for m, e, sec, cpu, f in rows:
         print(f"{m:40s} {sec:9.2e} {cpu:9.2e} {_f(e['median'], '.2e'):>9} "
               f"{_f(e['p99'], '.2e'):>9} {_f(e['max'], '.2e'):>9} {f:6.3f}")
-    for key in ("throughput_table_only", "throughput_interp_kernel", "throughput_shape_factor"):
+    for key in ("throughput_table_only", "throughput_no_store", "throughput_small_store",
+                "throughput_interp_kernel", "throughput_shape_factor"):
         if key in res:
             v = res[key]
             print(f"{key}: {v['n']} rows, wall {min(v['wall_s']):.3f} s (median "
@@ -330,6 +346,17 @@ def _bench(args, db, rtols, loaded):
         json.dump(res, fh, indent=1, default=float)
     print(f"wrote {args.out}")
     return 0
+
+
+def _small_store(path, radii, sides, qstar, version):
+    """A throat store at ``path`` holding ``qstar`` for the given throats (status ok)."""
+    k = len(radii)
+    cr, cs = throats.canonical_form(radii, sides)
+    with open_store(path) as st:
+        st.put(shape_keys(signature(radii, sides)), cr, cs, solver_version=version, rtol=1e-3,
+               qstar=qstar, open_area=np.full(k, np.nan), contact_type=np.full(k, "", object),
+               error_estimate=np.zeros(k), n_elements=np.full(k, -1), seconds=np.zeros(k),
+               status=np.full(k, "ok", object), message=np.full(k, "", object))
 
 
 def _extension(n, seed, version):

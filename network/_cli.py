@@ -11,6 +11,7 @@ the packing file's unit (``--units``, default m); physical quantities (``--depth
 from __future__ import annotations
 
 import argparse
+import logging
 import math
 import os
 from pathlib import Path
@@ -20,8 +21,11 @@ from ._lean import keep_heap
 from .core import (EXIT_BAD_INPUT, EXIT_FAILED, EXIT_OK, CliError, CliParser, bad_input,
                    check_output_list, check_outputs, check_writable_folder, computing, finish,
                    progress_log, run, warn)
+from .conductance import first_run_note
 from .packing import (UNITS, check_three_dimensional, default_packing_path, read_container,
                       read_packing, scale_warning)
+
+log = logging.getLogger(__name__)
 
 __all__ = ["EXIT_OK", "EXIT_FAILED", "EXIT_BAD_INPUT", "CliError", "CliParser", "bad_input",
            "computing", "run", "finish", "progress_log", "add_packing", "add_sample", "add_air",
@@ -187,9 +191,14 @@ def check_common(args) -> None:
 
 def load_packing(args):
     """(path, packing in metres) of ``args.packing`` (bundled scene if None) in ``args.units``;
-    the scale warning, if any, as one stderr line. A ``--depth`` thinner than the largest
-    sphere is refused (ValueError). A companion JSON whose container is of an
+    the scale warning, if any, as one stderr line, and first a ``note:`` progress line when
+    the Q* tables are used for the first time on this machine (:func:`first_run_note`). A
+    ``--depth`` thinner than the largest sphere is refused (ValueError). A companion JSON
+    whose container is of an
     unknown kind or malformed is refused here, before any work (:func:`read_container`)."""
+    note = first_run_note(getattr(args, "policy", None))
+    if note:
+        log.info("note: %s", note)
     path = Path(args.packing) if args.packing else default_packing_path()
     packing = read_packing(path, units=args.units)
     check_three_dimensional(packing.centers, str(path))

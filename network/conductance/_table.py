@@ -9,7 +9,7 @@ from pathlib import Path
 
 import numpy as np
 
-from cache import default_db_path, load_grid_table, open_store
+from cache import cold_tables, default_db_path, load_grid_table, open_store
 
 __all__ = ["default_table", "grid_alone", "has_grid", "table_totals"]
 
@@ -57,3 +57,19 @@ def table_totals(path) -> tuple[int, float]:
         n = store.count()
         seconds = float(np.nansum(store.load()["seconds"])) if n else 0.0
     return int(n), seconds
+
+
+def first_run_note(policy: str | None = None) -> str | None:
+    """One line for a command's start when the Q* tables are used for the first time on this
+    machine (:func:`cache.cold_tables`: their derived arrays are not saved yet, and deriving
+    them takes several seconds, once), else None; None for the shape-factor policy, which
+    uses no table."""
+    if policy == "shape-factor":
+        return None
+    cold = cold_tables()
+    if not cold:
+        return None
+    return (f"first use of the Q* tables ({', '.join(cold)}) on this machine: deriving their "
+            f"interpolation arrays takes several seconds, once; they are kept in "
+            f"{default_db_path().parent}")
+
