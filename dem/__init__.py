@@ -6,7 +6,7 @@ Material, SOYBEAN
     Grain and wall properties (thesis Table 3.1 defaults).
 Container, SCENES, scene_container
     Box / cylinder bins; ``'rect-bin'`` (Appendix A) and ``'cyl-bin'`` (Appendices B–C).
-pack_bed(container, *, porosity=0.408, rng=None, procedure='lid'|'sediment', ...) -> PackResult
+pack_bed(container, *, porosity=0.408, rng=None, options=PackOptions(), run=RunOptions()) -> PackResult
     Generate at reduced radius, expand (Eqs. 3.1–3.10), settle to equilibrium; 'sediment'
     (frictionless sedimentation + annealed taps, friction restored for the last settle) is the
     rect-bin default (``SCENE_DEFAULTS``), the only way found to its 0.408 ± 0.01 target with
@@ -51,7 +51,7 @@ from ._measure import Region, coordination_numbers, porosity_in_region, porosity
 from ._container import SCENE_DEFAULTS, SCENES, Container, default_measure_spheres, scene_container
 from ._fill import generate_spheres, thesis_particle_count
 from ._measure import lens_volume, sphere_volume
-from ._procedures import PROCEDURES, PackResult, pack_bed
+from ._procedures import PROCEDURES, PackOptions, PackResult, RunOptions, pack_bed
 from ._summary import summarize, surface_height
 from ._vibrate import VibrationResult, intensity_g, rest_motion, vibrate_bed
 from ._walls import CylinderWall, PlaneWall
@@ -66,7 +66,7 @@ from .templates import (LIBRARY_MAX_SPHERES, ROW_SPACING, TEMPLATE_GRAINS, Templ
 __all__ = [
     "Material", "SOYBEAN", "Simulation", "DemInstabilityError",
     "linear_contact_forces", "series_stiffness", "damping_coefficient", "restitution_coefficient",
-    "Container", "SCENES", "SCENE_DEFAULTS", "PROCEDURES", "scene_container", "pack_bed", "PackResult", "summarize", "thesis_particle_count",
+    "Container", "SCENES", "SCENE_DEFAULTS", "PROCEDURES", "scene_container", "pack_bed", "PackResult", "PackOptions", "RunOptions", "summarize", "thesis_particle_count",
     "vibrate_bed", "VibrationResult",
     "Region", "porosity_in_spheres", "porosity_in_region", "coordination_numbers",
     "read_packing", "write_packing",

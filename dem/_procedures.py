@@ -31,7 +31,7 @@ from ._material import SOYBEAN
 from ._measure import sphere_volume
 from ._summary import interior_porosity, overlap_fractions, summarize
 
-__all__ = ["PROCEDURES", "PackResult", "pack_bed"]
+__all__ = ["PROCEDURES", "PackOptions", "PackResult", "RunOptions", "pack_bed"]
 
 log = logging.getLogger(__name__)
 
@@ -49,11 +49,115 @@ class PackResult:
 PROCEDURES = ("lid", "sediment")
 
 
-def pack_bed(container, *, material=SOYBEAN, porosity=0.408, n_particles=None, rng=None, initial_multiplier=1.4,
-         mass_scale=100.0, dt_safety=0.25, grow_steps=3000, tol=2e-3, max_steps=200000, check_every=200,
-         open_top=True, packing_friction=None, lid_headroom=0.2, settle_time_s=None, measure_spheres=None,
-         progress=None, procedure="lid", sediment_steps=3000, tap_freq_hz=30.0, tap_amplitude_m=1.6e-3,
-         tap_duration_s=0.6, tap_settle_steps=3000, tap_decay=True):
+@dataclass(frozen=True, kw_only=True)
+class PackOptions:
+    r"""The packing procedure of :func:`pack_bed` (module notes; defaults: Appendix B's ``'lid'``).
+
+    Parameters
+    ----------
+    procedure : {'lid', 'sediment'}
+        'lid' (default): expansion and closed stage under the lid with the material's friction
+        (or ``packing_friction``), then settling (Appendices A–B). 'sediment': frictionless
+        sedimentation and taps, friction restored for the last settle (the default of
+        ``--scene rect-bin``); ``packing_friction`` (default 0 here) applies to particle and
+        wall contacts.
+    initial_multiplier : float
+        m₀ >= 1: generation radii are the nominal ones divided by m₀ (default 1.4, Appendix A).
+    grow_steps : int
+        Steps over which the radii grow to their final size (default 3000).
+    lid_headroom : float
+        The lid sits at (1 + lid_headroom) × the fill height during expansion (default 0.2:
+        Appendix B's 0.05 m above a 0.25 m fill); 0 is Appendix A's closed box.
+    packing_friction : float | None
+        Particle friction during expansion and the closed stage (default None: the material's
+        for 'lid', 0 for 'sediment'); the material's friction is restored for the last settle.
+    open_top : bool
+        Remove the lid and settle again before measuring (default True, Appendix A).
+    sediment_steps : int
+        'sediment': steps of frictionless settling after the expansion (default 3000).
+    tap_freq_hz, tap_amplitude_m, tap_duration_s : float
+        'sediment': container motion :math:`z = A \sin 2\pi f t` (Hz, m, s; default 30 Hz,
+        1.6 mm, 0.6 s), run for round(f · duration) whole periods (at least one); A = 0 or
+        duration 0 skips it.
+    tap_settle_steps : int
+        'sediment': frictionless steps after the taps (default 3000).
+    tap_decay : bool
+        'sediment': amplitude falls linearly from ``tap_amplitude_m`` to 0 (default True).
+    """
+
+    procedure: str = "lid"
+    initial_multiplier: float = 1.4
+    grow_steps: int = 3000
+    lid_headroom: float = 0.2
+    packing_friction: float | None = None
+    open_top: bool = True
+    sediment_steps: int = 3000
+    tap_freq_hz: float = 30.0
+    tap_amplitude_m: float = 1.6e-3
+    tap_duration_s: float = 0.6
+    tap_settle_steps: int = 3000
+    tap_decay: bool = True
+
+    def __post_init__(self):
+        if self.procedure not in PROCEDURES:
+            raise ValueError(f"procedure must be one of {PROCEDURES}, got {self.procedure!r}")
+        if not self.initial_multiplier >= 1.0:
+            raise ValueError(f"initial_multiplier must be >= 1, got {self.initial_multiplier}")
+        if not (self.grow_steps >= 1 and self.lid_headroom >= 0):
+            raise ValueError(f"grow_steps must be >= 1 and lid_headroom >= 0, got {self.grow_steps}, "
+                             f"{self.lid_headroom}")
+        if self.packing_friction is not None and not self.packing_friction >= 0:
+            raise ValueError(f"packing_friction must be >= 0, got {self.packing_friction}")
+        if self.procedure == "sediment" and not (
+                self.lid_headroom > 0 and self.sediment_steps >= 0 and self.tap_duration_s >= 0
+                and self.tap_amplitude_m >= 0 and self.tap_freq_hz > 0 and self.tap_settle_steps >= 0):
+            raise ValueError("procedure 'sediment' needs lid_headroom > 0, tap_freq_hz > 0 and non-negative "
+                             "sediment_steps, tap_duration_s, tap_amplitude_m, tap_settle_steps (Appendix A's "
+                             "closed box is procedure 'lid' with lid_headroom 0)")
+
+
+@dataclass(frozen=True, kw_only=True)
+class RunOptions:
+    """How the stages of :func:`pack_bed` run.
+
+    Parameters
+    ----------
+    mass_scale : float
+        Density scaling S >= 1 of every stage (default 100; 1 = physical masses).
+    dt_safety : float
+        Time step as this fraction of the lightest sphere's critical step (default 0.25).
+    tol : float
+        Mean unbalanced-force ratio that counts as equilibrium, each stage (default 2e-3).
+    max_steps : int
+        Step limit per equilibrium stage (default 200 000).
+    check_every : int
+        Steps between equilibrium checks and progress calls (default 200).
+    settle_time_s : float | None
+        Settle for this simulated time instead of until ``tol`` (default None; used to compare
+        density scalings at equal physical time).
+    """
+
+    mass_scale: float = 100.0
+    dt_safety: float = 0.25
+    tol: float = 2e-3
+    max_steps: int = 200_000
+    check_every: int = 200
+    settle_time_s: float | None = None
+
+    def __post_init__(self):
+        if not self.mass_scale >= 1.0:
+            raise ValueError(f"mass_scale must be >= 1, got {self.mass_scale}")
+        if not 0 < self.dt_safety <= 1:
+            raise ValueError(f"dt_safety must be in (0, 1], got {self.dt_safety}")
+        if not (self.tol > 0 and self.max_steps >= 1 and self.check_every >= 1):
+            raise ValueError(f"need tol > 0, max_steps >= 1 and check_every >= 1, got {self.tol}, "
+                             f"{self.max_steps}, {self.check_every}")
+        if self.settle_time_s is not None and not self.settle_time_s > 0:
+            raise ValueError(f"settle_time_s must be > 0, got {self.settle_time_s}")
+
+
+def pack_bed(container, *, material=SOYBEAN, porosity=0.408, n_particles=None, rng=None,
+             options=PackOptions(), run=RunOptions(), measure_spheres=None, progress=None):
     """Make a settled packing in ``container`` (procedures: module notes and ``docs/dem-packing.md``).
 
     Parameters
@@ -61,50 +165,19 @@ def pack_bed(container, *, material=SOYBEAN, porosity=0.408, n_particles=None, r
     container : Container
     material : Material
     porosity : float
-        Target porosity φ of the closed volume (0.408, thesis Table 3.1).
+        Target porosity φ of the closed volume (default 0.408, thesis Table 3.1).
     n_particles : int, optional
         Default: thesis Eq. 3.10.
     rng : numpy.random.Generator | int | None
         Seed or generator; the same seed gives the same packing.
-    initial_multiplier : float
-        m₀: generation radii are the nominal ones divided by m₀ (Appendix A: 1.4).
-    mass_scale : float
-        Density scaling S during expansion and settling (1 = physical masses).
-    grow_steps : int
-        Steps over which the radii grow to their final size.
-    tol : float
-        Mean unbalanced-force ratio that counts as equilibrium (each stage).
-    max_steps : int
-        Step limit per equilibrium stage.
-    packing_friction : float, optional
-        Particle–particle friction used during expansion and the closed-box stage
-        (None: the material's). The material's friction is restored before the open-box
-        settling.
-    lid_headroom : float
-        The lid sits at (1 + lid_headroom) × the fill height during expansion (Appendix B:
-        0.05 m above a 0.25 m fill, i.e. 0.2); 0 is Appendix A's closed box.
-    settle_time_s : float, optional
-        Settle for this simulated time instead of until ``tol`` (used to compare density
-        scalings at equal physical time).
-    open_top : bool
-        Remove the lid and settle again (thesis Appendix A) before measuring.
+    options : PackOptions
+        The procedure and its stages.
+    run : RunOptions
+        Mass scale, time step, equilibrium tolerance and step limit.
+    measure_spheres : ((M, 3) array, float) | None
+        Centres and radius of measurement spheres (default: thesis B1–B5).
     progress : callable(stage, sim, force) | None
-        Called every ``check_every`` steps.
-    procedure : {'lid', 'sediment'}
-        'lid': expansion and closed stage under the lid with the material's friction (or
-        ``packing_friction``), then settling (Appendices A–B). 'sediment': frictionless
-        sedimentation and taps, friction restored for the last settle (module notes; the
-        default of ``--scene rect-bin``). ``packing_friction`` (default 0 here) applies to
-        particle and wall contacts.
-    sediment_steps : int
-        'sediment': steps of frictionless settling after the expansion.
-    tap_freq_hz, tap_amplitude_m, tap_duration_s : float
-        'sediment': container motion :math:`z = A \\sin 2\\pi f t` (Hz, m, s), run for
-        round(f · duration) whole periods (at least one); A = 0 or duration 0 skips it.
-    tap_decay : bool
-        'sediment': amplitude falls linearly from ``tap_amplitude_m`` to 0 over the taps.
-    tap_settle_steps : int
-        'sediment': frictionless steps after the taps.
+        Called every ``run.check_every`` steps.
 
     Returns
     -------
@@ -112,21 +185,19 @@ def pack_bed(container, *, material=SOYBEAN, porosity=0.408, n_particles=None, r
     """
     if not isinstance(container, Container):
         raise TypeError(f"container must be a Container, got {type(container).__name__}")
+    if not isinstance(options, PackOptions) or not isinstance(run, RunOptions):
+        raise TypeError(f"options must be PackOptions and run RunOptions, got {type(options).__name__}, "
+                        f"{type(run).__name__}")
     check_fill(container, porosity, material)
-    if not initial_multiplier >= 1.0:
-        raise ValueError(f"initial_multiplier must be >= 1, got {initial_multiplier}")
     rng = np.random.default_rng(rng)
     n = thesis_particle_count(container, porosity, material) if n_particles is None else int(n_particles)
     if n < 1:
         raise ValueError(f"no sphere fits: n_particles = {n}")
     check_sphere_count(n, "spheres (thesis Eq. 3.10)" if n_particles is None else "spheres")
-    if procedure not in PROCEDURES:
-        raise ValueError(f"procedure must be one of {PROCEDURES}, got {procedure!r}")
-    if procedure == "sediment" and not (lid_headroom > 0 and sediment_steps >= 0 and tap_duration_s >= 0
-                                        and tap_amplitude_m >= 0 and tap_freq_hz > 0 and tap_settle_steps >= 0):
-        raise ValueError("procedure 'sediment' needs lid_headroom > 0, tap_freq_hz > 0 and non-negative "
-                         "sediment_steps, tap_duration_s, tap_amplitude_m, tap_settle_steps (Appendix A's closed box is "
-                         "procedure 'lid' with lid_headroom 0)")
+    o = options
+    procedure, initial_multiplier, lid_headroom, packing_friction = (o.procedure, o.initial_multiplier,
+                                                                     o.lid_headroom, o.packing_friction)
+    mass_scale, tol, max_steps, check_every = run.mass_scale, run.tol, run.max_steps, run.check_every
     t_wall = time.perf_counter()
     r_lo = material.radius_min_m / initial_multiplier
     r_hi = material.radius_max_m / initial_multiplier
@@ -144,13 +215,13 @@ def pack_bed(container, *, material=SOYBEAN, porosity=0.408, n_particles=None, r
         mu = 0.0 if packing_friction is None else float(packing_friction)
         mat_pack = replace(material, friction=mu, wall_friction=mu)
     sim = make_simulation(container, centers, r0, material=mat_pack, lid=True, lid_height_m=lid_height,
-                          mass_scale=mass_scale, dt_safety=dt_safety)
+                          mass_scale=mass_scale, dt_safety=run.dt_safety)
     stages = {}
 
     def cb(stage):
         return None if progress is None else (lambda s, f: progress(stage, s, f))
 
-    stages["expand"] = sim.run(max_steps=grow_steps, grow_from=r0, grow_to=r0 * mult, check_every=check_every,
+    stages["expand"] = sim.run(max_steps=o.grow_steps, grow_from=r0, grow_to=r0 * mult, check_every=check_every,
                                callback=cb("expand"))
     if procedure == "lid":
         # closed stage: relax the expanded assembly under the lid before opening the top, so that
@@ -163,23 +234,23 @@ def pack_bed(container, *, material=SOYBEAN, porosity=0.408, n_particles=None, r
     else:
         # frictionless sedimentation for a fixed number of steps (a frictionless bed under
         # viscous damping alone creeps towards the force criterion very slowly), then taps
-        stages["sediment"] = sim.run(max_steps=sediment_steps, check_every=check_every, callback=cb("sediment"))
+        stages["sediment"] = sim.run(max_steps=o.sediment_steps, check_every=check_every, callback=cb("sediment"))
         stages["sediment"]["porosity_interior"] = interior_porosity(sim, container)
-        stages["tap"] = _tap(sim, tap_freq_hz, tap_amplitude_m, tap_duration_s, check_every, cb("tap"),
-                             decay=tap_decay)
-        stages["tap_settle"] = sim.run(max_steps=tap_settle_steps, check_every=check_every,
+        stages["tap"] = _tap(sim, o.tap_freq_hz, o.tap_amplitude_m, o.tap_duration_s, check_every, cb("tap"),
+                             decay=o.tap_decay)
+        stages["tap_settle"] = sim.run(max_steps=o.tap_settle_steps, check_every=check_every,
                                        callback=cb("tap_settle"))
         stages["tap_settle"]["porosity_interior"] = interior_porosity(sim, container)
         stages["tap_settle"]["max_overlap_fraction"] = float(np.max(overlap_fractions(sim)))
         for name in ("sediment", "tap", "tap_settle"):
             stages[name]["converged"] = True  # fixed-length stages
     sim.set_material(material)
-    if open_top:
+    if o.open_top:
         sim.set_walls(container.walls(lid=False))
-    if settle_time_s is None:
+    if run.settle_time_s is None:
         stages["settle"] = sim.run(max_steps=max_steps, tol=tol, check_every=check_every, callback=cb("settle"))
     else:
-        stages["settle"] = sim.run(duration_s=settle_time_s, check_every=check_every, callback=cb("settle"))
+        stages["settle"] = sim.run(duration_s=run.settle_time_s, check_every=check_every, callback=cb("settle"))
         stages["settle"]["converged"] = True
     for name, st in stages.items():
         if name != "expand" and not st["converged"]:

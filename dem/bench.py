@@ -33,7 +33,7 @@ import numpy as np
 
 from ._cli import EXIT_FAILED, OneLineParser, check_output, run_main
 from ._container import Container, make_simulation
-from ._procedures import pack_bed
+from ._procedures import PackOptions, RunOptions, pack_bed
 from .clumps import ClumpSimulation
 from .templates import library_template
 from .vibrate import main as vibrate_main
@@ -152,8 +152,8 @@ def mass_scale_study(scales=(1.0, 10.0, 100.0), *, seed=1, settle_time_s=0.3, gr
     out = []
     for s in scales:
         dt = 0.25 * np.sqrt(s * 1285 * 4 / 3 * np.pi * (0.00275 / 1.4) ** 3 / 4e6)  # first-step dt
-        res = pack_bed(c, rng=seed, mass_scale=s, grow_steps=int(grow_time_s / dt), settle_time_s=settle_time_s,
-                   lid_headroom=0.5)
+        res = pack_bed(c, rng=seed, options=PackOptions(grow_steps=int(grow_time_s / dt), lid_headroom=0.5),
+                       run=RunOptions(mass_scale=s, settle_time_s=settle_time_s))
         m = res.summary
         out.append({"mass_scale": s, "n": m["n_spheres"], "porosity_interior": m["porosity_interior"],
                     "porosity_global_surface": m["porosity_global_surface"],

@@ -44,7 +44,7 @@ from ._clump_pack import grains_path, pack_grains, pack_grains_to_porosity, writ
 from ._contacts import damping_ratio_for_restitution
 from ._load import janssen_stress, load_bed
 from ._pour import FILL_METHODS, FillOptions, check_fill_options, poured_bed_summary, pour_grains
-from ._procedures import PROCEDURES, pack_bed
+from ._procedures import PROCEDURES, PackOptions, RunOptions, pack_bed
 from .grains import grain
 from .templates import resolve_template
 
@@ -474,12 +474,12 @@ def _pack(args) -> int:
         measure = (np.array(args.measure, dtype=float), r)
     opts = _procedure_options(args)
     porosity = 0.408 if args.porosity is None else args.porosity
+    options = PackOptions(packing_friction=args.packing_friction, open_top=not args.keep_lid, **opts)
+    run = RunOptions(mass_scale=args.mass_scale, tol=args.tol, dt_safety=args.dt_safety,
+                     max_steps=SPHERE_MAX_STEPS if args.max_steps is None else args.max_steps)
     res = pack_bed(container, material=material, porosity=porosity, n_particles=args.n_particles,
-                   rng=args.seed, mass_scale=args.mass_scale, packing_friction=args.packing_friction,
-                   open_top=not args.keep_lid, tol=args.tol,
-                   max_steps=SPHERE_MAX_STEPS if args.max_steps is None else args.max_steps,
-                   dt_safety=args.dt_safety, measure_spheres=measure,
-                   progress=progress_printer(quiet=args.quiet), **opts)
+                   rng=args.seed, options=options, run=run, measure_spheres=measure,
+                   progress=progress_printer(quiet=args.quiet))
     s = res.summary
     s["scene"] = args.scene
     s["procedure_options"] = opts

@@ -35,7 +35,7 @@ from ._integrate import DemInstabilityError
 from ._io import read_packing, write_packing, write_summary
 from ._material import SOYBEAN, Material
 from ._plots import plot_study
-from ._procedures import pack_bed
+from ._procedures import PackOptions, RunOptions, pack_bed
 from ._vibrate import intensity_g, vibrate_bed
 
 __all__ = ["run_study", "NETWORK_STEPS"]
@@ -63,7 +63,7 @@ def _bed(out, container, scene, seed, mass_scale, quiet):
         raise ValueError(f"{path} holds a packing of another container; remove it or choose another --out")
     _log(f"packing the {scene} bed (seed {seed}) -> {path}", quiet)
     opts = dict(SCENE_DEFAULTS.get(scene, {"procedure": "lid", "lid_headroom": 0.2}))
-    res = pack_bed(container, rng=seed, mass_scale=mass_scale, **opts)
+    res = pack_bed(container, rng=seed, options=PackOptions(**opts), run=RunOptions(mass_scale=mass_scale))
     summary = dict(res.summary, scene=scene, seed=seed, procedure_options=opts)
     write_packing(path, res.centers, res.radii, summary)
     _log(f"packed {len(res.radii)} spheres in {summary['wall_time_s']:.0f} s, interior porosity "

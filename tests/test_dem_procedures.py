@@ -8,17 +8,19 @@ grains) checks that the 'sediment' procedure does what it says, with short stage
 import numpy as np
 import pytest
 
-from dem import SCENE_DEFAULTS, Container, pack_bed
+from dem import SCENE_DEFAULTS, Container, PackOptions, RunOptions, pack_bed
 
 SLAB = Container("box", (0.06, 0.02), 0.06)
-SHORT = dict(rng=3, grow_steps=1000, tol=1e-2, max_steps=4000)
-SED = dict(procedure="sediment", lid_headroom=0.3, sediment_steps=1500, tap_freq_hz=60.0, tap_amplitude_m=1.5e-4,
-           tap_duration_s=0.05, tap_settle_steps=1000, **SHORT)
+SHORT = dict(rng=3, run=RunOptions(tol=1e-2, max_steps=4000))
+SED = dict(options=PackOptions(procedure="sediment", grow_steps=1000, lid_headroom=0.3, sediment_steps=1500,
+                               tap_freq_hz=60.0, tap_amplitude_m=1.5e-4, tap_duration_s=0.05, tap_settle_steps=1000),
+           **SHORT)
 
 
 @pytest.fixture(scope="module")
 def slabs():
-    return pack_bed(SLAB, **SED), pack_bed(SLAB, procedure="lid", lid_headroom=0.2, **SHORT)
+    return pack_bed(SLAB, **SED), pack_bed(SLAB, options=PackOptions(procedure="lid", grow_steps=1000,
+                                                                     lid_headroom=0.2), **SHORT)
 
 
 def test_sediment_is_denser_than_frictional_lid_with_sane_contacts(slabs):
@@ -49,7 +51,7 @@ def test_sediment_restores_friction_and_taps_whole_periods(slabs):
 
 def test_procedure_arguments_are_checked():
     with pytest.raises(ValueError, match="procedure must be one of"):
-        pack_bed(SLAB, procedure="appendix-z")
+        PackOptions(procedure="appendix-z")
     with pytest.raises(ValueError, match="lid_headroom > 0"):
-        pack_bed(SLAB, procedure="sediment", lid_headroom=0.0)
+        PackOptions(procedure="sediment", lid_headroom=0.0)
     assert SCENE_DEFAULTS["rect-bin"]["procedure"] == "sediment"

@@ -4,7 +4,7 @@ import numpy as np
 import pytest
 
 from dem import (SCENES, Container, Material, Region, coordination_numbers, generate_spheres, intensity_g,
-                 lens_volume, pack_bed, porosity_in_region, porosity_in_spheres, read_packing, sphere_volume,
+                 lens_volume, pack_bed, PackOptions, RunOptions, porosity_in_region, porosity_in_spheres, read_packing, sphere_volume,
                  thesis_particle_count, vibrate_bed, write_packing)
 
 TINY = Container("box", (0.03, 0.02), 0.03)
@@ -86,7 +86,7 @@ def test_non_positive_stiffness_is_refused(field):
         Material(**{field: -1.0})
 
 
-KW = dict(rng=7, tol=5e-3, grow_steps=500, max_steps=20000, lid_headroom=1.0)
+KW = dict(rng=7, options=PackOptions(grow_steps=500, lid_headroom=1.0), run=RunOptions(tol=5e-3, max_steps=20000))
 
 
 @pytest.fixture(scope="module")

@@ -7,7 +7,7 @@ import numpy as np
 import pytest
 from scipy.optimize import brentq
 
-from dem import Container, Material, PlaneWall, Simulation, intensity_g, pack_bed, vibrate_bed
+from dem import Container, Material, PlaneWall, Simulation, intensity_g, pack_bed, vibrate_bed, PackOptions, RunOptions
 
 TINY = Container("box", (0.03, 0.02), 0.03)
 R = 0.00325
@@ -17,7 +17,8 @@ G = 9.81
 @pytest.fixture(scope="module")
 def bed():
     # settled to a force ratio 5e-3 (dem.vibrate's rest check passes: motion 6e-4 radii)
-    return pack_bed(TINY, rng=7, tol=5e-3, grow_steps=500, max_steps=20000, lid_headroom=1.0)
+    return pack_bed(TINY, rng=7, options=PackOptions(grow_steps=500, lid_headroom=1.0),
+                    run=RunOptions(tol=5e-3, max_steps=20000))
 
 
 def test_sphere_on_a_vibrating_floor_follows_the_analytic_trajectory():
