@@ -233,3 +233,50 @@ def test_d_a_floor_duct_in_3d_balances_and_keeps_its_keys(shape, tmp_path):
     assert r["mass_balance"]["relative_difference"] < 1e-8
     assert r["static_pressure_pa"] == 100.0
     assert r["geometry"]["ducts"][0]["shape"] == shape
+
+
+def test_the_fan_operating_point_is_on_the_fan_curve_and_the_bins(tmp_path):
+    """--fan: the solved operating point's (Q, P) lies on the fan curve (linear between its
+    rows) and is the bin's own solve (P is the pressure solved at, Q its plenum inflow)."""
+    fan = tmp_path / "fan.csv"
+    fan.write_text("airflow_m3_s,static_pressure_pa\n0,400\n0.5,300\n1.0,150\n1.3,0\n")
+    out = tmp_path / "f.json"
+    code = main(["--diameter", "8", "--depth", "5", "--fan", str(fan), "--json", str(out),
+                 "--no-figure", "--elements", "2000", "--no-refinement-check", "-q"])
+    assert code == 0
+    r = json.loads(out.read_text())
+    q, p = r["airflow_m3_s"], r["static_pressure_pa"]
+    assert p == pytest.approx(np.interp(q, [0, 0.5, 1.0, 1.3], [400, 300, 150, 0]), rel=1e-8)
+    ps = np.array([s["static_pressure_pa"] for s in r["system_curve"]])
+    qs = np.array([s["airflow_m3_s"] for s in r["system_curve"]])
+    i = np.searchsorted(ps, p)
+    assert qs[i - 1] < q < qs[i]
+
+
+@pytest.mark.parametrize("text, words", [
+    ("depth_m,porosity\n0,0.41\n1,1.2\n", "row 3: porosity must be in (0, 1)"),
+    ("depth_m,porosity\n0,0.41\n0,0.40\n", "row 3: depth_m 0 does not increase"),
+    ("depth,porosity\n0,0.41\n", "header must be depth_m,porosity"),
+])
+def test_a_bad_porosity_profile_names_its_row(text, words, tmp_path, capsys):
+    f = tmp_path / "p.csv"
+    f.write_text(text)
+    code = main(["--diameter", "8", "--depth", "5", "--pressure", "100", "--porosity-profile",
+                 str(f), "--no-figure", "-q"])
+    err = capsys.readouterr().err
+    assert code == 2 and words in err and err.count("\n") == 1
+
+
+def test_janssen_makes_the_deep_grain_denser(wheat):
+    """--compaction: Janssen's stress grows with depth toward rho_b g R_h/(mu_w K), so the
+    porosity of a falling porosity-stress curve falls with depth."""
+    from network.bin._material import _profile, janssen_stress
+
+    s = janssen_stress(np.array([0.0, 1.0, 5.0, 200.0]), bulk_density_kg_m3=750.0,
+                       diameter_m=8.0, wall_friction=0.5, lateral_ratio=0.5)
+    assert s[0] == 0 and np.all(np.diff(s) > 0)
+    assert s[-1] == pytest.approx(750.0 * 9.80665 * 2.0 / 0.25, rel=1e-9)
+    prof = _profile("wheat", None, None, (np.array([0.0, 3e4]), np.array([0.415, 0.385])),
+                    (750.0, 8.0, 0.5, 0.5))
+    e = prof(np.array([0.0, 1.0, 5.0]))
+    assert e[0] == pytest.approx(0.415) and np.all(np.diff(e) < 0)
