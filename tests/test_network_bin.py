@@ -174,6 +174,10 @@ def test_the_command_reports_pressure_uniformity_and_the_check(tmp_path, capsys)
     assert code == 0
     r = json.loads(out.read_text())
     assert r["airflow_m3_per_min_t"] == pytest.approx(0.1, rel=1e-8)
+    # the numbers README.md quotes for this command
+    assert (round(r["static_pressure_pa"], 1), round(r["airflow_m3_s"], 3),
+            round(r["grain_mass_t"], 1)) == (51.0, 0.349, 209.5)
+    assert round(100 * r["underaerated_fraction"], 1) == 0.7
     assert 8 <= len(r["system_curve"]) <= 12
     ps = [s["static_pressure_pa"] for s in r["system_curve"]]
     qs = [s["airflow_m3_s"] for s in r["system_curve"]]

@@ -6,12 +6,14 @@ network's vertical gradient at three velocities) are fitted bed by bed with
 ``network.flow.fit_curve``'s Forchheimer form, g = μU/k + βρU², and ln k, ln β linearly in ε
 over the beds:
 
-.. math:: k_v(\varepsilon) = e^{\kappa_0 + \kappa_1\varepsilon}, \qquad
-          \beta_v(\varepsilon) = e^{b_0 + b_1\varepsilon}
+.. math:: k_v(\varepsilon) = k_p\,e^{\kappa_1(\varepsilon - \varepsilon_p)}, \qquad
+          \beta_v(\varepsilon) = \beta_p\,e^{b_1(\varepsilon - \varepsilon_p)}
 
-(wheat: eight beds, ε 0.376-0.431). The horizontal permeability is k_h = a k_v with
-a = k_x/k_z of the bundled bed's Forchheimer fits in both directions
-(``network/data/anisotropy_<grain>.json``); β_h follows from the tensor law
+(wheat: eight beds, ε 0.376-0.431), the slopes κ_1, b_1 from the beds and the values k_p, β_p
+from the Forchheimer fit of the bundled bed's own vertical curve at its porosity ε_p, the bed
+``network.report`` moves along its band (``network/data/anisotropy_<grain>.json``, which also
+holds the horizontal curve). The horizontal permeability is k_h = a k_v with a = k_x/k_z of
+the bundled bed's fits in both directions; β_h follows from the tensor law
 (:mod:`network.bin._law`). A grain without band data has no bin law here (``network.report``
 packs sphere beds for its band, minutes per run): the bin then needs ``law="d272"``.
 
@@ -238,12 +240,16 @@ def _band_fit(grain: str):
                               an["viscosity_pa_s"], an["density_kg_m3"])
         kx, bx = _forchheimer(ua, np.array(an["horizontal_pa_per_m"], float),
                               an["viscosity_pa_s"], an["density_kg_m3"])
+        # anchored at the bundled bed, as network.report moves its bed along the band
+        e_p = float(an["porosity"])
+        k0, b0 = math.log(kz) - k1 * e_p, math.log(bz) - b1 * e_p
         a = kx / kz
-        note_a = (f"k_h/k_v = {a:.4f} from the bundled bed's fits in x and z "
-                  f"(network/data/{apath.name}); the tensor law's beta_h/beta_v = "
-                  f"{a**-1.5:.4f}, the network's own {bx / bz:.4f}")
-    note = (f"network law: ln k_v and ln beta_v linear in porosity over the {len(eps)} beds of "
-            f"network/data/{path.name} (Forchheimer fit per bed); {note_a}")
+        note_a = (f"anchored at the bundled bed's vertical fit (porosity {e_p:.4f}, "
+                  f"network/data/{apath.name}); k_h/k_v = {a:.4f} from its fits in x and z; "
+                  f"the tensor law's beta_h/beta_v = {a**-1.5:.4f}, the network's own "
+                  f"{bx / bz:.4f}")
+    note = (f"network law: the slopes of ln k_v and ln beta_v in porosity over the {len(eps)} "
+            f"beds of network/data/{path.name} (Forchheimer fit per bed); {note_a}")
     return (float(k0), float(k1)), (float(b0), float(b1)), (min(eps), max(eps)), a, note
 
 
