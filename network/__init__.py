@@ -42,8 +42,6 @@ if _network_command():          # a command process (network._lean): the pipelin
     from ._lean import lean_imports as _lean_imports
     _lean_imports()
     from . import conductance, flow, packing, paths, pores, validation  # noqa: F401
-    from ._lean import imports_done as _imports_done
-    _imports_done()             # the collector back on, what was imported frozen
 
 #: public name -> the subpackage that defines it; imported on first use (PEP 562), so that
 #: ``import network.core`` (what ``dem`` imports) loads the core alone

@@ -17,7 +17,6 @@ import os
 from pathlib import Path
 
 from ._air import MU_AIR_PA_S, P_ATM_PA, RHO_AIR_KG_M3, check_positive
-from ._lean import keep_heap
 from .core import (EXIT_BAD_INPUT, EXIT_FAILED, EXIT_OK, CliError, CliParser, bad_input,
                    check_output_list, check_outputs, check_writable_folder, computing, finish,
                    progress_log, run, warn)
@@ -208,7 +207,6 @@ def load_packing(args):
         raise ValueError(f"--depth {depth:g} m is thinner than one grain of {path} (its largest "
                          f"sphere alone is {2e3 * float(packing.radii.max()):.3g} mm across): "
                          "give the bed depth in metres")
-    keep_heap(packing.n)
     msg = scale_warning(packing)
     if msg:
         warn(msg)

@@ -1,5 +1,6 @@
-"""Lean imports of command processes (network._lean): NumPy's f2py, testing
-and ma are deferred, SciPy's docstring tables skipped, and nothing a command computes changes."""
+"""Lean command processes (network._lean): NumPy's f2py and testing deferred, pyamg's and
+scipy.spatial's __init__ deferred, SciPy's docstring tables skipped, OpenBLAS on one thread, and
+nothing a command computes changes."""
 
 from __future__ import annotations
 
@@ -7,8 +8,6 @@ import json
 import os
 import subprocess
 import sys
-
-from network._lean import HEAP_KEPT_MAX_SPHERES, MALLOC_ENV
 
 PROBE = """
 import json, sys
@@ -207,78 +206,6 @@ def test_command_process_starts_openblas_with_one_thread_unless_told_otherwise()
         assert kept["threads"] == [2]
     plain = _blas(["-c"])
     assert plain["env"] is None and plain["single"] is False and plain["user"] is None
-
-
-HEAP = """
-import json, resource, sys
-sys.argv = {argv!r}
-import numpy as np
-from network import _lean
-
-
-def faults(nbytes):
-    '''Minor page faults of filling and freeing an nbytes block, twice.'''
-    out = []
-    for _ in range(2):
-        f0 = resource.getrusage(resource.RUSAGE_SELF).ru_minflt
-        block = np.ones(nbytes // 8)
-        del block
-        out.append(resource.getrusage(resource.RUSAGE_SELF).ru_minflt - f0)
-    return out
-
-
-kept = _lean.keep_heap({n})
-print(json.dumps({{"kept": kept, "faults": faults(64 << 20)}}))
-"""
-
-
-def _heap(argv, n, **env):
-    base = {k: v for k, v in os.environ.items() if k not in MALLOC_ENV}
-    # 4 kB pages throughout: NumPy's huge-page advice would hide the faults being counted
-    return _json(HEAP.format(argv=argv, n=n), env={**base, "NUMPY_MADVISE_HUGEPAGE": "0", **env})
-
-
-def test_command_process_keeps_freed_heap_for_the_next_block_on_glibc():
-    """A 64 MB block (above glibc's largest automatic mmap threshold, 32 MB) filled and freed
-    twice: in a command process with a packing of at most HEAP_KEPT_MAX_SPHERES the second fill
-    re-uses the first one's pages (no fault); for a larger packing, in a library session or with
-    the user's own MALLOC_* setting, the second fill faults as many pages as the first (16 384
-    with 4 kB pages; fewer where the kernel gives huge pages unasked)."""
-    try:
-        glibc = bool(os.confstr("CS_GNU_LIBC_VERSION"))
-    except (ValueError, OSError):
-        glibc = False
-    got = _heap(["-m"], 5000)
-    assert got["kept"] is glibc
-    if glibc:
-        first, second = got["faults"]
-        assert first >= 16 and second <= 0.05 * first
-    for argv, n, env in ((["-m"], HEAP_KEPT_MAX_SPHERES + 1, {}), (["-c"], 5000, {}),
-                         (["-m"], 5000, {"MALLOC_TOP_PAD_": "131072"})):
-        other = _heap(argv, n, **env)
-        assert other["kept"] is False, (argv, n, env)
-        if glibc:
-            first, second = other["faults"]
-            assert first >= 16 and second >= 0.9 * first, (argv, n, env)
-
-
-GC_PROBE = """
-import gc, json, sys
-sys.argv = {argv!r}
-import network
-print(json.dumps({{"enabled": gc.isenabled(), "frozen": gc.get_freeze_count(),
-                  "modules": len(sys.modules)}}))
-"""
-
-
-def test_command_process_imports_without_collections_then_freezes_them():
-    """python -m network.<command>: the collector is on again after the package's import, with
-    the imported objects (at least one per module loaded) frozen out of its passes; a library
-    session's collector is untouched."""
-    got = _json(GC_PROBE.format(argv=["-m"]))
-    assert got["enabled"] is True and got["frozen"] > got["modules"]
-    plain = _json(GC_PROBE.format(argv=["-c"]))
-    assert plain["enabled"] is True and plain["frozen"] == 0
 
 
 SPATIAL = AT_ONCE + """

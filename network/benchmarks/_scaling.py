@@ -20,7 +20,6 @@ from pathlib import Path
 import numpy as np
 
 from ..flow import solve_network
-from .._lean import keep_heap
 from ..packing import periodic_copies, random_packing, read_packing, write_packing_csv
 from .._cli import available_cores
 from ._common import qstar_sources
@@ -69,7 +68,6 @@ def run_one(path: Path, policy: str, db, repeats: int, trace: bool = True,
     for _ in range(repeats):
         t0 = time.perf_counter()
         pk = read_packing(path)
-        keep_heap(pk.n)                  # as network.solve does in its command process
         t_read = time.perf_counter() - t0
         res = solve_network(pk, axis="z", policy=policy, db=db, threads=available_cores(),
                             trace_memory=False, conductance_model=model)
