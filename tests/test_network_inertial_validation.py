@@ -138,7 +138,7 @@ NETWORK100 = {"grown": [1.0622, 1.1573], "mc": [1.0421, 1.1197]}
 
 
 def test_beetstra_holds_on_its_own_kind_of_packing_and_the_network_follows_the_lbm():
-    # docs/inertial-flow.md, "the packing ensemble": Beetstra's law was fitted
+    # docs/inertial-flow.md, "Validation" (Monte Carlo configurations): Beetstra's law was fitted
     # on Monte Carlo hard-sphere configurations; on one the resolved flow follows it within
     # 0.8 % and the network is within 2 % of both; on the contact-rich grown packing the
     # resolved flow itself is 3.2 % above the law at Re_p 10
