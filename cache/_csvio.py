@@ -7,28 +7,33 @@ import os
 
 import numpy as np
 
+from network.core import read_table
+
 __all__: list[str] = []
 
 SHAPE_COLUMNS = ("r1", "r2", "r3", "l12", "l13", "l23")
 
 
-def read_throat_csv(path, parse_errors=None):
+def read_throat_csv(path, parse_errors=None, option="--csv"):
     """Read a throat CSV: ``(header list, rows list of lists, radii (N,3), sides (N,3))``.
 
-    Cells that do not parse as numbers become NaN (the row is then reported as invalid); with
-    a dict ``parse_errors``, row index -> "cannot parse l12='abc'" (or, for a row too short to
-    hold a shape column, "the row has 5 of 6 values") is filled in.
+    Read as spreadsheets write it (:func:`network.core.read_table`: BOM, CRLF, UTF-16 with a
+    mark, quoted fields, spaces after the commas); errors name ``option`` and the file. Cells
+    that do not parse as numbers become NaN (the row is then reported as invalid); with a dict
+    ``parse_errors``, row index -> "cannot parse l12='abc'" (or, for a row too short to hold a
+    shape column, "the row has 5 of 6 values") is filled in.
     """
-    with open(path, newline="") as fh:
-        reader = csv.reader(fh)
-        try:
-            header = [h.strip() for h in next(reader)]
-        except StopIteration:
-            raise ValueError(f"{path}: empty file, expected a header {','.join(SHAPE_COLUMNS)}") from None
-        missing = [c for c in SHAPE_COLUMNS if c not in header]
-        if missing:
-            raise ValueError(f"{path}: missing column(s) {missing}; header is {header}")
-        rows = [row for row in reader if row]
+    try:
+        header, table = read_table(path, option, what="a throat list")
+    except ValueError as e:
+        if "empty file" not in str(e):
+            raise
+        raise ValueError(f"{option} {path}: empty file, expected a header "
+                         f"{','.join(SHAPE_COLUMNS)}") from None
+    missing = [c for c in SHAPE_COLUMNS if c not in header]
+    if missing:
+        raise ValueError(f"{option} {path}: missing column(s) {missing}; header is {header}")
+    rows = [fields for _, fields in table]
     cols = [header.index(c) for c in SHAPE_COLUMNS]
     vals = np.full((len(rows), 6), np.nan)
     for j, c in enumerate(cols):

@@ -31,6 +31,8 @@ import numpy as np
 from scipy.sparse import coo_matrix
 from scipy.sparse.csgraph import connected_components
 
+from network.core import read_table
+
 from ._rigid import union_mass_properties
 from .grains import grain
 
@@ -225,7 +227,8 @@ def library_template(name):
 
 
 def check_template(positions, radii, *, where="template", first_row=1):
-    """ValueError naming the row when radii are not positive/finite or the spheres are not one body.
+    """ValueError naming the row when radii are not positive/finite, a sphere lies inside another
+    (coincident or contained) or the spheres are not one body.
 
     Rows are numbered from ``first_row`` (2 for a CSV with a header, as a spreadsheet does).
     """
@@ -241,6 +244,14 @@ def check_template(positions, radii, *, where="template", first_row=1):
         k = int(np.flatnonzero(bad)[0])
         raise ValueError(f"{where} row {first_row + k}: radius {r[k]:g} must be positive")
     d = np.linalg.norm(x[:, None] - x[None], axis=2)
+    inside = (d + r[None] <= r[:, None] * (1 + 1e-12)) & ~np.eye(len(r), dtype=bool)
+    if inside.any():            # row j within row i: a coincident or contained sphere
+        big, small = np.argwhere(inside)[0]
+        if r[small] == r[big] and small < big:
+            big, small = small, big
+        raise ValueError(f"{where} row {first_row + int(small)}: the sphere lies inside the sphere "
+                         f"of row {first_row + int(big)} (coincident or contained spheres add "
+                         "nothing to the grain): remove it")
     i, j = np.nonzero(d < r[:, None] + r[None])
     _, label = connected_components(coo_matrix((np.ones(len(i)), (i, j)), shape=(len(r), len(r))), directed=False)
     apart = np.flatnonzero(label != label[0])
@@ -249,42 +260,65 @@ def check_template(positions, radii, *, where="template", first_row=1):
                          f"row {first_row} (spheres of a grain must overlap)")
 
 
-def read_template(path, *, units="mm", name=None):
-    """A user template: CSV with header ``x,y,z,r`` in the body frame, ``units`` 'mm' or 'm'.
+#: Smallest grain (largest extent, m) a template read in mm may describe: below it the file is
+#: taken to be in metres (a 2 mm kernel written in metres and read in mm is 0.002 mm across)
+MIN_TEMPLATE_EXTENT_M = 50e-6
 
-    Errors name the file and the row (header = row 1); the template is moved to its principal frame.
+
+def read_template(path, *, units="mm", name=None, option="--grain"):
+    """A user template: CSV with columns ``x,y,z,r`` in the body frame, ``units`` 'mm' or 'm'.
+
+    Read as spreadsheets write it (:func:`network.core.read_table`: BOM, CRLF, quoted header,
+    spaces after separators; columns in any order, extra ones ignored). Errors name ``option``,
+    the file and the row (header = row 1); a grain under :data:`MIN_TEMPLATE_EXTENT_M` across
+    read in mm is refused with the unit it is probably in. The template is moved to its
+    principal frame.
     """
     scale = {"mm": 1e-3, "m": 1.0}.get(units)
     if scale is None:
         raise ValueError(f"template units must be 'mm' or 'm', got {units!r}")
     path = Path(path)
-    lines = path.read_text().splitlines()
-    if not lines or lines[0].strip().replace(" ", "").lower() != "x,y,z,r":
-        got = lines[0].strip() if lines else "an empty file"
-        raise ValueError(f"{path} row 1: expected the header 'x,y,z,r', got {got!r}")
+    where = f"{option} {path}"
+    try:
+        header, table = read_table(path, option, what="a grain template")
+    except ValueError as e:
+        if "empty file" not in str(e):
+            raise
+        header, table = [], []
+    names = [h.lower() for h in header]
+    if not all(c in names for c in "xyzr"):
+        got = ",".join(header) if header else "an empty file"
+        raise ValueError(f"{where} row 1: expected the header 'x,y,z,r', got {got!r}")
+    cols = [names.index(c) for c in "xyzr"]
     rows = []
-    for k, line in enumerate(lines[1:], start=2):
-        if not line.strip():
-            continue
-        parts = line.split(",")
+    for k, fields in table:
         try:
-            vals = [float(p) for p in parts]
+            vals = [float(fields[c]) for c in cols] if len(fields) == len(names) else []
         except ValueError:
             vals = []
         if len(vals) != 4:
-            raise ValueError(f"{path} row {k}: expected four numbers x,y,z,r, got {line.strip()!r}")
+            raise ValueError(f"{where} row {k}: expected four numbers x,y,z,r, got "
+                             f"{','.join(fields)!r}")
         rows.append((k, vals))
     if not rows:
-        raise ValueError(f"{path}: no spheres (empty template)")
+        raise ValueError(f"{where}: no spheres (empty template)")
     data = np.array([v for _, v in rows])
     row_no = [k for k, _ in rows]
     try:  # checked in the file's units, so the message quotes the file's numbers
-        check_template(data[:, :3], data[:, 3], where=str(path), first_row=0)
-    except ValueError as e:  # renumber the row as the file's
+        check_template(data[:, :3], data[:, 3], where=where, first_row=0)
+    except ValueError as e:  # renumber the rows as the file's
         msg = str(e)
-        idx = int(msg.split(" row ")[1].split(":")[0])
-        raise ValueError(msg.replace(f" row {idx}:", f" row {row_no[idx]}:", 1).replace(
-            "with row 0", f"with row {row_no[0]}")) from None
+        for idx in sorted({int(t.split(":")[0].split(" ")[0]) for t in msg.split(" row ")[1:]},
+                          reverse=True):
+            msg = msg.replace(f" row {idx}:", f" row {row_no[idx]}:").replace(
+                f"of row {idx} ", f"of row {row_no[idx]} ").replace(
+                f"with row {idx} ", f"with row {row_no[idx]} ")
+        raise ValueError(msg) from None
+    extent = float(np.max(np.ptp(data[:, :3], axis=0) + 2 * data[:, 3].max())) * scale
+    if units == "mm" and extent < MIN_TEMPLATE_EXTENT_M:
+        raise ValueError(f"{where}: the grain is {extent * 1e3:.3g} mm across read in mm "
+                         f"(--template-units mm): a template written in metres? give "
+                         f"--template-units m")
     data = data * scale
     return _principal(name or path.stem, data[:, :3], data[:, 3], f"user file {path} ({units})", {})
 

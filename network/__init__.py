@@ -25,16 +25,17 @@ import sys as _sys
 
 
 def _network_command() -> bool:
-    """Whether this process is a command on the network pipeline: started as ``python -m
-    <module>`` (``sys.argv[0]`` is ``'-m'`` while the package is imported) with a module not
-    of ``dem``, which imports only :mod:`network.core`."""
+    """Whether this process is a network command: started as ``python -m network.<command>``
+    (``sys.argv[0]`` is ``'-m'`` while the package is imported; where the interpreter keeps no
+    ``orig_argv``, any ``-m``). The commands of the other packages import :mod:`network.core`
+    alone (dem, cache, throats) or the public API (the benchmarks), lazily."""
     if _sys.argv[:1] != ["-m"]:
         return False
     orig = list(getattr(_sys, "orig_argv", ()))
     for k, arg in enumerate(orig[1:], 1):
         if arg.startswith("-m"):
             module = arg[2:] or (orig[k + 1] if k + 1 < len(orig) else "")
-            return module.split(".")[0] != "dem"
+            return module.split(".")[0] == "network"
     return True
 
 

@@ -2,9 +2,10 @@
 
 Rules:
 
-* packages: ``throats`` <- ``cache`` <- ``network``; ``dem`` imports one module of another
-  package, ``network.core`` (the packing format and the command-line base, NumPy only at
-  import), and no package imports ``dem``. A benchmark (``<package>/bench.py``) is a tool on top of
+* packages: ``throats`` <- ``cache`` <- ``network``; below them all ``network.core`` (the
+  packing format, the text reader and the command-line base, NumPy only at import), the one
+  module of ``network`` that ``dem``, ``throats`` and ``cache`` import (it imports none of
+  them); no package imports ``dem``. A benchmark (``<package>/bench.py``) is a tool on top of
   the pipeline and may import the public API (the package itself, never a private module) of the
   packages below or beside it;
 * inside a package, subpackages form layers (``LAYERS``): a module imports only its own layer
@@ -26,11 +27,11 @@ import pytest
 ROOT = Path(__file__).resolve().parents[1]
 PACKAGES = ("throats", "cache", "network", "dem")
 #: which project packages each package may import (bench modules: see ``BENCH_MAY_IMPORT``)
-MAY_IMPORT = {"throats": set(), "cache": {"throats"}, "network": {"throats", "cache"},
-              "dem": {"network"}}
-#: of another package, a package may import only these modules where listed (dem shares the
-#: light core of network, nothing else of it)
-ONLY_MODULES = {"dem": {"network": "network.core"}}
+MAY_IMPORT = {"throats": {"network"}, "cache": {"throats", "network"},
+              "network": {"throats", "cache"}, "dem": {"network"}}
+#: of another package, a package may import only these modules where listed (the light core
+#: of network, nothing else of it)
+ONLY_MODULES = {p: {"network": "network.core"} for p in ("dem", "throats", "cache")}
 #: what the shared core may import of its own package: itself and the deferred SciPy modules
 CORE = "network.core"
 CORE_MAY_IMPORT = ("network.core", "network._deferred")
@@ -156,7 +157,7 @@ def test_the_shared_core_loads_numpy_alone():
 
     core = loaded("network.core")
     assert set(core) == {"network", "network._deferred", "network.core", "network.core._cli",
-                         "network.core._io", "network.core._packing"}, core
+                         "network.core._io", "network.core._packing", "network.core._text"}, core
     net = {m for m in loaded("dem") if m.split(".")[0] == "network"}
     assert net == set(core), net
 

@@ -36,6 +36,8 @@ import time
 
 import numpy as np
 
+from network.core import read_table
+
 from ._area import open_area
 from ._geometry import contact_type, mean_radius, validate_throats
 from ._shape_factor import FIT, shape_factor_qstar
@@ -141,14 +143,14 @@ def _compute(radii, sides, method, rtol, workers, progress):
 
 
 def _read_csv(path):
-    """Rows of the CSV as float arrays; unparsable cells become NaN (flagged later)."""
-    with open(path, newline="") as fh:
-        reader = csv.DictReader(fh)
-        missing = [c for c in COLUMNS if c not in (reader.fieldnames or [])]
-        if missing:
-            raise ValueError(f"{path}: missing columns {missing}; need {','.join(COLUMNS)}")
-        rows = list(reader)
-        fields = list(reader.fieldnames)
+    """Rows of the CSV (dicts; a short row's missing fields None) as float arrays; unparsable
+    cells become NaN (flagged later). Read as spreadsheets write it
+    (:func:`network.core.read_table`); errors name ``--csv`` and the file."""
+    fields, table = read_table(path, "--csv", what="a throat list")
+    missing = [c for c in COLUMNS if c not in fields]
+    if missing:
+        raise ValueError(f"--csv {path}: missing columns {missing}; need {','.join(COLUMNS)}")
+    rows = [dict(zip(fields, vals + [None] * (len(fields) - len(vals)))) for _, vals in table]
     vals = np.full((len(rows), 6), np.nan)
     parse_err = {}
     for k, row in enumerate(rows):

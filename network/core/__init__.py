@@ -18,6 +18,7 @@ from ._cli import (EXIT_BAD_INPUT, EXIT_FAILED, EXIT_OK, CliError, CliParser, ba
                    progress_log, run, same_file, warn)
 from ._io import (FORMATS, UNITS, default_packing_path, read_container, read_packing,
                   read_summary, summary_path, write_packing_csv, write_summary)
+from ._text import delimiter_of, read_table, read_text, split_fields
 from ._packing import (MIN_SPHERES, PLAUSIBLE_DIAMETER_M, DegeneratePackingError, Packing,
                        check_grains, check_three_dimensional, grain_volumes, scale_warning,
                        validate_spheres)
@@ -28,4 +29,5 @@ __all__ = ["EXIT_BAD_INPUT", "EXIT_FAILED", "EXIT_OK", "FORMATS", "MIN_SPHERES",
            "check_three_dimensional", "check_writable_folder", "computing",
            "default_packing_path", "finish", "grain_volumes", "progress_log", "read_container",
            "read_packing", "read_summary", "run", "same_file", "scale_warning", "summary_path",
-           "validate_spheres", "warn", "write_packing_csv", "write_summary"]
+           "validate_spheres", "warn", "write_packing_csv", "write_summary", "read_text",
+           "read_table", "split_fields", "delimiter_of"]

@@ -19,6 +19,7 @@ from pathlib import Path
 import numpy as np
 
 from ._packing import MIN_SPHERES, Packing, check_grains, validate_spheres
+from ._text import read_text, split_fields
 
 __all__ = ["read_packing", "write_packing_csv", "default_packing_path", "read_container",
            "read_summary", "summary_path", "write_summary", "UNITS", "FORMATS"]
@@ -58,15 +59,12 @@ def _delimiter(line: str):
     return None
 
 
-def _split(line: str, delim):
-    return [f.strip() for f in (line.split(delim) if delim else line.split())]
-
-
-def _read_csv(path: Path, rules) -> Packing:
+def _read_csv(path: Path, text: str, rules) -> Packing:
     """Delimited text: comma, semicolon, or spaces/tabs (YADE's ``export.text``: ``#`` comment
-    lines, then ``x y z r`` rows); an optional header names x, y, z and r/radius/diameter."""
+    lines, then ``x y z r`` rows); an optional header names x, y, z and r/radius/diameter
+    (quoted or not)."""
     src = str(path)
-    text = path.read_text(encoding="utf-8-sig", errors="replace").splitlines()  # BOM: Excel
+    text = text.splitlines()
     # the first line that is neither blank nor a comment: the header or the first row
     first = next((i for i, ln in enumerate(text)
                   if (t := ln.strip()) and not t.startswith("#")), None)
@@ -74,7 +72,7 @@ def _read_csv(path: Path, rules) -> Packing:
         raise ValueError(f"{src}: empty file (no data row)")
     head_no, head = first + 1, text[first].strip()
     delim = _delimiter(head)
-    names = [h.lower() for h in _split(head, delim)]
+    names = [h.lower() for h in split_fields(head, delim)]
     scale = 1.0
     if any(not _isfloat(h) for h in names):
         rname = [c for c in _RADIUS_NAMES + _DIAMETER_NAMES if c in names]
@@ -109,7 +107,7 @@ def _read_csv(path: Path, rules) -> Packing:
         body = [(i, t) for i, ln in enumerate(raw, start + 1)
                 if (t := ln.strip()) and not t.startswith("#")]
         if fast is None or fast.shape != (len(body), ncols):
-            fast = _parse_rows([_split(ln, delim) for _, ln in body], ncols,
+            fast = _parse_rows([split_fields(ln, delim) for _, ln in body], ncols,
                                [i for i, _ in body], src)
         lineno = np.array([i for i, _ in body])
     data = fast[:, cols]
@@ -166,10 +164,10 @@ def _read_npz(path: Path, rules) -> Packing:
     return Packing(c, r, source=src, grain_id=grain)
 
 
-def _read_dump(path: Path, rules) -> Packing:
+def _read_dump(path: Path, text: str, rules) -> Packing:
     """LAMMPS/LIGGGHTS ``dump custom`` text; the last snapshot in the file is read."""
     src = str(path)
-    text = path.read_text(encoding="utf-8-sig").splitlines()
+    text = text.splitlines()
     starts = [i for i, ln in enumerate(text) if ln.startswith("ITEM: ATOMS")]
     if not starts:
         raise ValueError(f"{src}: no 'ITEM: ATOMS' line: not a LAMMPS/LIGGGHTS dump custom file")
@@ -225,7 +223,9 @@ def read_packing(path: str | os.PathLike, *, units: str = "m", min_spheres: int 
         r, radius or diameter in any order, extra columns ignored; without a header the columns
         are x, y, z, r; ``#`` comments allowed); ``*.npz`` with arrays ``centers`` (N, 3) and
         ``radii`` (N,); LAMMPS/LIGGGHTS ``dump custom`` text (``x y z radius`` columns, the
-        last snapshot).
+        last snapshot). Text as spreadsheets write it: UTF-8 with or without a byte-order
+        mark, UTF-16 with one, CRLF line ends, quoted header fields
+        (:func:`~network.core.read_text`).
     units : {'m', 'mm', 'cm'}, keyword-only
         Unit of the file's lengths (default metres); the packing is returned in metres, every
         column (``grain_id``) kept.
@@ -266,15 +266,12 @@ def read_packing(path: str | os.PathLike, *, units: str = "m", min_spheres: int 
             raise ValueError(f"{p}: not a readable .npz file ({e}); formats read: "
                              f"{'; '.join(FORMATS)}") from e
     else:
-        with open(p, "rb") as f:
-            head = f.read(65536)
-        if b"\0" in head:
-            raise ValueError(f"{p}: a binary file, not a packing; formats read: "
-                             f"{'; '.join(FORMATS)}")
-        if b"ITEM: ATOMS" in head or b"ITEM: TIMESTEP" in head:
-            pk = _read_dump(p, rules)
+        text = read_text(p, what=f"a packing; formats read: {'; '.join(FORMATS)}")
+        head = text[:65536]
+        if "ITEM: ATOMS" in head or "ITEM: TIMESTEP" in head:
+            pk = _read_dump(p, text, rules)
         else:
-            pk = _read_csv(p, rules)
+            pk = _read_csv(p, text, rules)
     if units != "m":
         pk = pk.scaled(UNITS[units], source=f"{pk.source} ({units})")
     log.info("read %d spheres from %s", pk.n, p)

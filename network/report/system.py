@@ -17,11 +17,12 @@ log-log interpolated between the solved velocities).
 
 from __future__ import annotations
 
-import csv
 import logging
 import math
 
 import numpy as np
+
+from ..core import read_table
 
 __all__ = ["AIRFLOW_UNITS", "FAN_COLUMNS", "M3_MIN_M3_PER_CFM_BU", "airflow_unit", "bulk_density",
            "check_fan_shape", "floor_area", "velocity_from_airflow", "system_rows", "dense_system", "read_fan", "operating_point", "curve_range"]
@@ -118,32 +119,35 @@ def dense_system(velocity_m_s, gradient_pa_per_m, *, depth_m, area_m2, n=400):
 
 def read_fan(path) -> tuple[np.ndarray, np.ndarray]:
     """Fan curve (airflow m³/s, static pressure Pa), sorted by airflow, from a CSV with the
-    header ``airflow_m3_s,static_pressure_pa``. ValueError naming the file and row of a missing,
-    non-numeric, negative or repeated value; at least two rows."""
+    header ``airflow_m3_s,static_pressure_pa`` (any column order, extra columns ignored; read as
+    spreadsheets write it: :func:`network.core.read_table`). ValueError naming ``--fan``, the
+    file and the row of a missing, non-numeric, negative or repeated value; at least two
+    rows."""
+    header, table = read_table(path, "--fan", what="a fan curve")
+    names = [h.lower() for h in header]
+    missing = [c for c in FAN_COLUMNS if c not in names]
+    if missing:
+        raise ValueError(f"--fan {path}: missing column(s) {', '.join(missing)} (header "
+                         f"{','.join(FAN_COLUMNS)}: airflow m^3/s, static pressure Pa; got "
+                         f"{','.join(header)})")
+    cols = [names.index(c) for c in FAN_COLUMNS]
     rows = []
-    with open(path, newline="") as f:
-        reader = csv.DictReader(f)
-        missing = [c for c in FAN_COLUMNS if c not in (reader.fieldnames or [])]
-        if missing:
-            raise ValueError(f"--fan {path}: missing column(s) {', '.join(missing)} (header "
-                             f"{','.join(FAN_COLUMNS)}: airflow m^3/s, static pressure Pa)")
-        for i, row in enumerate(reader, start=2):
-            if None in row:                 # DictReader's key for the fields past the header
-                raise ValueError(f"--fan {path} row {i}: {len(FAN_COLUMNS) + len(row[None])} "
-                                 f"values, the header has {len(FAN_COLUMNS)}")
-            vals = []
-            for c in FAN_COLUMNS:
-                text = (row.get(c) or "").strip()
-                try:
-                    v = float(text)
-                except ValueError:
-                    raise ValueError(f"--fan {path} row {i}: {c} {text!r} is not a "
-                                     "number") from None
-                if not math.isfinite(v) or v < 0:
-                    raise ValueError(f"--fan {path} row {i}: {c} must be finite and >= 0, "
-                                     f"got {text}")
-                vals.append(v)
-            rows.append(vals)
+    for i, fields in table:
+        if len(fields) != len(names):
+            raise ValueError(f"--fan {path} row {i}: {len(fields)} values, the header has "
+                             f"{len(names)}")
+        vals = []
+        for c, k in zip(FAN_COLUMNS, cols):
+            text = fields[k]
+            try:
+                v = float(text)
+            except ValueError:
+                raise ValueError(f"--fan {path} row {i}: {c} {text!r} is not a number") from None
+            if not math.isfinite(v) or v < 0:
+                raise ValueError(f"--fan {path} row {i}: {c} must be finite and >= 0, "
+                                 f"got {text}")
+            vals.append(v)
+        rows.append(vals)
     if len(rows) < 2:
         raise ValueError(f"--fan {path}: needs at least two rows, got {len(rows)}")
     a = np.array(sorted(rows))
