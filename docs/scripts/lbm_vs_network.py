@@ -5,9 +5,10 @@ For each LBM JSON (a run of ``lbm_periodic.py``, or a stored table of rows such 
 ``docs/data/lbm_n800_reference.json`` and ``lbm_reference.json``, whose rows carry phi, seed, n
 and re): the packing (phi, n, seed) is rebuilt by ``random_inertial_case`` (copied 3 x 3 x 3, the
 middle two periods as the sample) and the network's k/k_app is solved at the Reynolds numbers the
-LBM obtained, with the package's current constants, with the laws ``window`` (the package's)
-and the alternatives ``docs/inertial-flow.md`` compares it with (``--laws`` picks). Printed per row: LBM, Beetstra, HKL, the
-network laws, and the relative differences in % of the pressure gradient. ``--json`` writes
+LBM obtained, with the package's current constants, with the law ``window`` (the package's) and
+the alternatives ``docs/inertial-flow.md`` compares it with (``--laws`` picks). Printed per row:
+LBM, Beetstra, HKL, the network laws, and the relative differences in % of the pressure
+gradient. ``--json`` writes
 the rows. ``--packing NPZ ...`` (one per LBM file, in order; the NPZ that ``lbm_periodic.py
 --packing`` ran, e.g. a Monte Carlo configuration of ``mc_ensemble.py --export``) takes the
 network's packing from the file instead of rebuilding it (``periodic_inertial_case``, the same
