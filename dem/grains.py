@@ -1,4 +1,4 @@
-"""The grain library: measured kernel and bed properties of the crops grainflow packs, with sources.
+r"""The grain library: measured kernel and bed properties of the crops grainflow packs, with sources.
 
 Every number is a :class:`Sourced` value: the value (a float, a ``(low, high)`` range or a
 ``(length, width, thickness)`` triple), the source it was read from (paper or standard, the
@@ -15,6 +15,18 @@ thickness in mm; densities kg/m^3; porosity a fraction; friction and restitution
 material is named in the note). The D272 airflow constants live in ``network/_grains.py``
 (DESIGN: network owns the empirical equations), under the same grain names.
 
+Bin loads. The vertical stress at depth z of a round bin of diameter D (Janssen):
+
+.. math:: \sigma_v(z) = \frac{\rho_b g D}{4 \mu_w K}\left(1 - e^{-4 \mu_w K z / D}\right)
+
+takes ``wall_friction_steel`` (mu_w: the bulk sliding on a smooth steel wall, a property of
+the bulk against a wall surface) and ``lateral_pressure_ratio`` (K = sigma_h / sigma_v); where
+no measured K was found but ``internal_friction_deg`` (phi) was, K is Jaky's 1 - sin(phi) and
+the note says so. mu_w is not the DEM's grain-wall contact friction ``friction_pw``: the two
+are the same number only where one measurement (a grain sliding on a steel sheet) is the
+source of both, and the notes say which. ``bulk_unit_weight_kn_m3`` is EN 1991-4's design
+range of the bulk unit weight (rho_b g), ``bulk_density_kg_m3`` a measured loose fill.
+
 >>> grain("soybean").particle_density_kg_m3.value
 1285.0
 >>> grain("oats")
@@ -25,6 +37,7 @@ ValueError: unknown grain 'oats'; known grains: barley, canola, rough_rice, shel
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 
 __all__ = ["Sourced", "Grain", "GRAINS", "grain", "GRAIN_FIELDS"]
@@ -57,23 +70,38 @@ class Grain:
     particle_density_kg_m3: Sourced  #: true (kernel) density
     bulk_porosity: Sourced          #: measured loose-fill bulk porosity (low, high)
     friction_pp: Sourced            #: grain-grain sliding friction coefficient
-    friction_pw: Sourced            #: grain-wall sliding friction coefficient
+    friction_pw: Sourced            #: grain-wall contact friction of the DEM walls (not Janssen's mu_w)
     restitution_pp: Sourced         #: grain-grain coefficient of restitution
     restitution_pw: Sourced         #: grain-wall coefficient of restitution
-    #: bulk lateral pressure ratio K = sigma_h / sigma_v (Janssen)
+    #: bulk lateral pressure ratio K = sigma_h / sigma_v of Janssen's equation (module notes);
+    #: where no measured K was found but an angle of internal friction was, Jaky's K = 1 - sin(phi)
     lateral_pressure_ratio: Sourced = Sourced(None, "not found", "no source found for a lateral pressure "
-                                              "ratio; searched: EN 1991-4 Annex E and ASAE EP433 tables "
-                                              "(pages corpus): only wheat's row was readable")
-    #: angle of internal friction of the bulk, degrees (Jaky's K = 1 - sin phi where K is missing)
+                                              "ratio nor an angle of internal friction to take Jaky's K from")
+    #: angle of internal friction of the bulk, degrees
     internal_friction_deg: Sourced = Sourced(None, "not found", "no source found for an angle of internal "
-                                             "friction; searched: EN 1991-4 Annex E tables (pages corpus): "
-                                             "only wheat's row was readable")
+                                             "friction; searched: EN 1991-4 Table E.1 (four grains only) and "
+                                             "physical-property abstracts of this crop (pages corpus)")
+    #: Janssen's wall friction coefficient mu_w of the bulk against a smooth steel wall (module notes)
+    wall_friction_steel: Sourced = Sourced(None, "not found", "no source found for a bulk-on-steel wall "
+                                           "friction coefficient")
+    #: Janssen's mu_w against a corrugated steel wall
+    wall_friction_corrugated: Sourced = Sourced(None, "not found", "no source found for a corrugated-wall "
+                                                "friction coefficient: EN 1991-4 Table E.1 (as found) "
+                                                "tabulates wall categories D1-D3 only, and no ASAE EP433 "
+                                                "table of coefficients was readable")
+    #: bulk unit weight (lower, upper) of silo design, kN/m^3 (EN 1991-4 gamma_l, gamma_u)
+    bulk_unit_weight_kn_m3: Sourced = Sourced(None, "not found", "not in EN 1991-4 Table E.1 (as found): "
+                                              "the crop has no row there")
+    #: measured loose-fill bulk density (low, high) over the source's moisture series, kg/m^3
+    bulk_density_kg_m3: Sourced = Sourced(None, "not found", "the abstracts found for this crop give no "
+                                          "bulk density")
 
 
 #: the Sourced fields of :class:`Grain`, in order
 GRAIN_FIELDS = ("axes_mm", "axes_sd_mm", "particle_density_kg_m3", "bulk_porosity",
                 "friction_pp", "friction_pw", "restitution_pp", "restitution_pw",
-                "lateral_pressure_ratio", "internal_friction_deg")
+                "lateral_pressure_ratio", "internal_friction_deg", "wall_friction_steel",
+                "wall_friction_corrugated", "bulk_unit_weight_kn_m3", "bulk_density_kg_m3")
 
 _SD_SEARCH = "the abstracts found report means/ranges only, no standard deviations"
 _THESIS = ("thesis Table 3.1 (seed/thesis.txt; PFC parameters reported by Liu et al. 2008a; "
@@ -130,6 +158,28 @@ _EN1991_WHEAT = ("EN 1991-4:2006 (Eurocode 1, Actions on silos and tanks) Annex 
                  "(mean values), as tabulated in Studia Geotechnica et Mechanica 2018, "
                  "doi:10.2478/sgem-2018-0043; https://reference-global.com/article/10.2478/sgem-2018-0043")
 _DEM_SEARCH = "DEM calibration abstracts (pages corpus) for this crop gave no value"
+_EN_E1 = ("EN 1991-4:2006 (Eurocode 1, Actions on silos and tanks) Annex E Table E.1, mean values and "
+          "conversion factors, as transcribed in the 'particles' sheet of @Silo/constants.xls of the sandTES "
+          "Engineering Manual software (S. Thanheiser, TU Wien 2023, GPL-3.0, doi:10.5281/zenodo.10207330; "
+          "GitHub sthanhe/engMan, commit cf17706); the sheet's columns are those of Table E.1 (gamma_l, "
+          "gamma_u kN/m^3, phi_r, phi_im deg, a_phi, K_m, a_K, mu_m for wall categories D1, D2, D3, a_mu, "
+          "C_op) and its wheat row equals the Annex E wheat row of the SGEM 2018 table in every value shown")
+_RAPESEED = ("Models for predicting frictional properties of rapeseed (authors include Xue Chen), Int. "
+             "Agrophys. 2019, 33(1):61-66, abstract; http://www.international-agrophysics.org/"
+             "Models-for-predicting-frictional-properties-of-rapeseed,104377,0,2.html")
+
+
+def _jaky(phi: Sourced, searched: str) -> Sourced:
+    """Jaky's lateral pressure ratio K = 1 - sin(phi) from a sourced angle of internal friction."""
+    return Sourced(1.0 - math.sin(math.radians(phi.value)), phi.source,
+                   f"Jaky's K = 1 - sin(phi) with phi = {phi.value:g} deg (internal_friction_deg): no "
+                   f"measured K found; searched: {searched}")
+
+
+_NO_K = "EN 1991-4 Table E.1 (the crop has no row) and ASAE EP433 (its table was not readable)"
+_CANOLA_PHI = Sourced(23.91, _RAPESEED, "rapeseed, direct shear: 23.91-34.99 deg, falling with normal "
+                      "stress (25-100 kPa) and rising with moisture (6.58-11.16 % w.b.); the low end kept "
+                      "(by the trends stated: dry seed, 100 kPa); stainless-steel friction 0.25-0.50")
 
 GRAINS: dict[str, Grain] = {
     "soybean": Grain(
@@ -152,6 +202,17 @@ GRAINS: dict[str, Grain] = {
         restitution_pp=Sourced(0.6, _BOAC, "calibrated particle restitution of the best model"),
         restitution_pw=_missing("a soybean-wall restitution",
                                 "Boac 2010 abstract gives one particle restitution only"),
+        lateral_pressure_ratio=Sourced(0.63, _EN_E1, "'Soya beans' row: K_m 0.63, a_K 1.11"),
+        internal_friction_deg=Sourced(25.0, _EN_E1, "'Soya beans' row: phi_im 25, a_phi 1.16 (angle of "
+                                      "repose phi_r 29); Kibar 2008 measured 27.37-31.81 deg over 8-16 % "
+                                      "moisture"),
+        wall_friction_steel=Sourced(0.38, _EN_E1, "'Soya beans' row: mu_m on a D2 (smooth) wall; D1 0.24, "
+                                    "D3 0.48, a_mu 1.16. Not the DEM's friction_pw (0.3 against "
+                                    "Plexiglass, thesis); Kibar 2008 measured 0.164-0.286 on galvanized "
+                                    "steel (single kernels on a sheet)"),
+        bulk_unit_weight_kn_m3=Sourced((7.0, 8.0), _EN_E1, "'Soya beans' row: gamma_l 7.0, gamma_u 8.0"),
+        bulk_density_kg_m3=Sourced((644.4, 749.1), _WANDKAR, "749.1 at 7.37 % d.b. to 644.4 at 15.80 %; "
+                                   "Kibar 2008: 766.12-719.00 over 8-16 %"),
     ),
     "wheat": Grain(
         "wheat",
@@ -172,9 +233,18 @@ GRAINS: dict[str, Grain] = {
         restitution_pw=Sourced(0.47, _WHEAT_DEM, "wheat-steel"),
         lateral_pressure_ratio=Sourced(0.54, _EN1991_WHEAT, "K_m, factor a_K 1.11 (0.49-0.60); the "
                                        "same row: unit weight 7.5-9.0 kN/m^3, wall friction 0.57 "
-                                       "against concrete (D3)"),
+                                       "against concrete (D3); the Table E.1 transcription of "
+                                       "sthanhe/engMan gives the same"),
         internal_friction_deg=Sourced(30.0, _EN1991_WHEAT, "phi_im, factor a_phi 1.12 "
-                                      "(26.8-33.6 degrees)"),
+                                      "(26.8-33.6 degrees); angle of repose phi_r 34 (engMan)"),
+        wall_friction_steel=Sourced(0.38, _EN_E1, "'Wheat' row: mu_m on a D2 (smooth) wall; D1 0.24, D3 "
+                                    "0.57 (= the SGEM 2018 row's concrete value), a_mu 1.16. Not the "
+                                    "DEM's friction_pw (0.5023, a calibrated wheat-steel contact)"),
+        bulk_unit_weight_kn_m3=Sourced((7.5, 9.0), _EN1991_WHEAT, "gamma lower 7.5, upper 9.0; the same "
+                                       "in the engMan transcription"),
+        bulk_density_kg_m3=Sourced((538.8, 740.0), _WHEAT_PROPS, "740 at 0 % to 538.8 kg/m^3 at 22 % d.b. "
+                                   "(rewetted wheat); 1 - 740/1240 = 0.403, inside Ramaj's in-bin "
+                                   "porosity range"),
     ),
     "shelled_corn": Grain(
         "shelled_corn",
@@ -191,6 +261,15 @@ GRAINS: dict[str, Grain] = {
         friction_pw=Sourced(0.545, _CORN_DEM, "maize-steel, measured on an inclined plane"),
         restitution_pp=Sourced(0.318, _CORN_DEM, "maize-maize, calibrated"),
         restitution_pw=Sourced(0.5, _CORN_DEM, "maize-steel, measured"),
+        lateral_pressure_ratio=Sourced(0.53, _EN_E1, "'Maize' row: K_m 0.53, a_K 1.14"),
+        internal_friction_deg=Sourced(31.0, _EN_E1, "'Maize' row: phi_im 31, a_phi 1.14 (angle of repose "
+                                      "phi_r 35)"),
+        wall_friction_steel=Sourced(0.36, _EN_E1, "'Maize' row: mu_m on a D2 (smooth) wall; D1 0.22, D3 "
+                                    "0.53, a_mu 1.24. Not the DEM's friction_pw (0.545, single kernels "
+                                    "on steel, inclined plane)"),
+        bulk_unit_weight_kn_m3=Sourced((7.0, 8.0), _EN_E1, "'Maize' row: gamma_l 7.0, gamma_u 8.0"),
+        bulk_density_kg_m3=Sourced((709.50, 746.00), _CORN_DARFOUR, "five varieties and the moisture "
+                                   "series; with the true density 1250: porosity 0.4324-0.4032"),
     ),
     "barley": Grain(
         "barley",
@@ -209,6 +288,15 @@ GRAINS: dict[str, Grain] = {
                             "(concrete 0.877-0.993, wood 0.560-0.713)"),
         restitution_pp=_missing("a barley restitution", _DEM_SEARCH),
         restitution_pw=_missing("a barley-wall restitution", _DEM_SEARCH),
+        lateral_pressure_ratio=Sourced(0.59, _EN_E1, "'Barley' row: K_m 0.59, a_K 1.11"),
+        internal_friction_deg=Sourced(28.0, _EN_E1, "'Barley' row: phi_im 28, a_phi 1.14 (angle of "
+                                      "repose phi_r 31); Ozturk & Esen 2008: 22.50 deg at 14 % d.b."),
+        wall_friction_steel=Sourced(0.33, _EN_E1, "'Barley' row: mu_m on a D2 (smooth) wall; D1 0.24, "
+                                    "D3 0.48, a_mu 1.16. Not the DEM's friction_pw (0.773, Ozturk & "
+                                    "Esen 2008, grain on galvanized steel)"),
+        bulk_unit_weight_kn_m3=Sourced((7.0, 8.0), _EN_E1, "'Barley' row: gamma_l 7.0, gamma_u 8.0"),
+        bulk_density_kg_m3=Sourced((623.00, 647.34), _BARLEY_OE, "647.34 at 10 % to 623.00 kg/m^3 at "
+                                   "14 % d.b.; Sahra (J): 568.10-613.68"),
     ),
     "rough_rice": Grain(
         "rough_rice",
@@ -227,6 +315,13 @@ GRAINS: dict[str, Grain] = {
                             "over 8-21 % d.b. (glass 0.3168-0.4369, plywood 0.4394-0.5264)"),
         restitution_pp=_missing("a rough-rice restitution", _DEM_SEARCH),
         restitution_pw=_missing("a rough-rice-wall restitution", _DEM_SEARCH),
+        internal_friction_deg=_missing("a rough-rice angle of internal friction",
+                                       "EN 1991-4 Table E.1 (no rice row); a paddy abstract (FARO 44/57, "
+                                       "Nigerian J. Trop. Eng. 2024) gives only 'at least 15.2 deg ... 35 "
+                                       "deg also obtained', no value to use"),
+        wall_friction_steel=Sourced(0.4179, _RICE, "the friction_pw value: the same measurement (grains "
+                                    "on a galvanized iron sheet, Alikazemi at 8 % d.b.) is the source of "
+                                    "both"),
     ),
     "canola": Grain(
         "canola",
@@ -247,6 +342,12 @@ GRAINS: dict[str, Grain] = {
         restitution_pp=_missing("a canola restitution", "Cao et al. 2021 abstract gives no values"),
         restitution_pw=_missing("a canola-wall restitution",
                                 "Cao et al. 2021 abstract gives no values"),
+        internal_friction_deg=_CANOLA_PHI,
+        lateral_pressure_ratio=_jaky(_CANOLA_PHI, _NO_K),
+        wall_friction_steel=Sourced(0.301, _CANOLA, "the friction_pw value: the same measurement (seeds "
+                                    "on a galvanized iron sheet) is the source of both"),
+        bulk_density_kg_m3=Sourced((666.06, 738.8), _CANOLA, "lowest (Hyola) and highest (SLM) of four "
+                                   "varieties over 5.27-23.69 % w.b."),
     ),
     "sorghum": Grain(
         "sorghum",
@@ -259,6 +360,10 @@ GRAINS: dict[str, Grain] = {
         friction_pw=Sourced(0.32, _SORGHUM, "iron, 0.32-0.43 (acrylic 0.25-0.48, zinc 0.21-0.42)"),
         restitution_pp=_missing("a sorghum restitution", _DEM_SEARCH),
         restitution_pw=_missing("a sorghum-wall restitution", _DEM_SEARCH),
+        wall_friction_steel=Sourced(0.32, _SORGHUM, "the friction_pw value: the same measurement (grains "
+                                    "on an iron sheet; zinc 0.21-0.42) is the source of both"),
+        bulk_density_kg_m3=Sourced((712.60, 815.40), _SORGHUM, "815.40 at 9.06 % to 712.60 kg/m^3 at "
+                                   "29.15 % w.b."),
     ),
 }
 

@@ -346,26 +346,27 @@ def _fill_options(args):
 
 
 def _janssen_inputs(name):
-    """(wall friction, lateral pressure ratio K, what they are) of a library grain for Janssen's
-    stress: the grain-wall friction the DEM walls use, K measured or else Jaky's 1 - sin(phi);
-    ValueError when the library lacks them."""
+    """(wall friction mu_w, lateral pressure ratio K, what they are) of a library grain for Janssen's
+    stress: the bulk's friction on a smooth steel wall (``wall_friction_steel``, not the DEM walls'
+    contact friction) and K (measured, or Jaky's 1 - sin(phi) as the library notes); ValueError
+    when the library lacks them."""
     try:
         g = grain(name)
     except ValueError:
         raise ValueError(f"--depth needs a library grain (wall friction and K); {name!r} is a template file: "
                          "give --stress") from None
-    mu = g.friction_pw.value
+    mu = g.wall_friction_steel.value
     if mu is None:
-        raise ValueError(f"--depth: the grain library has no wall friction for {g.name}: give --stress")
+        raise ValueError(f"--depth: the grain library has no wall friction against steel for {g.name}: give --stress")
     if g.lateral_pressure_ratio.value is not None:
-        k, k_src = g.lateral_pressure_ratio.value, f"measured: {g.lateral_pressure_ratio.source}"
+        k, k_src = g.lateral_pressure_ratio.value, g.lateral_pressure_ratio.source
     elif g.internal_friction_deg.value is not None:
         phi = g.internal_friction_deg.value
         k, k_src = 1 - math.sin(math.radians(phi)), f"Jaky 1 - sin({phi:g} deg): {g.internal_friction_deg.source}"
     else:
         raise ValueError(f"--depth: the grain library has no lateral pressure ratio K nor angle of internal friction "
                          f"for {g.name} (Janssen's stress needs one): give --stress")
-    return float(mu), float(k), {"wall_friction": mu, "wall_friction_source": g.friction_pw.source,
+    return float(mu), float(k), {"wall_friction": mu, "wall_friction_source": g.wall_friction_steel.source,
                                  "lateral_pressure_ratio": k, "lateral_pressure_ratio_source": k_src}
 
 

@@ -21,6 +21,10 @@ BOUNDS = {
     "axes_sd_mm": (0.0, 3.0),
     "lateral_pressure_ratio": (0.2, 1.0),
     "internal_friction_deg": (15.0, 50.0),
+    "wall_friction_steel": (0.1, 1.0),
+    "wall_friction_corrugated": (0.1, 1.0),
+    "bulk_unit_weight_kn_m3": (5.0, 10.0),
+    "bulk_density_kg_m3": (500.0, 900.0),
 }
 
 
@@ -51,9 +55,10 @@ def test_numbers_positive_and_sensible(name):
     if g.axes_mm.value is not None:
         length, width, thickness = g.axes_mm.value
         assert length >= width >= thickness
-    if g.bulk_porosity.value is not None:
-        lo, hi = g.bulk_porosity.value
-        assert lo <= hi
+    for field in ("bulk_porosity", "bulk_unit_weight_kn_m3", "bulk_density_kg_m3"):
+        if getattr(g, field).value is not None:
+            lo, hi = getattr(g, field).value
+            assert lo <= hi, (name, field)
 
 
 def test_frozen():
@@ -175,3 +180,96 @@ def test_network_bed_properties_agree_with_dem_grains(name):
         lo, hi = b.bulk_porosity
         assert b.loose_fill_porosity == pytest.approx(0.5 * (lo + hi), abs=1e-12)
     assert set(BED) == set(D272) == set(GRAINS)
+
+
+#: EN 1991-4 Table E.1 rows as the transcription (sthanhe/engMan @Silo/constants.xls, sheet
+#: 'particles') gives them: gamma_l, gamma_u (kN/m^3), phi_im (deg), K_m, mu_m on walls D1, D2, D3
+EN_E1 = {"soybean": ("Soya beans", 7.0, 8.0, 25.0, 0.63, 0.24, 0.38, 0.48),
+         "wheat": ("Wheat", 7.5, 9.0, 30.0, 0.54, 0.24, 0.38, 0.57),
+         "shelled_corn": ("Maize", 7.0, 8.0, 31.0, 0.53, 0.22, 0.36, 0.53),
+         "barley": ("Barley", 7.0, 8.0, 28.0, 0.59, 0.24, 0.33, 0.48)}
+
+
+@pytest.mark.parametrize("name", sorted(EN_E1))
+def test_janssen_inputs_are_the_en_1991_4_table_e1_row(name):
+    """K, phi, mu_w (D2, smooth wall; D1 and D3 in the note) and the unit weight of each grain
+    that Table E.1 lists are its row; wheat's K, phi and unit weight come from the SGEM 2018 table
+    of the same Annex, which agrees with the transcription."""
+    row, gl, gu, phi, k, d1, d2, d3 = EN_E1[name]
+    g = grain(name)
+    assert g.lateral_pressure_ratio.value == k and g.internal_friction_deg.value == phi
+    assert g.bulk_unit_weight_kn_m3.value == (gl, gu)
+    mu = g.wall_friction_steel
+    assert mu.value == d2 and "EN 1991-4" in mu.source and "engMan" in mu.source
+    assert f"'{row}' row" in mu.note and f"D1 {d1:g}" in mu.note and f"D3 {d3:g}" in mu.note
+    assert "D2 (smooth)" in mu.note and "Not the DEM's friction_pw" in mu.note
+    assert mu.value != g.friction_pw.value and mu.source != g.friction_pw.source
+    for field in ("lateral_pressure_ratio", "internal_friction_deg", "bulk_unit_weight_kn_m3"):
+        assert "EN 1991-4" in getattr(g, field).source and "Jaky" not in getattr(g, field).note
+
+
+def test_jaky_k_only_where_no_measured_k():
+    """K = 1 - sin(phi) (Jaky) exactly where the library holds phi but no measured K, from the
+    same source as phi, and the note says so; canola (rapeseed phi 23.91 deg) is the one grain."""
+    jaky = {n for n, g in GRAINS.items() if g.lateral_pressure_ratio.value is not None
+            and "Jaky" in g.lateral_pressure_ratio.note}
+    assert jaky == {"canola"}
+    for name in jaky:
+        g = GRAINS[name]
+        phi = g.internal_friction_deg
+        assert g.lateral_pressure_ratio.value == pytest.approx(1 - math.sin(math.radians(phi.value)), abs=1e-15)
+        assert g.lateral_pressure_ratio.source == phi.source
+        assert f"phi = {phi.value:g} deg" in g.lateral_pressure_ratio.note
+    assert GRAINS["canola"].internal_friction_deg.value == 23.91
+    assert GRAINS["canola"].lateral_pressure_ratio.value == pytest.approx(0.594699, abs=1e-6)
+
+
+def test_wall_friction_steel_is_friction_pw_only_where_one_measurement_gives_both():
+    """mu_w (Janssen) and friction_pw (DEM contact) are one Sourced number only where a grain on a
+    steel sheet is the source of both: rough rice 0.4179, canola 0.301, sorghum 0.32."""
+    same = {n for n, g in GRAINS.items() if g.wall_friction_steel.value is not None
+            and g.wall_friction_steel.source == g.friction_pw.source}
+    assert same == {"rough_rice", "canola", "sorghum"}
+    for name in same:
+        g = GRAINS[name]
+        assert g.wall_friction_steel.value == g.friction_pw.value
+        assert "the friction_pw value" in g.wall_friction_steel.note
+    assert {n: GRAINS[n].wall_friction_steel.value for n in same} == {
+        "rough_rice": 0.4179, "canola": 0.301, "sorghum": 0.32}
+    assert all(g.wall_friction_corrugated.value is None for g in GRAINS.values())
+
+
+def test_measured_bulk_density_is_the_sources_numbers_and_agrees_with_their_porosity():
+    """Loose-fill bulk densities as the abstracts give them; where one source gives true density,
+    porosity and bulk density (corn: Darfour 2022; soybean: Wandkar 2012 at 7.37 % d.b., true
+    density 1250; sorghum: 1257.33 and 1126.72 at the two ends), rho_bulk = rho_true (1 - porosity)
+    to the sources' rounding (porosity to 0.01 %: 1e-4 of the bulk density)."""
+    assert {n: g.bulk_density_kg_m3.value for n, g in GRAINS.items()} == {
+        "soybean": (644.4, 749.1), "wheat": (538.8, 740.0), "shelled_corn": (709.50, 746.00),
+        "barley": (623.00, 647.34), "rough_rice": None, "canola": (666.06, 738.8),
+        "sorghum": (712.60, 815.40)}
+    corn = GRAINS["shelled_corn"]
+    lo, hi = corn.bulk_porosity.value
+    assert corn.bulk_density_kg_m3.value == pytest.approx(
+        (corn.particle_density_kg_m3.value * (1 - hi), corn.particle_density_kg_m3.value * (1 - lo)), rel=1e-4)
+    assert GRAINS["soybean"].bulk_density_kg_m3.value[1] == pytest.approx(1250.0 * (1 - 0.4007), rel=1e-4)
+    sorghum = GRAINS["sorghum"]
+    assert sorghum.bulk_density_kg_m3.value == pytest.approx((1126.72 * (1 - 0.3675), 1257.33 * (1 - 0.3515)),
+                                                             rel=1e-4)
+    assert sorghum.bulk_porosity.value == (0.3515, 0.3675)
+
+
+def test_dem_pack_takes_janssen_inputs_from_the_library():
+    """dem.pack --depth takes mu_w = wall_friction_steel and the library's K for the five grains
+    that have both, and refuses rough rice and sorghum (no K, no phi) with a message naming the
+    grain."""
+    from dem.pack import _janssen_inputs
+    for name in ("soybean", "wheat", "shelled_corn", "barley", "canola"):
+        g = GRAINS[name]
+        mu, k, src = _janssen_inputs(name)
+        assert (mu, k) == (g.wall_friction_steel.value, g.lateral_pressure_ratio.value)
+        assert src["wall_friction_source"] == g.wall_friction_steel.source
+        assert src["lateral_pressure_ratio_source"] == g.lateral_pressure_ratio.source
+    for name in ("rough_rice", "sorghum"):
+        with pytest.raises(ValueError, match=f"no lateral pressure ratio K nor angle of internal friction for {name}"):
+            _janssen_inputs(name)
