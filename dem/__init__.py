@@ -11,7 +11,7 @@ pack_bed(container, *, porosity=0.408, rng=None, options=PackOptions(), run=RunO
     (frictionless sedimentation + annealed taps, friction restored for the last settle) is the
     rect-bin default (``SCENE_DEFAULTS``), the only way found to its 0.408 ± 0.01 target with
     overlaps below 1 % of a radius (0.415 interior; numbers in ``docs/dem-packing.md``).
-vibrate_bed(centers, radii, container, *, freq_hz, amplitude_m, duration_s, ...) -> VibrationResult
+vibrate_bed(centers, radii, container, *, vibration=VibrationOptions(), run=SETTLE_RUN) -> VibrationResult
     Sinusoidal vertical motion of the bin (Eq. 3.11) with porosity histories, steady stop and
     checkpoints to resume from; rest_motion tells whether a packing is at rest.
 Simulation, DemInstabilityError, PlaneWall, CylinderWall, ClumpSimulation
@@ -53,7 +53,8 @@ from ._fill import generate_spheres, thesis_particle_count
 from ._measure import lens_volume, sphere_volume
 from ._procedures import PROCEDURES, PackOptions, PackResult, RunOptions, pack_bed
 from ._summary import summarize, surface_height
-from ._vibrate import VibrationResult, intensity_g, rest_motion, vibrate_bed
+from ._vibrate import (SETTLE_RUN, VibrationOptions, VibrationResult, intensity_g, rest_motion,
+                       vibrate_bed)
 from ._walls import CylinderWall, PlaneWall
 from .clumps import ClumpSimulation
 from ._load import janssen_stress, load_bed
@@ -67,7 +68,7 @@ __all__ = [
     "Material", "SOYBEAN", "Simulation", "DemInstabilityError",
     "linear_contact_forces", "series_stiffness", "damping_coefficient", "restitution_coefficient",
     "Container", "SCENES", "SCENE_DEFAULTS", "PROCEDURES", "scene_container", "pack_bed", "PackResult", "PackOptions", "RunOptions", "summarize", "thesis_particle_count",
-    "vibrate_bed", "VibrationResult",
+    "vibrate_bed", "VibrationOptions", "VibrationResult", "SETTLE_RUN",
     "Region", "porosity_in_spheres", "porosity_in_region", "coordination_numbers",
     "read_packing", "write_packing",
     # walls, generation and measuring helpers (the tests and CLIs use these, not private modules)

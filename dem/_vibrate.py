@@ -15,6 +15,7 @@ interior region (two mean diameters from the walls, the floor and the initial su
 from __future__ import annotations
 
 import logging
+import math
 import time
 from dataclasses import dataclass, field
 
@@ -23,9 +24,11 @@ import numpy as np
 from ._material import SOYBEAN
 from ._measure import porosity_in_region, porosity_in_spheres, sphere_volume
 from ._container import default_measure_spheres, make_simulation
+from ._procedures import RunOptions
 from ._summary import summarize, surface_height
 
-__all__ = ["vibrate_bed", "VibrationResult", "intensity_g", "rest_motion", "REST_PROBE_S"]
+__all__ = ["vibrate_bed", "VibrationOptions", "VibrationResult", "intensity_g", "rest_motion",
+           "REST_PROBE_S", "SETTLE_RUN"]
 
 log = logging.getLogger(__name__)
 G = 9.81
@@ -40,6 +43,80 @@ def intensity_g(freq_hz, amplitude_m):
     1.81
     """
     return float(amplitude_m) * (2 * np.pi * float(freq_hz)) ** 2 / G
+
+
+def _positive(name, value, *, zero=False):
+    """``float(value)`` if finite and > 0 (>= 0 with ``zero``), else ValueError naming it."""
+    v = float(value)
+    if not math.isfinite(v) or v < 0 or (v == 0 and not zero):
+        raise ValueError(f"{name} must be finite and {'>=' if zero else '>'} 0, got {value!r}")
+    return v
+
+
+@dataclass(frozen=True, kw_only=True)
+class VibrationOptions:
+    r"""The walls' motion, when it may stop early, and what :func:`vibrate_bed` records.
+
+    Parameters
+    ----------
+    freq_hz : float
+        f, > 0 (default 15 Hz, the thesis's).
+    amplitude_m : float
+        A, >= 0 (default 2 mm; thesis: 0.5–4 mm); 0 is a control run (the bed at rest for the
+        same time).
+    duration_s : float
+        Vibration time, > 0 (default 1 s; thesis: 16 s).
+    steady_window_s : float, optional
+        Stop the vibration early once the global porosity has been steady this long (> 0): the
+        means of the window's two halves differ by less than ``steady_tol`` including two
+        standard errors (per-period values that still fluctuate are not steady). Default None:
+        vibrate for ``duration_s``.
+    steady_tol : float
+        Porosity change that counts as steady, > 0 (default 1e-3).
+    record_every_s : float, optional
+        History interval, > 0; default None: a quarter period.
+    snapshot_times_s : sequence of float
+        Times (s, >= 0) at which a copy of the centres is kept (default none).
+    rest_tol : float, optional
+        Refuse (ValueError) a packing that is not at rest: one whose spheres move on average
+        more than ``rest_tol`` (> 0) mean radii in :data:`REST_PROBE_S` with the walls still
+        (:func:`rest_motion`; settled beds: below 0.003, unsettled ones 0.02–0.6). Default None:
+        no check.
+
+    >>> round(VibrationOptions(freq_hz=15.0, amplitude_m=0.002).intensity_g, 2)
+    1.81
+    """
+
+    freq_hz: float = 15.0
+    amplitude_m: float = 0.002
+    duration_s: float = 1.0
+    steady_window_s: float | None = None
+    steady_tol: float = 1e-3
+    record_every_s: float | None = None
+    snapshot_times_s: tuple = ()
+    rest_tol: float | None = None
+
+    def __post_init__(self):
+        put = object.__setattr__
+        put(self, "freq_hz", _positive("freq_hz", self.freq_hz))
+        put(self, "amplitude_m", _positive("amplitude_m", self.amplitude_m, zero=True))
+        put(self, "duration_s", _positive("duration_s", self.duration_s))
+        put(self, "steady_tol", _positive("steady_tol", self.steady_tol))
+        for name in ("steady_window_s", "record_every_s", "rest_tol"):
+            if getattr(self, name) is not None:
+                put(self, name, _positive(name, getattr(self, name)))
+        put(self, "snapshot_times_s", tuple(_positive("snapshot_times_s", t, zero=True)
+                                            for t in self.snapshot_times_s))
+
+    @property
+    def intensity_g(self) -> float:
+        """Γ = A (2π f)² / g (thesis Eq. 3.11)."""
+        return intensity_g(self.freq_hz, self.amplitude_m)
+
+
+#: How :func:`vibrate_bed` runs by default: the packing's mass scaling and time step, and the
+#: final settling to a mean unbalanced-force ratio of 1e-3 within 100 000 steps.
+SETTLE_RUN = RunOptions(tol=1e-3, max_steps=100_000)
 
 
 @dataclass
@@ -74,11 +151,9 @@ def rest_motion(centers, radii, container, *, material=SOYBEAN, mass_scale=100.0
     return float(np.mean(np.linalg.norm(sim.centers - np.asarray(centers), axis=1)) / np.mean(radii))
 
 
-def vibrate_bed(centers, radii, container, *, freq_hz=15.0, amplitude_m=0.002, duration_s=1.0, material=SOYBEAN,
-                mass_scale=100.0, dt_safety=0.25, record_every_s=None, snapshot_times_s=(), measure_spheres=None,
-                tol=1e-3, max_settle_steps=100000, progress=None, check_every=200, steady_window_s=None,
-                steady_tol=1e-3, rest_tol=None, checkpoint=None, checkpoint_every_s=None, resume=None,
-                threads=None):
+def vibrate_bed(centers, radii, container, *, vibration=VibrationOptions(), run=SETTLE_RUN,
+                material=SOYBEAN, measure_spheres=None, threads=None, progress=None,
+                checkpoint=None, checkpoint_every_s=None, resume=None):
     """Vibrate a packing vertically and record its porosity.
 
     Parameters
@@ -86,28 +161,22 @@ def vibrate_bed(centers, radii, container, *, freq_hz=15.0, amplitude_m=0.002, d
     centers : (N, 3) array, m
     radii : (N,) array, m
     container : Container
-    freq_hz : float
-        f (thesis: 15 Hz).
-    amplitude_m : float
-        A (thesis: 0.5–4 mm); 0 is a control run (the bed at rest for the same time).
-    duration_s : float
-        Vibration time (thesis: 16 s).
-    mass_scale : float
-        Density scaling S (equivalent to stiffnesses divided by S; 1 = physical).
-    record_every_s : float, optional
-        History interval; default a quarter period.
-    snapshot_times_s : sequence of float
-        Times at which a copy of the centres is kept.
-    tol : float
-        Equilibrium criterion of the final settling (after the walls stop).
-    steady_window_s : float, optional
-        Stop the vibration early once the global porosity has been steady this long: the means
-        of the window's two halves differ by less than ``steady_tol`` including two standard
-        errors (per-period values that still fluctuate are not steady).
-    rest_tol : float, optional
-        Refuse (ValueError) a packing that is not at rest: one whose spheres move on average
-        more than ``rest_tol`` mean radii in :data:`REST_PROBE_S` with the walls still
-        (:func:`rest_motion`; settled beds: below 0.003, unsettled ones 0.02–0.6).
+    vibration : VibrationOptions
+        The walls' motion, the early stop and what is recorded (default: 2 mm at 15 Hz for
+        1 s).
+    run : RunOptions
+        Mass scaling S (equivalent to stiffnesses divided by S; 1 = physical), time-step
+        safety, and the final settling after the walls stop: ``tol`` (mean unbalanced-force
+        ratio), ``max_steps``, ``check_every`` (default :data:`SETTLE_RUN`: S = 100, tol 1e-3,
+        100 000 steps); ``settle_time_s`` is not taken (the bed settles to ``tol``).
+    material : Material
+        Contact law and density (default soybeans).
+    measure_spheres : (centres (M, 3), radii (M,)), optional
+        Measurement spheres (default :func:`dem.default_measure_spheres` of the container).
+    threads : int, optional
+        Threads of the step (default: chosen by timing; the result does not depend on it).
+    progress : callable(stage, sim, force), optional
+        Called every ``run.check_every`` steps.
     checkpoint : callable(dict) -> None, optional
         Called every ``checkpoint_every_s`` of simulated vibration with what ``resume`` takes.
     resume : dict, optional
@@ -118,9 +187,19 @@ def vibrate_bed(centers, radii, container, *, freq_hz=15.0, amplitude_m=0.002, d
     -------
     VibrationResult
     """
-    if not freq_hz > 0 or not amplitude_m >= 0 or not duration_s > 0:
-        raise ValueError(f"need freq_hz > 0, amplitude_m >= 0, duration_s > 0; got {freq_hz}, {amplitude_m}, "
-                         f"{duration_s}")
+    if not isinstance(vibration, VibrationOptions):
+        raise TypeError(f"vibration must be a VibrationOptions, got {type(vibration).__name__}")
+    if not isinstance(run, RunOptions):
+        raise TypeError(f"run must be a RunOptions, got {type(run).__name__}")
+    if run.settle_time_s is not None:
+        raise ValueError("vibrate_bed settles to run.tol after the vibration; settle_time_s is "
+                         "not taken")
+    freq_hz, amplitude_m, duration_s = vibration.freq_hz, vibration.amplitude_m, vibration.duration_s
+    steady_window_s, steady_tol = vibration.steady_window_s, vibration.steady_tol
+    record_every_s, snapshot_times_s = vibration.record_every_s, vibration.snapshot_times_s
+    rest_tol = vibration.rest_tol
+    mass_scale, dt_safety, tol = run.mass_scale, run.dt_safety, run.tol
+    max_settle_steps, check_every = run.max_steps, run.check_every
     centers = np.array(centers, dtype=float)
     radii = np.array(radii, dtype=float)
     omega = 2 * np.pi * freq_hz

@@ -26,6 +26,7 @@ import os
 import subprocess
 import sys
 import time
+from dataclasses import replace
 from pathlib import Path
 
 import numpy as np
@@ -36,7 +37,7 @@ from ._io import read_packing, write_packing, write_summary
 from ._material import SOYBEAN, Material
 from ._plots import plot_study
 from ._procedures import PackOptions, RunOptions, pack_bed
-from ._vibrate import intensity_g, vibrate_bed
+from ._vibrate import SETTLE_RUN, VibrationOptions, intensity_g, vibrate_bed
 
 __all__ = ["run_study", "NETWORK_STEPS"]
 
@@ -187,6 +188,12 @@ def run_study(args, container, amplitudes) -> int:
     quiet = args.quiet
     duration = 16.0 if args.duration is None else args.duration
     steady = 2.0 if args.steady_window is None else args.steady_window
+    # every option checked before the bed is packed
+    run = RunOptions(mass_scale=args.mass_scale, tol=SETTLE_RUN.tol, max_steps=args.settle_steps)
+    base = VibrationOptions(freq_hz=args.freq, duration_s=duration, record_every_s=1.0 / args.freq,
+                            steady_window_s=steady or None,
+                            rest_tol=args.rest_tol if args.rest_tol > 0 else None)
+    vibrations = [replace(base, amplitude_m=amp) for amp in amplitudes]
     bed_csv, centers, radii, bed_summary = _bed(out, container, args.scene, args.seed, args.mass_scale, quiet)
     measure = default_measure_spheres(container)
     network_before = None if args.no_network else _network(bed_csv, container, out / "network_before.json", quiet)
@@ -213,11 +220,10 @@ def run_study(args, container, amplitudes) -> int:
             t0 = time.perf_counter()
             wall_before = float((resume or {}).get("wall_s") or 0.0)
             try:
-                res = vibrate_bed(centers, radii, container, freq_hz=args.freq, amplitude_m=amp, duration_s=duration,
-                                  material=_material(bed_summary), mass_scale=args.mass_scale,
-                                  record_every_s=1.0 / args.freq, measure_spheres=measure,
-                                  max_settle_steps=args.settle_steps, steady_window_s=steady or None,
-                                  rest_tol=args.rest_tol if resume is None else None, progress=progress,
+                # a resumed run was at rest when it started
+                vibration = vibrations[k] if resume is None else replace(vibrations[k], rest_tol=None)
+                res = vibrate_bed(centers, radii, container, vibration=vibration, run=run,
+                                  material=_material(bed_summary), measure_spheres=measure, progress=progress,
                                   checkpoint=_checkpointer(ck_path, wall_before, t0), checkpoint_every_s=args.checkpoint_every,
                                   resume=resume, threads=args.threads)
             except DemInstabilityError as e:

@@ -27,7 +27,8 @@ from ._container import SCENES
 from ._integrate import DemInstabilityError
 from ._material import Material
 from ._io import read_packing, write_packing
-from ._vibrate import intensity_g, vibrate_bed
+from ._procedures import RunOptions
+from ._vibrate import SETTLE_RUN, VibrationOptions, intensity_g, vibrate_bed
 from .study import run_study
 
 THESIS_AMPLITUDES_M = (0.0005, 0.001, 0.002, 0.003, 0.004)
@@ -109,17 +110,19 @@ def _vibrate(args) -> int:
     container = resolve_container(args.scene, size_m=args.size, height_m=args.height, summary=summary)
     material = Material(**summary["material"]) if summary and "material" in summary else Material()
     duration = 1.0 if args.duration is None else args.duration
+    run = RunOptions(mass_scale=args.mass_scale, tol=SETTLE_RUN.tol, max_steps=args.settle_steps)
+    vibrations = [VibrationOptions(freq_hz=args.freq, amplitude_m=amp, duration_s=duration,
+                                   record_every_s=args.record_every, snapshot_times_s=args.snapshots,
+                                   steady_window_s=args.steady_window or None,
+                                   rest_tol=args.rest_tol if args.rest_tol > 0 and amp == amps[0] else None)
+                  for amp in amps]                      # every option checked before any work
     out = Path(args.out or "vibration_out")
     out.mkdir(parents=True, exist_ok=True)
     rows = []
-    for amp in amps:
+    for amp, vibration in zip(amps, vibrations):
         t0 = time.perf_counter()
         try:
-            res = vibrate_bed(centers, radii, container, freq_hz=args.freq, amplitude_m=amp, duration_s=duration,
-                              material=material, mass_scale=args.mass_scale, record_every_s=args.record_every,
-                              snapshot_times_s=args.snapshots, max_settle_steps=args.settle_steps,
-                              steady_window_s=args.steady_window or None,
-                              rest_tol=args.rest_tol if args.rest_tol > 0 and amp == amps[0] else None,
+            res = vibrate_bed(centers, radii, container, vibration=vibration, run=run, material=material,
                               threads=args.threads, progress=progress_printer(f"A={amp * 1e3:.1f} mm ", quiet=args.quiet))
         except DemInstabilityError as e:
             raise DemInstabilityError(f"A = {amp} m: {e}") from e

@@ -5,7 +5,7 @@ import pytest
 
 from dem import (SCENES, Container, Material, Region, coordination_numbers, generate_spheres, intensity_g,
                  lens_volume, pack_bed, PackOptions, RunOptions, porosity_in_region, porosity_in_spheres, read_packing, sphere_volume,
-                 thesis_particle_count, vibrate_bed, write_packing)
+                 thesis_particle_count, vibrate_bed, VibrationOptions, write_packing)
 
 TINY = Container("box", (0.03, 0.02), 0.03)
 
@@ -120,8 +120,10 @@ def test_same_seed_same_packing_and_io_roundtrip(tmp_path, tiny_bed):
 
 def test_vibration_records_histories(tiny_bed):
     # amplitude 0: the library allows a control run (the CLI refuses A <= 0)
-    res = vibrate_bed(tiny_bed.centers, tiny_bed.radii, TINY, freq_hz=15, amplitude_m=0.0, duration_s=0.02,
-                  record_every_s=0.005, snapshot_times_s=[0.01], max_settle_steps=200)
+    res = vibrate_bed(tiny_bed.centers, tiny_bed.radii, TINY,
+                      vibration=VibrationOptions(freq_hz=15, amplitude_m=0.0, duration_s=0.02,
+                                                 record_every_s=0.005, snapshot_times_s=[0.01]),
+                      run=RunOptions(tol=1e-3, max_steps=200))
     # 0.02 s recorded every 0.005 s, plus the initial and the post-settling records
     assert len(res.times_s) == 6 and res.porosity_spheres.shape == (6, 5)
     assert 0.01 in res.snapshots
@@ -129,8 +131,16 @@ def test_vibration_records_histories(tiny_bed):
         assert np.all((h > 0) & (h < 1))
     assert np.all(res.centers[:, 2] - res.radii > -1e-4)  # nobody fell through the floor
     assert res.summary["intensity_g"] == 0.0
-    with pytest.raises(ValueError, match="freq_hz"):
-        vibrate_bed(tiny_bed.centers, tiny_bed.radii, TINY, freq_hz=0.0, amplitude_m=0.001, duration_s=0.1)
+    with pytest.raises(ValueError, match="freq_hz must be finite and > 0"):
+        VibrationOptions(freq_hz=0.0, amplitude_m=0.001, duration_s=0.1)
+    with pytest.raises(ValueError, match="amplitude_m must be finite and >= 0"):
+        VibrationOptions(amplitude_m=-1e-3)
+    with pytest.raises(ValueError, match="snapshot_times_s must be finite and >= 0"):
+        VibrationOptions(snapshot_times_s=[0.01, float("nan")])
+    with pytest.raises(ValueError, match="settle_time_s is not taken"):
+        vibrate_bed(tiny_bed.centers, tiny_bed.radii, TINY, run=RunOptions(settle_time_s=0.1))
+    with pytest.raises(TypeError, match="vibration must be a VibrationOptions"):
+        vibrate_bed(tiny_bed.centers, tiny_bed.radii, TINY, vibration={"freq_hz": 15.0})
 
 
 def test_clis_refuse_bad_arguments_and_vibrate_runs(tmp_path, tiny_bed, capsys):

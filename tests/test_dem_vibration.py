@@ -7,11 +7,17 @@ import numpy as np
 import pytest
 from scipy.optimize import brentq
 
-from dem import Container, Material, PlaneWall, Simulation, intensity_g, pack_bed, vibrate_bed, PackOptions, RunOptions
+from dem import (Container, Material, PackOptions, PlaneWall, RunOptions, Simulation, VibrationOptions,
+                 intensity_g, pack_bed, vibrate_bed)
 
 TINY = Container("box", (0.03, 0.02), 0.03)
 R = 0.00325
 G = 9.81
+
+
+def _settle(max_steps):
+    """The default settling after the vibration (force ratio 1e-3) within ``max_steps`` steps."""
+    return RunOptions(tol=1e-3, max_steps=max_steps)
 
 
 @pytest.fixture(scope="module")
@@ -59,8 +65,10 @@ def test_bed_at_045_g_moves_with_the_floor_and_leaves_it_at_181_g(bed):
     # (1.2 A) at 1.81 g, where the bed takes off each period
     ranges = {}
     for a in (0.0005, 0.002):
-        res = vibrate_bed(bed.centers, bed.radii, TINY, freq_hz=15.0, amplitude_m=a, duration_s=0.2,
-                          record_every_s=1 / 300, max_settle_steps=100)
+        res = vibrate_bed(bed.centers, bed.radii, TINY,
+                          vibration=VibrationOptions(freq_hz=15.0, amplitude_m=a, duration_s=0.2,
+                                                     record_every_s=1 / 300),
+                          run=_settle(100))
         rel = res.motion["bed_z_m"] - res.motion["floor_z_m"]
         sel = (res.times_s > 1 / 15) & (res.times_s <= 0.2)
         ranges[a] = np.ptp(rel[sel]) / a
@@ -74,8 +82,9 @@ def test_bed_at_045_g_moves_with_the_floor_and_leaves_it_at_181_g(bed):
 
 
 def test_interrupted_vibration_resumes_to_the_same_numbers(bed):
-    kw = dict(freq_hz=15.0, amplitude_m=0.002, duration_s=0.04, record_every_s=1 / 60, max_settle_steps=300,
-              snapshot_times_s=[0.03])
+    kw = dict(vibration=VibrationOptions(freq_hz=15.0, amplitude_m=0.002, duration_s=0.04,
+                                         record_every_s=1 / 60, snapshot_times_s=[0.03]),
+              run=_settle(300))
     ckpts = []
     full = vibrate_bed(bed.centers, bed.radii, TINY, checkpoint=ckpts.append, checkpoint_every_s=0.015, **kw)
     assert len(ckpts) == 2  # at 0.015 s and 0.03 s
@@ -87,8 +96,11 @@ def test_interrupted_vibration_resumes_to_the_same_numbers(bed):
 
 
 def test_vibration_stops_when_the_porosity_is_steady(bed):
-    res = vibrate_bed(bed.centers, bed.radii, TINY, freq_hz=15.0, amplitude_m=0.0005, duration_s=1.0,
-                      record_every_s=1 / 150, steady_window_s=0.2, steady_tol=0.01, max_settle_steps=100)
+    res = vibrate_bed(bed.centers, bed.radii, TINY,
+                      vibration=VibrationOptions(freq_hz=15.0, amplitude_m=0.0005, duration_s=1.0,
+                                                 record_every_s=1 / 150, steady_window_s=0.2,
+                                                 steady_tol=0.01),
+                      run=_settle(100))
     assert res.summary["stopped_by"] == "steady"
     assert 0.2 <= res.summary["vibrated_s"] < 1.0
 
@@ -158,7 +170,9 @@ def test_resume_from_the_studys_npz_checkpoint_is_bit_for_bit(bed, tmp_path):
     """The study's checkpoint file (dem.study._checkpointer -> .npz -> _load_checkpoint) resumes
     to the same centres, records and porosities as a run never stopped, to the last bit."""
     from dem.study import _checkpointer, _load_checkpoint
-    kw = dict(freq_hz=15.0, amplitude_m=0.003, duration_s=0.2, record_every_s=1 / 15, max_settle_steps=300)
+    kw = dict(vibration=VibrationOptions(freq_hz=15.0, amplitude_m=0.003, duration_s=0.2,
+                                         record_every_s=1 / 15),
+              run=_settle(300))
     full = vibrate_bed(bed.centers, bed.radii, TINY, **kw)
     path, saved = tmp_path / "checkpoint.npz", []
 
@@ -175,13 +189,15 @@ def test_resume_from_the_studys_npz_checkpoint_is_bit_for_bit(bed, tmp_path):
 
 
 def test_vibration_ends_where_the_floor_passes_zero(bed):
-    # 0.25 s at 15 Hz is 3.75 periods: the floor stood at -A when the walls were set back to 0,
-    # a 2 mm jump into the bed (3 spheres thrown out, exit 1 in the audit). Now the run goes on to
-    # the end of that half period, 0.2667 s, where the floor passes z = 0 within half a step
-    res = vibrate_bed(bed.centers, bed.radii, TINY, freq_hz=15.0, amplitude_m=0.002,
-                      duration_s=0.25, max_settle_steps=100)
+    # 0.25 s at 15 Hz is 3.75 periods: the floor stands at -A there, and setting the walls back
+    # to 0 would be a 2 mm jump into the bed (3 spheres thrown out). The run goes on to the end
+    # of that half period, 0.2667 s, where the floor passes z = 0 within half a step
+    res = vibrate_bed(bed.centers, bed.radii, TINY,
+                      vibration=VibrationOptions(freq_hz=15.0, amplitude_m=0.002, duration_s=0.25),
+                      run=_settle(100))
     s = res.summary
     assert s["vibrated_s"] == pytest.approx(8 / 30, abs=s["dt_s"])
     assert abs(0.002 * np.sin(2 * np.pi * 15.0 * s["vibrated_s"])) < 0.002 * np.pi * 15 * s["dt_s"]
     with pytest.raises(ValueError, match="1e\\+06 Hz is not resolved by the time step"):
-        vibrate_bed(bed.centers, bed.radii, TINY, freq_hz=1e6, amplitude_m=1e-9, duration_s=1e-4)
+        vibrate_bed(bed.centers, bed.radii, TINY,
+                    vibration=VibrationOptions(freq_hz=1e6, amplitude_m=1e-9, duration_s=1e-4))
