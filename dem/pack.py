@@ -34,6 +34,7 @@ from dataclasses import replace
 from pathlib import Path
 
 import numpy as np
+from network.core import check_physical_porosity, reach_text, recorded_reach
 
 from ._cli import (EXIT_FAILED, check_output, check_seed, progress_printer, resolve_container,
                    run_main)
@@ -178,7 +179,14 @@ def _pack_grains(args, fill) -> int:
               size_cv=size_cv,
               tol=args.tol, max_steps=GRAIN_MAX_STEPS if args.max_steps is None else args.max_steps,
               progress=lambda sim, f: pr("grains", _Progress(sim), None))
+    if args.porosity is not None:
+        check_physical_porosity(args.porosity)
     if args.porosity is not None and args.deposition_friction is None:
+        rec = recorded_reach(template.name, container.to_dict())
+        if rec is not None and not (rec["range"][0] - rec["tol"] <= args.porosity
+                                    <= rec["range"][1] + rec["tol"]):
+            raise ValueError(f"--porosity {args.porosity:g} is outside what dem.pack reaches for "
+                             f"{template.name} in this container: {reach_text(rec)}")
         try:
             xs, r, gid, grains, s = pack_grains_to_porosity(container, template, porosity=args.porosity,
                                                             porosity_tol=args.porosity_tol,

@@ -241,7 +241,8 @@ def _main(args) -> int:
            "grain": grain, "workers": args.workers, "density_kg_m3": args.density,
            "inertial_law": INERTIAL_LAW,
            "viscosity_pa_s": args.viscosity,
-           "porosity": res.porosity, "sauter_diameter_m": res.sauter_diameter_m,
+           "porosity": res.porosity, "porosity_sample": res.porosity_sample,
+           "sauter_diameter_m": res.sauter_diameter_m,
            "permeability_stokes_m2": res.permeability_m2, "points": pts} | fits | {
            "fits_note": FITS_NOTE,
            "seconds": dict(res.timings_s, wall=total)}

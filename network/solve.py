@@ -123,8 +123,12 @@ def _print_result(res, out):
     print(f"axis {res.axis}: {s['n_pores']} pores, {s['n_throats']} throats "
           f"({s['n_inlet_pores']} inlet, {s['n_outlet_pores']} outlet, "
           f"{s['n_dropped_pores']} disconnected dropped)", file=out)
+    where = ""
+    if s["sample_estimator"] == "inset" and s.get("porosity_sample") is not None:
+        where = (f" (inset window, where k is measured; whole sample "
+                 f"{s['porosity_sample']:.4f})")
     print(f"  sample H = {s['sample_length_m']:.4g} m, A = {s['sample_area_m2']:.4g} m², "
-          f"porosity {s['porosity']:.4f} ± {s['porosity_std']:.4f}", file=out)
+          f"porosity {s['porosity']:.4f} ± {s['porosity_std']:.4f}{where}", file=out)
     print(f"  permeability k = {s['permeability_m2']:.4e} m²   k/d32² = {s['k_over_d2']:.4e}",
           file=out)
     if s["permeability_core_m2"] is not None:

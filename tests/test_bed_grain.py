@@ -162,3 +162,37 @@ def test_solve_marks_an_unconverged_inertial_answer(tmp_path, capsys, monkeypatc
     assert r["converged"] is False and r["inertial_solver"]["converged"] is False
     assert "NOT CONVERGED: the nonlinear solve stopped short" in cap.out
     assert "error: the nonlinear solve did not converge along z at 0.013 m/s" in cap.err
+
+
+def test_impossible_and_unreachable_porosities_are_refused_at_once(tmp_path, monkeypatch,
+                                                                   capsys):
+    """--porosity 0.9 (no bed of grains is that loose) and 0.2 (denser than any packing of
+    equal spheres) are refused before any packing by network.report and dem.pack; 0.45 for
+    soybean in the bundled bed's box is refused at once with the one recorded range, quoted the
+    same by the report (packing anew or moving along the band) and by dem.pack."""
+    import time
+
+    from dem.pack import main as pack_main
+    from network.core import reach_text, recorded_reach
+    monkeypatch.chdir(tmp_path)
+    box = ["--scene", "box", "--size", "0.05", "0.05", "--height", "0.05", "--grain", "soybean"]
+    t0 = time.perf_counter()
+    for p, words in (("0.9", "no static bed of grains is that loose"),
+                     ("0.2", "no packing of grains is that dense")):
+        assert report_main(["--porosity", p, "-q"]) == 2
+        assert f"error: --porosity {p}: {words}" in capsys.readouterr().err
+        assert pack_main([*box, "--fill", "grow", "--porosity", p, "--out", "b.csv",
+                          "--quiet"]) == 2
+        assert f"error: --porosity {p}: {words}" in capsys.readouterr().err
+    quoted = reach_text(recorded_reach("soybean"))
+    assert quoted.startswith("0.3490-0.4114 ")
+    for argv in (["--porosity", "0.45"], ["--porosity", "0.45", "--move-along-band"]):
+        assert report_main([*argv, "-q"]) == 2
+        err = capsys.readouterr().err.strip().splitlines()
+        assert len(err) == 1 and quoted in err[0], err
+    assert pack_main([*box, "--fill", "grow", "--porosity", "0.45", "--out", "b.csv",
+                      "--quiet"]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and quoted in err[0], err
+    assert time.perf_counter() - t0 < 30          # refusals, not packings (a packing: minutes)
+    assert list(tmp_path.iterdir()) == []

@@ -151,13 +151,14 @@ def test_an_empty_network_region_is_named_not_nan(monkeypatch):
 
 
 def test_pack_cli_unreachable_porosity_exits_2(tmp_path, monkeypatch, capsys):
-    """dem.pack --grain --porosity 0.2: exit 2 with the reachable range, nothing written."""
+    """dem.pack --grain --porosity 0.45 beyond what the search's ends reach in a container
+    without a recorded range: exit 2 with the reachable range, nothing written."""
     monkeypatch.setattr(cp, "pack_grains", _fake(lambda lam: 0.32 + 0.04 * (lam + 1), []))
     from dem.pack import main
     out = tmp_path / "g.csv"
     assert main(["--scene", "box", "--size", "0.08", "0.08", "--height", "0.05", "--grain",
-                 "soybean", "--porosity", "0.2", "--out", str(out), "--quiet"]) == 2
+                 "soybean", "--porosity", "0.45", "--out", str(out), "--quiet"]) == 2
     err = [ln for ln in capsys.readouterr().err.splitlines() if not ln.startswith("[search]")]
-    assert len(err) == 1 and err[0].startswith("error: porosity 0.2 is outside"), err
+    assert len(err) == 1 and err[0].startswith("error: porosity 0.45 is outside"), err
     assert "0.3200-0.4000" in err[0]
     assert not list(tmp_path.iterdir())

@@ -157,7 +157,8 @@ def test_the_shared_core_loads_numpy_alone():
 
     core = loaded("network.core")
     assert set(core) == {"network", "network._deferred", "network.core", "network.core._cli",
-                         "network.core._io", "network.core._packing", "network.core._text"}, core
+                         "network.core._io", "network.core._packing", "network.core._reach",
+                         "network.core._text"}, core
     net = {m for m in loaded("dem") if m.split(".")[0] == "network"}
     assert net == set(core), net
 

@@ -96,7 +96,10 @@ def solve_network(packing: Packing, *, axis="z", region: Region | None = None,
     solver : callable, optional
         ``solver(A, b) -> x`` instead of pyamg (tests pass ``spsolve``).
     porosity_points : int
-        Monte-Carlo points for the porosity (0 skips it: NaN).
+        Monte-Carlo points for the porosity (0 skips it: NaN, or ``porosity`` as given). The
+        porosity reported is that of the region ``permeability_m2`` is measured in: the inset
+        window (:func:`inset_window`) when the sample is wide enough for one, else the sample;
+        the sample's is ``porosity_sample``.
     conductance : callable, optional
         ``conductance(tessellation, throat_ids) -> g`` overriding model and policy (tests).
     trace_memory : bool
@@ -252,6 +255,11 @@ def solve_network(packing: Packing, *, axis="z", region: Region | None = None,
         k_inset = _inset_estimate(sample, g, p, reg, packing.grain_diameter, viscosity_pa_s,
                                   tess)
         k = k_whole if k_inset is None else k_inset
+    eps_sample, eps_sample_err = eps, eps_err
+    if k_inset is not None and porosity_points:   # k of the inset window: its porosity
+        with stage("porosity"):
+            eps, eps_err = region_porosity(packing, inset_window(reg, ax, packing.grain_diameter),
+                                           ax, n_points=porosity_points)
     # pressures and flows of the flow-imposed problem (thesis BC): Q = v A
     scale = velocity_m_s * sample.area_m2 / q1
     d32 = packing.sauter_diameter
@@ -280,7 +288,8 @@ def solve_network(packing: Packing, *, axis="z", region: Region | None = None,
         area_m2=sample.area_m2, flow_m3_s=q1, permeability_m2=k,
         permeability_whole_m2=k_whole, sample_estimator="whole" if k_inset is None else "inset",
         mean_diameter_m=packing.mean_diameter, sauter_diameter_m=d32, porosity=eps,
-        porosity_std=eps_err, solver=solver_info, check=chk, qstar_stats=qstats,
+        porosity_std=eps_err, porosity_sample=eps_sample, porosity_sample_std=eps_sample_err,
+        solver=solver_info, check=chk, qstar_stats=qstats,
         timings_s=times, pressure_pa=p * scale, throat_flow_m3_s=check["throat_flow"] * scale,
         throat_conductance=g, pore_ids=sample.pores, throat_ids=sample.throats,
         conns=sample.conns, pore_xyz=sample.pore_xyz, pore_groups=sample.groups,
@@ -308,6 +317,25 @@ CORE_MIN_DIAMETERS = 5.0
 #: narrowest inset window (diameters, both lateral directions) for which it is used.
 INSET_DIAMETERS = (1.5, 1.0)
 INSET_MIN_DIAMETERS = 4.0
+
+
+def inset_window(region, axis: int, grain_diameter_m: float):
+    """The inset window of a box sample, :data:`INSET_DIAMETERS` grain diameters in from its
+    lateral faces and ends (the region whose permeability is ``permeability_m2`` when
+    ``sample_estimator`` is 'inset'), or None: a cylinder, or a sample too narrow for it."""
+    if region.radius is not None:
+        return None
+    d = float(grain_diameter_m)
+    lat, end = INSET_DIAMETERS
+    lo, hi = np.asarray(region.lo, float).copy(), np.asarray(region.hi, float).copy()
+    width = hi - lo
+    axis = int(axis)
+    if np.any(np.delete(width, axis) - 2 * lat * d < INSET_MIN_DIAMETERS * d) \
+            or width[axis] - 2 * end * d < INSET_MIN_DIAMETERS * d:
+        return None
+    inset = np.full(3, lat * d)
+    inset[axis] = end * d
+    return Region(lo + inset, hi - inset)
 
 
 def _inset_estimate(sample, g, p, region, grain_diameter_m, viscosity_pa_s, tessellation):
@@ -416,6 +444,6 @@ def solve_axes(packing: Packing, regions: dict, **options) -> list[FlowResult]:
         key = (tuple(reg.lo), tuple(reg.hi), reg.radius)
         res = solve_network(packing, axis=axis, region=reg, porosity=porosity_of.get(key),
                             **options)
-        porosity_of.setdefault(key, (res.porosity, res.porosity_std))
+        porosity_of.setdefault(key, (res.porosity_sample, res.porosity_sample_std))
         results.append(res)
     return results

@@ -45,6 +45,9 @@ class FlowResult:
     permeability_m2: float
     mean_diameter_m: float
     sauter_diameter_m: float
+    #: porosity of the region ``permeability_m2`` is measured in (the inset window when
+    #: ``sample_estimator`` is 'inset', else the sample) and its error: the pair (k, porosity)
+    #: that k/d², Ergun, Kozeny-Carman and the fits use
     porosity: float
     porosity_std: float
     solver: dict
@@ -75,6 +78,9 @@ class FlowResult:
     #: ``inertia=True``): ``density_kg_m3``, ``velocities_m_s`` (the first is
     #: ``velocity_m_s``) and their :class:`network.flow.InertialPoint` ``points``.
     inertial: dict | None = dataclasses.field(default=None, repr=False)
+    #: porosity of the whole sample box and its error (= ``porosity`` without an inset window)
+    porosity_sample: float | None = None
+    porosity_sample_std: float | None = None
     #: The grain the bed is of (a key of :data:`network._grains.D272`), for the D272
     #: comparison; None: unknown, no D272 line.
     grain: str | None = None
@@ -182,6 +188,12 @@ class FlowResult:
             "flow_m3_s_note": "total flow for 1 Pa across the sample",
             "porosity": self.porosity,
             "porosity_std": self.porosity_std,
+            "porosity_sample": self.porosity_sample,
+            "porosity_sample_std": self.porosity_sample_std,
+            "porosity_note": (
+                "porosity is that of the region permeability_m2 is measured in (the inset "
+                "window with sample_estimator 'inset', else the sample), the pair k/d32^2, "
+                "Ergun, Kozeny-Carman and the fits use; porosity_sample is the whole sample's"),
             "mean_diameter_m": self.mean_diameter_m,
             "sauter_diameter_m": self.sauter_diameter_m,
             "n_pores": self.n_pores,
@@ -267,6 +279,7 @@ def combined_summary(results, *, seconds: dict | None = None, packing=None) -> d
             if any("pressure_gradient_stokes_pa_per_m" in b for b in by.values()) else ""),
         "porosity": first.porosity,
         "porosity_std": first.porosity_std,
+        "porosity_sample": first.porosity_sample,
         "n_pores": max(r.n_pores for r in results),
         "n_throats": max(r.n_throats for r in results),
         "anisotropy": {r.axis: float(r.permeability_m2 / k) for r in results},

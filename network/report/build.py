@@ -8,13 +8,15 @@ with inertia), the porosity is moved along the band (:mod:`network.report.porosi
 
 from __future__ import annotations
 
+import logging
 import time
 
 import numpy as np
 
 from .._cli import available_cores
 from .._grains import D272, d272_velocity_range
-from ..flow import INERTIAL_LAW, asabe_d272_gradient, ergun_gradient, fit_curve, solve_network
+from ..flow import (INERTIAL_LAW, asabe_d272_gradient, ergun_gradient, fit_curve, inset_window,
+                    solve_network)
 from ..packing import read_container
 from ..pores import region_porosity, sample_region
 from .band import BAND_OFFSETS, band_gradients, measured_band, pack_band, slope_at
@@ -28,6 +30,7 @@ __all__ = ["build_report", "KEYS", "SAME_POROSITY"]
 
 #: below this porosity difference the packing's own porosity is the report's (no move)
 SAME_POROSITY = 5e-4
+log = logging.getLogger(__name__)
 KEYS = ["velocity_m_s", "reynolds_particle", "pressure_gradient_pa_per_m",
         "apparent_permeability_m2", "converged"]
 
@@ -56,6 +59,20 @@ def _points(res):
     return [{k: p[k] for k in KEYS} for p in res.curve_points()]
 
 
+def _porosity_plan(o: ReportOptions, e_p: float):
+    """(porosity of the report, why, whether to move along the band, bulk density kg/m^3) for a
+    packing of porosity ``e_p``; UnreachablePorosity where the report's is out of reach."""
+    why = o.porosity_source
+    e = e_p if o.porosity is None else o.porosity
+    check_reachable(e, e_p, o.reachable, o.grain)
+    move = abs(e - e_p) > SAME_POROSITY
+    if move and not o.band:
+        why = (f"the packing's own: --no-band gives no computed slope to move it to {e:.4f} "
+               f"({why})")
+        e, move = e_p, False
+    return e, why, move, bulk_density(o.particle_density_kg_m3, e)
+
+
 def build_report(packing, path, options: ReportOptions) -> dict:
     """All the numbers of the report (the JSON document) of ``packing`` (read from ``path``).
 
@@ -78,19 +95,15 @@ def build_report(packing, path, options: ReportOptions) -> dict:
     t0 = time.perf_counter()
     container = None if o.sample_box_m else read_container(path)
     us = list(o.velocities_m_s)
-    # the porosity first (solve_network's): the airflow's velocity needs the bulk density
-    eps_z = region_porosity(packing, sample_region(packing, box=o.sample_box_m, margin=o.margin_m,
-                                                   container=container, axis="z"), 2,
-                            n_points=200_000)
-    e_p, why = eps_z[0], o.porosity_source
-    e = e_p if o.porosity is None else o.porosity
-    check_reachable(e, e_p, o.reachable, o.grain)
-    move = abs(e - e_p) > SAME_POROSITY
-    if move and not o.band:
-        why = (f"the packing's own: --no-band gives no computed slope to move it to {e:.4f} "
-               f"({why})")
-        e, move = e_p, False
-    rho_b = bulk_density(o.particle_density_kg_m3, e)
+    # the porosity first (solve_network's): the airflow's velocity needs the bulk density. It is
+    # the porosity of the region k is measured in: the inset window where the sample is wide
+    # enough for one (network.flow.inset_window), else the whole sample
+    reg_z = sample_region(packing, box=o.sample_box_m, margin=o.margin_m, container=container,
+                          axis="z")
+    eps_z = region_porosity(packing, reg_z, 2, n_points=200_000)
+    win = inset_window(reg_z, 2, packing.grain_diameter)
+    e_p = (eps_z if win is None else region_porosity(packing, win, 2, n_points=200_000))[0]
+    e, why, move, rho_b = _porosity_plan(o, e_p)
     u_air = None
     if o.airflow:
         u_air = velocity_from_airflow(*o.airflow, depth_m=o.depth_m,
@@ -98,6 +111,12 @@ def build_report(packing, path, options: ReportOptions) -> dict:
         if all(abs(u_air - u) > 1e-12 * u for u in us):
             us.append(u_air)
     rz = _solve(o, packing, container, "z", us, eps_z)
+    if rz.porosity != e_p:      # the window's k could not be measured: the sample's pair
+        log.warning("the inset window's permeability could not be measured: the report uses "
+                    "the whole sample's k and porosity %.4f (the airflow's bulk density was "
+                    "taken at %.4f)", rz.porosity, e_p)
+        e_p = rz.porosity
+        e, why, move, rho_b = _porosity_plan(o, e_p)
     rx, d32 = _solve(o, packing, container, "x", us), rz.sauter_diameter_m
     pts, pts_x = _points(rz), _points(rx)
     band = None
@@ -149,7 +168,12 @@ def build_report(packing, path, options: ReportOptions) -> dict:
            "porosity_source": f"{o.bed_label}; {why}",
            "bed": dict(o.bed_record) if o.bed_record is not None else user_bed_json(path),
            "porosity_packing": e_p, "porosity_packing_std": rz.porosity_std,
-           "porosity_reachable": o.reachable,
+           "porosity_packing_sample": rz.porosity_sample,
+           "porosity_packing_region": ("inset window (where k is measured)"
+                                       if rz.sample_estimator == "inset" else "sample"),
+           "porosity_reachable": None if o.reachable is None else list(o.reachable["range"]),
+           "porosity_reachable_tol": None if o.reachable is None else o.reachable["tol"],
+           "porosity_reachable_source": None if o.reachable is None else o.reachable["source"],
            "porosity_move": ("none: the packing's own porosity" if not move else
                              f"along the band's computed slope from the packing's {e_p:.4f} to "
                              f"{e:.4f} (g exp(S de); not packed anew)"),

@@ -27,7 +27,7 @@ from .build import build_report
 from .figures import write_figures, write_html
 from .options import ReportOptions, grain_key
 from .porosity import (bundled_grains, bundled_packing, check_reachable, packing_meta,
-                       reachable_range, requested_porosity)
+                       reach_record, requested_porosity)
 from .system import AIRFLOW_UNITS, airflow_unit, read_fan
 
 __all__ = ["build_parser", "main", "print_report", "report_options"]
@@ -137,7 +137,7 @@ def _check(args) -> dict:
     else:
         args.packing = bed["packing"]
         meta = packing_meta(args.packing)
-        reach = reachable_range(meta)
+        reach = reach_record(meta, Path(args.packing).with_suffix(".json"))
         if target is not None:
             check_reachable(target, meta.get("porosity_network_region"), reach, key)
     airflow = None
@@ -186,9 +186,13 @@ def _not_converged(p) -> str:
 
 def print_report(r) -> None:
     """The text report on stdout."""
+    where = ""
+    if r.get("porosity_packing_region", "sample") != "sample":
+        where = (f", in the inset window where k is measured (whole sample "
+                 f"{r['porosity_packing_sample']:.4f})")
     print(f"grain {r['grain']}: packing {r['packing']} ({r['n_grains']} grains, {r['n_spheres']} "
           f"spheres), own porosity {r['porosity_packing']:.4f} (std error "
-          f"{r['porosity_packing_std']:.1e})")
+          f"{r['porosity_packing_std']:.1e}){where}")
     b = r["bed"]
     print(f"bed: {b['how']}" + (f" with seed {b['seed']}" if b["how"] == "packed anew" else "")
           + (" (reused)" if b["reused"] else "")
@@ -298,7 +302,8 @@ def _main(args) -> int:
     bed = opts["bed"]
     args.packing = prepare_bed(bed, quiet=args.quiet)
     if bed["action"] == "pack":
-        opts["reachable"] = reachable_range(packing_meta(args.packing))
+        opts["reachable"] = reach_record(packing_meta(args.packing),
+                                         Path(args.packing).with_suffix(".json"))
     with bad_input():
         path, packing = load_packing(args)
         options = report_options(args, opts, path)

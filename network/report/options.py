@@ -12,6 +12,7 @@ from dataclasses import dataclass, field
 
 from .._air import MU_AIR_PA_S, RHO_AIR_KG_M3
 from .._grains import BED, grain_key
+from ..core import check_physical_porosity
 from ..curve import DEFAULT_VELOCITIES, parse_velocities
 from ..flow import DEFAULT_DEPTH_M
 from .system import AIRFLOW_UNITS, check_fan_shape
@@ -42,9 +43,10 @@ class ReportOptions:
         Porosity ε the report is for, in (0, 1); None (default): the packing's own.
     porosity_source : str
         Why that porosity, the first words of the JSON's ``porosity_source``.
-    reachable : (float, float) or None
-        Porosity range a packing of the grain reaches (``porosity_reachable``); None (default):
-        within ``MAX_SHIFT`` of the packing's own.
+    reachable : dict or None
+        The range a packing of the grain reaches, a record ``{"range": (low, high), "tol": t,
+        "source": s}`` (:func:`network.report.porosity.reach_record`); None (default): within
+        ``MAX_SHIFT`` of the packing's own.
     particle_density_kg_m3 : float or None
         Kernel density ρ_p, kg/m³, > 0, for the bulk density ρ_p (1 - ε); None (default): the
         grain library's (ValueError where it has none).
@@ -85,7 +87,7 @@ class ReportOptions:
         parse_velocities(DEFAULT_VELOCITIES)))
     porosity: float | None = None
     porosity_source: str = "the packing's own"
-    reachable: tuple | None = None
+    reachable: dict | None = None
     particle_density_kg_m3: float | None = None
     particle_density_source: str | None = None
     depth_m: float = DEFAULT_DEPTH_M
@@ -118,12 +120,19 @@ class ReportOptions:
         if self.porosity is not None and not (
                 isinstance(self.porosity, (int, float)) and 0 < self.porosity < 1):
             raise ValueError(f"porosity must be in (0, 1), got {self.porosity!r}")
+        if self.porosity is not None:
+            check_physical_porosity(self.porosity, "porosity")
         if self.reachable is not None:
-            lo, hi = (float(v) for v in self.reachable)
-            if not 0 <= lo <= hi <= 1:
-                raise ValueError(f"reachable must be (low, high) within [0, 1], got "
-                                 f"{self.reachable!r}")
-            set_(self, "reachable", (lo, hi))
+            try:
+                lo, hi = (float(v) for v in self.reachable["range"])
+                tol = float(self.reachable.get("tol", 0.0))
+            except (TypeError, ValueError, KeyError):
+                raise ValueError("reachable must be a record {'range': (low, high), 'tol': t, "
+                                 f"'source': s}}, got {self.reachable!r}") from None
+            if not (0 <= lo <= hi <= 1 and 0 <= tol < 1):
+                raise ValueError(f"reachable range must lie within [0, 1], got {self.reachable!r}")
+            set_(self, "reachable", {**self.reachable, "range": (lo, hi), "tol": tol,
+                                     "source": str(self.reachable.get("source", "given"))})
         for name in ("particle_density_kg_m3", "diameter_m", "floor_area_m2", "depth_m",
                      "viscosity_pa_s", "density_kg_m3"):
             _positive(name, getattr(self, name),

@@ -13,8 +13,10 @@ along the porosity band's computed slope S(U) (:mod:`network.report.band`), not 
 
 (g in Pa/m; σ_S the slope's standard error). The porosities a packing of the grain can reach
 are those its companion JSON records (``porosity_search.reachable`` of ``dem.pack --porosity``,
-the densest and loosest bed of the deposition-friction lever); a packing without that record
-accepts ε within ``MAX_SHIFT`` of its own (the band's span).
+the beds its search made, within its tolerance: one range per grain and container, quoted the
+same everywhere, :func:`network.core.reach_text`); a packing without that record accepts ε
+within ``MAX_SHIFT`` of its own (the band's span). A porosity no bed of grains has is refused
+at once (:func:`network.core.check_physical_porosity`).
 """
 
 from __future__ import annotations
@@ -25,10 +27,11 @@ from pathlib import Path
 import numpy as np
 
 from .._grains import BED
+from ..core import check_physical_porosity, reach_text
 
 __all__ = ["DATA_DIR", "MAX_SHIFT", "UnreachablePorosity", "bundled_packing", "bundled_grains",
-           "packing_meta",
-           "requested_porosity", "reachable_range", "check_reachable", "shift_factor"]
+           "packing_meta", "requested_porosity", "reach_record", "check_reachable",
+           "shift_factor"]
 
 DATA_DIR = Path(__file__).resolve().parents[1] / "data"
 #: largest move along the band without a recorded reachable range (the band's span), porosity
@@ -71,6 +74,7 @@ def requested_porosity(grain: str, porosity: float | None) -> tuple[float | None
     if porosity is not None:
         if not (np.isfinite(porosity) and 0 < porosity < 1):
             raise ValueError(f"--porosity must be in (0, 1), got {porosity!r}")
+        check_physical_porosity(porosity)
         return float(porosity), "--porosity (the user's)"
     bed = BED[grain]
     if bed.loose_fill_porosity is not None:
@@ -81,20 +85,29 @@ def requested_porosity(grain: str, porosity: float | None) -> tuple[float | None
     return None, f"the packing's own (no measured loose-fill porosity for {grain})"
 
 
-def reachable_range(meta: dict) -> tuple[float, float] | None:
-    """(low, high) porosity ``dem.pack --porosity`` reaches for this grain, from the JSON: the
-    porosities of its densest and loosest packing, widened by its tolerance (a request that far
-    outside still lands within the tolerance).
+def reach_record(meta: dict, source) -> dict | None:
+    """The range a packing of the grain reaches, from its companion JSON (``porosity_search`` of
+    ``dem.pack --porosity``: the porosities of the beds its search made, and its tolerance), as
+    :func:`network.core.recorded_reach` gives it; None without that record.
 
-    >>> reachable_range({"porosity_search": {"reachable": [0.35, 0.41], "tol": 0.005}})
-    (0.345, 0.415)
+    >>> r = reach_record({"porosity_search": {"reachable": [0.35, 0.41], "tol": 0.005}}, "b.json")
+    >>> r["range"], r["tol"]
+    ((0.35, 0.41), 0.005)
     """
     s = meta.get("porosity_search", {}) if isinstance(meta, dict) else {}
-    r = s.get("reachable")
-    if r is None or len(r) != 2:
+    r = s.get("reachable") if isinstance(s, dict) else None
+    if not isinstance(r, (list, tuple)) or len(r) != 2:
         return None
-    tol = float(s.get("tol", 0.0))
-    return round(float(min(r)) - tol, 12), round(float(max(r)) + tol, 12)
+    try:
+        lo, hi = sorted(float(v) for v in r)
+        tol = float(s.get("tol", 0.0))
+    except (TypeError, ValueError):
+        return None
+    src = Path(source)
+    if src.resolve().parent == DATA_DIR:        # a bundled bed: named as every command names it
+        src = Path("network/data") / src.name
+    return {"range": (lo, hi), "tol": tol, "container": meta.get("container"),
+            "seed": meta.get("seed"), "source": str(src)}
 
 
 class UnreachablePorosity(ValueError):
@@ -104,27 +117,30 @@ class UnreachablePorosity(ValueError):
 
 
 def check_reachable(porosity: float, own: float | None, reach, grain: str) -> None:
-    """:class:`UnreachablePorosity` unless ``porosity`` lies in ``reach`` (or, without one,
-    within MAX_SHIFT of the packing's ``own`` porosity), naming the reachable range.
+    """:class:`UnreachablePorosity` unless ``porosity`` lies in the recorded range ``reach`` (a
+    :func:`reach_record`) widened by its tolerance, or, without one, within MAX_SHIFT of the
+    packing's ``own`` porosity; the message quotes the range as every command does
+    (:func:`network.core.reach_text`).
 
-    >>> check_reachable(0.45, None, (0.37, 0.43), "wheat")  # doctest: +ELLIPSIS
+    >>> rec = {"range": (0.37, 0.43), "tol": 0.005, "source": "bed.json"}
+    >>> check_reachable(0.45, None, rec, "wheat")  # doctest: +ELLIPSIS
     Traceback (most recent call last):
     ...
     network.report.porosity.UnreachablePorosity: porosity 0.45 is outside the range ...
     """
     if reach is not None:
-        lo, hi = reach
-        how = ("dem.pack --porosity: this bed's densest and loosest packing +- its tolerance; "
-               f"another grain count may reach further: dem.pack --grain {grain} --porosity "
-               f"{porosity:g}, then --packing")
+        lo, hi = reach["range"]
+        lo, hi = lo - reach["tol"], hi + reach["tol"]
+        how = reach_text(reach)
     elif own is not None:
         lo, hi = own - MAX_SHIFT, own + MAX_SHIFT
-        how = f"the packing's own {own:.4f} +- {MAX_SHIFT} along the band; no recorded range"
+        how = (f"{lo:.4f}-{hi:.4f}: the packing's own {own:.4f} +- {MAX_SHIFT} along the band; "
+               "no recorded range")
     else:
         return
     if not lo - 1e-12 <= porosity <= hi + 1e-12:
         raise UnreachablePorosity(f"porosity {porosity:g} is outside the range a packing of "
-                                  f"{grain} reaches: {lo:.4f}-{hi:.4f} ({how})")
+                                  f"{grain} reaches: {how}")
 
 
 def shift_factor(slope: float, slope_stderr: float, d_porosity: float) -> tuple[float, float]:
