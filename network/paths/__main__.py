@@ -42,8 +42,7 @@ from .._cli import (CliParser, add_air, add_packing, bad_input, check_common, ch
 from . import (bed_depth, branched_table, face_graph, plot_paths, pore_pressure_array,
                pressure_along_path, random_entry_points, trace_paths)
 from ..conductance import POLICIES
-from ..flow import (DEFAULT_DEPTH_M, asabe_d272_gradient, ergun_gradient, inset_window,
-                    solve_network)
+from ..flow import DEFAULT_DEPTH_M, asabe_d272_gradient, ergun_gradient, inset_window, solve_network
 from ..packing import UNITS, Packing, random_packing
 from ..pores import (NoInteriorError, Region, axis_index, default_region, region_porosity,
                      tessellate)
@@ -388,15 +387,12 @@ def _branched(args, x, r, paths, dup, region):
 def _table_4_5(args, x, r, branched, region):
     """Pressure drops over --depth (Pa): measured (thesis, only at its 0.25 m), branched model
     (ours, mean of the MFx3 average-width paths, each drop / its L0 x depth), ASABE D272 and
-    Ergun (thesis 4.2.2) with the porosity and Sauter diameter that ``network.solve`` uses: the
-    exact porosity of the region its k is measured in (the default interior sample's inset
-    window, :func:`network.flow.inset_window`, where the sample is wide enough), so both
-    commands print one Ergun value for one bed."""
+    Ergun (thesis 4.2.2) with the porosity and Sauter diameter that ``network.solve`` uses (the
+    exact porosity of the sample's inset window where its k is measured), so both commands
+    print one Ergun value for one bed."""
     depth, velocities = args.depth, args.velocity
-    pk = Packing(x, r)
-    ax = axis_index(args.axis)
-    window = inset_window(region, ax, pk.grain_diameter)   # where network.solve measures k
-    porosity, _ = region_porosity(pk, region if window is None else window, ax)
+    pk, ax = Packing(x, r), axis_index(args.axis)    # porosity where network.solve's k is:
+    porosity, _ = region_porosity(pk, inset_window(region, ax, pk.grain_diameter) or region, ax)
     us = [f"{u:g}" for u in velocities]
     out = {}
     if any(_thesis_point(args, u) for u in us):

@@ -25,7 +25,8 @@ import numpy as np
 from ..core import read_table
 
 __all__ = ["AIRFLOW_UNITS", "FAN_COLUMNS", "M3_MIN_M3_PER_CFM_BU", "airflow_unit", "bulk_density",
-           "check_fan_shape", "floor_area", "velocity_from_airflow", "system_rows", "dense_system", "read_fan", "operating_point", "curve_range"]
+           "check_fan_shape", "floor_area", "velocity_from_airflow", "system_rows",
+           "dense_system", "read_fan", "operating_point", "curve_range"]
 
 #: units accepted by ``--airflow VALUE UNIT`` (any case): superficial velocity, airflow per
 #: tonne of grain, per cubic metre of grain, and the US cubic feet per minute per bushel
