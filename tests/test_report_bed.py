@@ -123,8 +123,10 @@ def test_default_run_and_explicit_move_use_the_bundled_bed(tmp_path, monkeypatch
         assert r["bed"]["not_packed"] is None
     assert "moved along the band (--move-along-band)" in r["porosity_source"]
     assert not list(tmp_path.glob("report_*"))
-    assert main(["--grain", "sorghum", "--packing", str(data / "soybean_default.csv"), "--seed",
-                 "3", "--porosity", "0.40"] + FAST + ["--json", str(out)]) == 0
+    bed = tmp_path / "bed.csv"             # a user's bed with no grain record: taken as sorghum
+    bed.write_bytes((data / "soybean_default.csv").read_bytes())
+    assert main(["--grain", "sorghum", "--packing", str(bed), "--seed", "3", "--porosity",
+                 "0.40"] + FAST + ["--json", str(out)]) == 0
     r = json.loads(out.read_text())
     assert r["bed"]["how"] == "user's packing" and "no multi-sphere template" in r["bed"][
         "not_packed"] and "not packed anew" in r["porosity_source"]
