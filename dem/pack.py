@@ -179,8 +179,6 @@ def _pack_grains(args, fill) -> int:
               size_cv=size_cv,
               tol=args.tol, max_steps=GRAIN_MAX_STEPS if args.max_steps is None else args.max_steps,
               progress=lambda sim, f: pr("grains", _Progress(sim), None))
-    if args.porosity is not None:
-        check_physical_porosity(args.porosity)
     if args.porosity is not None and args.deposition_friction is None:
         rec = recorded_reach(template.name, container.to_dict())
         if rec is not None and not (rec["range"][0] - rec["tol"] <= args.porosity
@@ -471,6 +469,8 @@ def _pack(args) -> int:
         raise ValueError(f"--max-steps must be >= 1, got {args.max_steps}")
     fill = _fill_options(args)
     _check_outputs(args)
+    if args.porosity is not None:       # a porosity no bed has: refused before any packing
+        check_physical_porosity(args.porosity)
     if args.grain is not None:
         return _pack_grains(args, fill)
     if args.mass_scale is None:

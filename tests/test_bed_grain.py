@@ -184,6 +184,8 @@ def test_impossible_and_unreachable_porosities_are_refused_at_once(tmp_path, mon
         assert pack_main([*box, "--fill", "grow", "--porosity", p, "--out", "b.csv",
                           "--quiet"]) == 2
         assert f"error: --porosity {p}: {words}" in capsys.readouterr().err
+        assert pack_main(["--scene", "box", "--porosity", p, "--out", "s.csv", "--quiet"]) == 2
+        assert f"error: --porosity {p}: {words}" in capsys.readouterr().err      # spheres too
     quoted = reach_text(recorded_reach("soybean"))
     assert quoted.startswith("0.3490-0.4114 ")
     for argv in (["--porosity", "0.45"], ["--porosity", "0.45", "--move-along-band"]):
