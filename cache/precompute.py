@@ -2,7 +2,7 @@
 
 Examples
 --------
-Every throat of a packing (as exported by ``python -m network.throats``)::
+Every throat of a packing (as exported by ``python -m network.throatlist``)::
 
     python -m cache.precompute --db throats.sqlite --csv THROATS.csv --workers 2
 
@@ -52,7 +52,7 @@ def build_parser():
     src = p.add_mutually_exclusive_group(required=True)
     src.add_argument("--csv", metavar="IN.csv",
                      help="throat shapes, columns r1,r2,r3,l12,l13,l23 in any one length unit "
-                          "(as written by python -m network.throats); a bad row is refused "
+                          "(as written by python -m network.throatlist); a bad row is refused "
                           "before anything is written")
     src.add_argument("--grid", choices=sorted(GRIDS), help="named interpolation grid to fill")
     p.add_argument("--rtol", type=float, default=1e-3,

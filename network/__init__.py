@@ -11,7 +11,7 @@ Each layer imports only the layers above it in this list (``tests/test_layers.py
 ``paths``              airflow paths, tortuosity, the branched-path model, plots
 ``validation``         reference permeabilities and validation cases through the one pipeline
 CLIs                   ``python -m network.solve`` (permeability and pressure drop; the bundled
-                       soybean scene by default), ``network.throats``, ``network.paths``,
+                       soybean scene by default), ``network.throatlist``, ``network.paths``,
                        ``network.curve`` (the resistance curve with inertia), ``network.bench``:
                        parse, call the pipeline, print
 
@@ -56,7 +56,7 @@ for _module, _names in {
               "asabe_d272_gradient", "fit_curve", "solve_inertial", "assemble_laplacian",
               "darcy_permeability", "ergun_gradient", "kozeny_carman_gradient",
               "solve_fixed_pressure", "solve_network", "solve_pressure", "verify_solution",
-              "write_network_vtu"),
+              "write_network_vtu", "SampleOptions", "ConductanceOptions", "FlowOptions"),
     ".packing": ("Packing", "default_packing_path", "lattice_packing", "lattice_radius",
                  "random_packing", "read_container", "read_packing", "write_packing_csv"),
     ".pores": ("QHULL_OPTIONS", "Region", "SampleNetwork", "Tessellation", "default_region",
@@ -94,7 +94,8 @@ __all__ = [
     "throat_conductance",
     "SolveInfo", "assemble_laplacian", "apply_pressure_bc", "solve_pressure",
     "solve_fixed_pressure", "verify_solution",
-    "FlowResult", "solve_network", "AMGSolver", "InertialPoint", "solve_inertial", "fit_curve",
+    "FlowResult", "solve_network", "SampleOptions", "ConductanceOptions", "FlowOptions",
+    "AMGSolver", "InertialPoint", "solve_inertial", "fit_curve",
     "ergun_gradient", "kozeny_carman_gradient", "asabe_d272_gradient", "darcy_permeability",
     "region_porosity", "random_packing", "sample_throats", "write_network_vtu",
     "lattice_packing", "lattice_radius",

@@ -13,13 +13,11 @@ use:
   ``importlib.metadata``, and ``scipy.spatial``'s brings ``distance`` (and ``scipy.special``),
   ``transform`` (and ``scipy.constants``), Voronoi and Procrustes, where the commands use the
   smoothed-aggregation modules, Qhull and the k-d tree alone;
-- OpenBLAS starts a thread per core whose waits spin on the cores the pipeline's own threads
-  use; the commands have no dense algebra large enough to gain from them.
+- OpenBLAS starts a thread per core whose waits spin on the cores of the pipeline's threads.
 
-What remains, each measured on ``python -m network.solve`` (the bundled scene, default and
-``--stokes``, and a 5 000-sphere packing with ``--stokes``; medians of 5 and of 8 paired runs
-with the trick and without, on a two-core machine shared with other work, so CPU seconds are
-compared beside wall seconds):
+What remains, each measured on ``python -m network.solve`` (bundled scene, default and
+``--stokes``; a 5 000-sphere packing, ``--stokes``; medians of paired runs with and without it,
+CPU seconds beside wall seconds on a shared two-core machine):
 
 1. :func:`lean_imports` registers ``numpy.f2py`` and ``numpy.testing`` with the standard
    library's :class:`importlib.util.LazyLoader` (the module object exists, its code runs on the
@@ -34,13 +32,11 @@ compared beside wall seconds):
    (:func:`user_environment` hands other programs the environment without it). Without it the
    commands take 7-14 % more CPU time and 10-11 % more wall time.
 
-Switching the garbage collector off during the imports and keeping glibc's freed heap
-(``mallopt``) each paid under 10 % of these commands (the collector 2-5 %, the heap 0-12 % and
-under 10 % on the default command) and are not done. Computations are untouched but for the last
-bits of long BLAS reductions. The package applies the two only when Python was started as
-``python -m network.<command>`` (``sys.argv[0]`` is ``'-m'`` while the package is imported), never
-when the library is imported into someone's session, whose NumPy, SciPy and pyamg stay as they
-are.
+The garbage collector off during the imports (2-5 %) and glibc's freed heap kept (``mallopt``,
+under 10 % of the default command) paid less and are not done. Computations are untouched but
+for the last bits of long BLAS reductions. Both act only where Python was started as
+``python -m network.<command>`` (``sys.argv[0]`` is ``'-m'`` while the package is imported),
+never in a library caller's session, whose NumPy, SciPy and pyamg stay as they are.
 """
 
 from __future__ import annotations

@@ -28,7 +28,8 @@ from ._cli import (CliError, CliParser, add_air, add_packing, add_sample, add_ta
                    warn_curve)
 from .conductance import POLICIES
 from ._grains import d272_constants, d272_velocity_range, grains_with_d272, packing_grain
-from .flow import (DEFAULT_DEPTH_M, GRAINS, INERTIAL_LAW, asabe_d272_gradient, ergun_gradient,
+from .flow import (DEFAULT_DEPTH_M, GRAINS, INERTIAL_LAW, ConductanceOptions, FlowOptions,
+                   SampleOptions, asabe_d272_gradient, ergun_gradient,
                    solve_network)
 from .packing import default_packing_path, read_container
 from .pores import sample_region
@@ -207,13 +208,13 @@ def _main(args) -> int:
         container = None if box else read_container(path)
         region = sample_region(packing, box=box, margin=margin, cylinder=args.cylinder,
                                container=container, axis=args.axis)
+        conductance = ConductanceOptions(policy=args.policy, rtol=args.rtol, db=args.db)
+        flow = FlowOptions(viscosity_pa_s=args.viscosity, velocity_m_s=us[0],
+                           depth_m=args.depth, inertia=True, density_kg_m3=args.density,
+                           curve_velocities_m_s=us[1:], inertial_workers=args.workers)
     with computing():
-        res = solve_network(packing, axis=args.axis, region=region, policy=args.policy,
-                            viscosity_pa_s=args.viscosity, velocity_m_s=us[0],
-                            depth_m=args.depth, rtol=args.rtol, db=args.db, inertia=True,
-                            density_kg_m3=args.density, curve_velocities_m_s=us[1:],
-                            inertial_workers=args.workers,
-                            threads=args.workers)
+        res = solve_network(packing, axis=args.axis, sample=SampleOptions(region=region),
+                            conductance=conductance, flow=flow, threads=args.workers)
         pts = [{k: p[k] for k in KEYS} | {"newton_iterations": p["newton_iterations"],
                                           "cg_iterations": p["cg_iterations"]}
                for p in res.curve_points()]

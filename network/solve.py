@@ -29,8 +29,8 @@ from ._cli import (CliError, CliParser, add_air, add_packing, add_sample, add_ta
                    sample_box_m, warn_validity)
 from ._grains import D272, grain_key, packing_grain
 from .conductance import MODELS, POLICIES, throat_qstar
-from .flow import (DEFAULT_DEPTH_M, DEFAULT_VELOCITY_M_S, combined_summary, solve_axes,
-                   write_network_vtu)
+from .flow import (DEFAULT_DEPTH_M, DEFAULT_VELOCITY_M_S, ConductanceOptions, FlowOptions,
+                   combined_summary, solve_axes, write_network_vtu)
 from .packing import default_packing_path, read_container
 from .pores import sample_region, tessellate
 
@@ -250,19 +250,20 @@ def _main(args) -> int:
         container = None if box else read_container(path)
         regions = {ax: sample_region(packing, box=box, margin=margin, cylinder=args.cylinder,
                                      container=container, axis=ax) for ax in axes}
+        conductance = ConductanceOptions(model=args.conductance_model, policy=args.policy,
+                                         rtol=args.rtol, db=args.db, workers=args.workers,
+                                         progress=not args.quiet)
+        flow = FlowOptions(viscosity_pa_s=args.viscosity, velocity_m_s=args.velocity,
+                           depth_m=args.depth, density_kg_m3=args.density,
+                           inertia=not args.stokes and args.conductance_model == "conduit")
     t_read = time.perf_counter() - t0
     if container is not None:
         print(f"container from {container['source']}: {container['kind']} {container['size_m']}")
     tables = args.vtk or args.pores_csv or args.throats_csv
     with computing():
         tess = tessellate(packing) if tables else None
-        results = solve_axes(
-            packing, regions, conductance_model=args.conductance_model, policy=args.policy,
-            viscosity_pa_s=args.viscosity, velocity_m_s=args.velocity, depth_m=args.depth,
-            rtol=args.rtol, db=args.db, workers=args.workers, progress=not args.quiet,
-            inertia=not args.stokes and args.conductance_model == "conduit",
-            density_kg_m3=args.density, tessellation=tess,
-            threads=args.threads)
+        results = solve_axes(packing, regions, conductance=conductance, flow=flow,
+                             tessellation=tess, threads=args.threads)
         results = [dataclasses.replace(r, grain=grain) for r in results]
         written = [p for res in results for p in (_write_tables(res, tess, args, len(axes) > 1)
                                                   if tables else [])]

@@ -68,6 +68,7 @@ BAD_INPUTS = [
     ("network.curve", ["--velocities", "0"]),
     ("network.paths", ["--axis", "q"]),
     ("network.report", ["--no-such-option"]),
+    ("network.throatlist", ["--out", "/nonexistent/d/t.csv"]),
     ("network.throats", ["--out", "/nonexistent/d/t.csv"]),
     ("network.bench", ["--repeat", "0"]),
     ("cache.precompute", ["--db", "x.sqlite"]),

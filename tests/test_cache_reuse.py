@@ -1,4 +1,4 @@
-"""Throats exported by network.throats and precomputed by cache.precompute are reused exactly
+"""Throats exported by network.throatlist and precomputed by cache.precompute are reused exactly
 by cache.lookup_qstar and network.solve: one signature, one rounding."""
 
 import json
@@ -9,7 +9,7 @@ import pytest
 import network
 import throats
 from cache import lookup_qstar, precompute as precompute_cli, shape_keys, signature
-from network import solve as solve_cli, throats as throats_cli
+from network import solve as solve_cli, throatlist as throats_cli
 
 
 def _no_fe(*a, **kw):

@@ -11,7 +11,7 @@ import importlib
 
 import pytest
 
-COMMANDS = ["network.solve", "network.curve", "network.paths", "network.report", "network.throats",
+COMMANDS = ["network.solve", "network.curve", "network.paths", "network.report", "network.throatlist", "network.throats",
             "network.bench", "network.bin.__main__", "cache.precompute", "cache.lookup", "cache.bench", "throats.solve",
             "throats.bench", "dem.pack", "dem.vibrate", "dem.bench"]
 

@@ -12,7 +12,7 @@ import pytest
 
 from network import bench
 from network.benchmarks import policy_lines
-from network.flow import solve_network
+from network.flow import ConductanceOptions, SampleOptions, solve_network
 from network.packing import random_packing
 
 N = 150
@@ -52,8 +52,10 @@ def test_k_equals_the_pipeline_directly(run, tmp_path):
     _, report = run
     pk = random_packing(N, rng=1, periodic=True, solid_fraction=0.60)
     for r in report["policies"]["rows"]:
-        res = solve_network(pk, axis="z", policy=r["policy"], db=tmp_path / "t.sqlite",
-                            porosity_points=0, conductance_model=r["conductance_model"])
+        res = solve_network(pk, axis="z", sample=SampleOptions(porosity_points=0),
+                            conductance=ConductanceOptions(model=r["conductance_model"],
+                                                           policy=r["policy"],
+                                                           db=tmp_path / "t.sqlite"))
         assert r["permeability_m2"] == pytest.approx(res.permeability_m2, rel=1e-9)
 
 

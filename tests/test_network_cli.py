@@ -1,4 +1,4 @@
-"""CLIs: python -m network.solve / network.throats on the bundled scene."""
+"""CLIs: python -m network.solve / network.throatlist on the bundled scene."""
 
 import json
 
@@ -7,7 +7,7 @@ import pytest
 
 from network import default_packing_path, read_packing, tessellate
 from network import solve as solve_cli
-from network import throats as throats_cli
+from network import throatlist as throats_cli
 from network.flow import read_vtu_arrays
 
 KEYS = ["permeability_m2", "pressure_drop_pa", "pressure_gradient_pa_per_m", "porosity",

@@ -11,12 +11,12 @@ import sys
 import numpy as np
 import pytest
 
-from network import _cli, curve, random_packing, read_packing, solve, throats
+from network import _cli, curve, random_packing, read_packing, solve, throatlist
 from network.packing import DegeneratePackingError, Packing
 from network.paths import __main__ as paths
 from network.pores import tessellate
 
-MAINS = {"solve": solve.main, "curve": curve.main, "throats": throats.main, "paths": paths.main}
+MAINS = {"solve": solve.main, "curve": curve.main, "throats": throatlist.main, "paths": paths.main}
 SAMPLE = ["--sample", "0", "0.05", "0", "0.05", "-0.002", "0.002"]
 
 
@@ -149,7 +149,7 @@ def test_wording_names_the_option_or_the_cause(files, name, argv, words, capsys)
 def test_a_csv_with_a_byte_order_mark_reads_as_without(files, tmp_path, capsys):
     a, b = read_packing(files["bom"]), read_packing(files["bed"])
     np.testing.assert_array_equal(a.centers, b.centers)
-    assert throats.main([files["bom"], "--all", "--out", str(tmp_path / "t.csv")]) == 0
+    assert throatlist.main([files["bom"], "--all", "--out", str(tmp_path / "t.csv")]) == 0
 
 
 def test_logged_warnings_become_one_warning_line_each(capsys):

@@ -1,6 +1,6 @@
-"""The shared CLI conventions of network.solve/curve/throats/paths: every option has
+"""The shared CLI conventions of network.solve/curve/throatlist/paths: every option has
 help with its unit or default, exit codes 0/1/2 with one ``error:`` line, numpy/scipy warnings
-captured, output folders and matplotlib checked before any work; curve and throats bad input."""
+captured, output folders and matplotlib checked before any work; curve and throatlist bad input."""
 
 import argparse
 import os
@@ -11,11 +11,11 @@ import warnings
 import numpy as np
 import pytest
 
-from network import _cli, curve, default_packing_path, solve, throats
+from network import _cli, curve, default_packing_path, solve, throatlist
 from network.paths import __main__ as paths
 
 PARSERS = {"solve": solve.build_parser, "curve": curve.build_parser,
-           "throats": throats.build_parser, "paths": paths._parser}
+           "throats": throatlist.build_parser, "paths": paths._parser}
 
 
 @pytest.mark.parametrize("name", sorted(PARSERS))
@@ -117,7 +117,7 @@ def test_outputs_may_not_overwrite_the_inputs_or_each_other(tmp_path, capsys, mo
         (curve, ["--csv", "c.csv", "--json", "c.csv"], "--csv c.csv: the same file as --json"),
         (curve, ["--json", "c.json", "--plot", "c.txt"], "--plot c.txt: matplotlib cannot "
                                                         "write .txt; use one of"),
-        (throats, ["--out", "bed.csv"], "--out bed.csv: the same file as the packing file"),
+        (throatlist, ["--out", "bed.csv"], "--out bed.csv: the same file as the packing file"),
         (paths, ["--json", "j.json", "--plot", "j.json"], "--plot j.json: the same file as"),
     ]
     for mod, argv, words in cases:
@@ -163,7 +163,7 @@ def test_curve_plot_without_matplotlib(monkeypatch, tmp_path, capsys):
 ])
 def test_throats_bad_input(argv, words, capsys, tmp_path, monkeypatch):
     monkeypatch.chdir(tmp_path)
-    assert throats.main(["-q"] + argv) == 2
+    assert throatlist.main(["-q"] + argv) == 2
     out, err = capsys.readouterr()
     assert out == "" and err.count("\n") == 1 and words in err
     assert not (tmp_path / "t.csv").exists()                     # nothing written
@@ -174,13 +174,14 @@ def test_throats_units_mm(tmp_path):
     mm = tmp_path / "bed_mm.csv"
     np.savetxt(mm, x[:, :4] * 1e3, delimiter=",", header="x,y,z,r", comments="")
     a, b = tmp_path / "a.csv", tmp_path / "b.csv"
-    assert throats.main(["-q", "--out", str(a)]) == 0
-    assert throats.main(["-q", str(mm), "--units", "mm", "--out", str(b)]) == 0
+    assert throatlist.main(["-q", "--out", str(a)]) == 0
+    assert throatlist.main(["-q", str(mm), "--units", "mm", "--out", str(b)]) == 0
     np.testing.assert_allclose(np.loadtxt(b, delimiter=",", skiprows=1),
                                np.loadtxt(a, delimiter=",", skiprows=1), rtol=1e-7)
 
 
-@pytest.mark.parametrize("module", ["network.curve", "network.throats", "network.paths"])
+@pytest.mark.parametrize("module", ["network.curve", "network.throatlist", "network.throats",
+                                    "network.paths"])
 def test_no_traceback_as_a_subprocess(module):
     run = subprocess.run([sys.executable, "-m", module, "--viscosity", "-1.8e-5", "--axis", "X",
                           "--units", "furlong"], capture_output=True, text=True, timeout=120)

@@ -176,7 +176,7 @@ def test_results_outside_the_checked_range_are_warned(capsys):
     # model's range (inertial law checked to Re_p 200, air taken incompressible)
     assert solve_cli.main(["-q", "--velocity", "50"]) == 0
     err = capsys.readouterr().err
-    assert "warning: Re_p 2.05e+04 is beyond the 200 the inertial law was checked to" in err
+    assert "warning: Re_p 2.05e+04 is beyond the 200 the inertial law is checked to" in err
     assert "warning: a pressure drop of 1.91e+06 Pa is 1881% of the atmosphere's" in err
     assert solve_cli.main(["-q"]) == 0                  # 0.013 m/s: Re_p 5.3, 1.6 Pa
     assert "warning" not in capsys.readouterr().err

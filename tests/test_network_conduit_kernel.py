@@ -112,11 +112,11 @@ def test_compiled_cache_follows_the_table_kernel_source():
 def test_permeability_does_not_depend_on_the_order_of_the_packing_rows():
     # the audit's find: a shuffled packing file moved k by 3e-5 (the table read each throat in
     # its Delaunay vertex order); now every lookup reads one order (cache/_order.py)
-    from network.flow import solve_network
+    from network.flow import FlowOptions, solve_network
     from network.packing import Packing, random_packing
 
     pk = random_packing(600, rng=3)
     perm = np.random.default_rng(0).permutation(pk.n)
-    ks = [solve_network(p, axis=2, viscosity_pa_s=1.9e-5, policy="table-only").permeability_m2
+    ks = [solve_network(p, axis=2, flow=FlowOptions(viscosity_pa_s=1.9e-5)).permeability_m2
           for p in (pk, Packing(pk.centers[perm], pk.radii[perm]))]
     assert ks[1] == pytest.approx(ks[0], rel=1e-9)

@@ -3,7 +3,7 @@
 A ``container`` entry of an unknown kind, or with sizes that do not fit its kind, is refused by
 every network command with one ``error:`` line naming the file, exit 2, nothing written; a JSON
 of the same stem without a ``container`` entry (another tool's output) is ignored. The
-``network.throats`` export samples the same cylinder as ``network.solve``.
+``network.throatlist`` export samples the same cylinder as ``network.solve``.
 """
 
 import json
@@ -12,7 +12,7 @@ import numpy as np
 import pytest
 
 from network import (Packing, random_packing, read_container, write_packing_csv)
-from network import curve, report, solve, throats
+from network import curve, report, solve, throatlist
 from network.paths import __main__ as paths
 
 
@@ -60,7 +60,7 @@ COMMANDS = {
     "solve": (solve.main, ["{bed}", "--stokes", "--json", "{tmp}/out.json"]),
     "curve": (curve.main, ["{bed}", "--velocities", "0.01,0.1", "--json", "{tmp}/out.json"]),
     "paths": (paths.main, ["{bed}", "--entries", "2", "--json", "{tmp}/out.json"]),
-    "throats": (throats.main, ["{bed}", "--out", "{tmp}/out.json"]),
+    "throats": (throatlist.main, ["{bed}", "--out", "{tmp}/out.json"]),
     "report": (report.main, ["--grain", "soybean", "--packing", "{bed}", "--no-band",
                              "--json", "{tmp}/out.json"]),
 }
@@ -80,16 +80,16 @@ def test_every_command_refuses_an_unknown_container_kind(name, cylinder_bed, tmp
 
 
 def test_throats_export_samples_the_cylinder_that_solve_solves(cylinder_bed, tmp_path):
-    """With the container, network.throats exports the throats of network.solve's cylinder (all
+    """With the container, network.throatlist exports the throats of network.solve's cylinder (all
     but a few at the sample faces), not the corners outside it; without it the export takes the
     bounding box (more throats)."""
     src, diameter, mid = cylinder_bed
     bed = tmp_path / "bed.csv"
     bed.write_bytes(src.read_bytes())
-    assert throats.main([str(bed), "--out", str(tmp_path / "box.csv"), "--quiet"]) == 0
+    assert throatlist.main([str(bed), "--out", str(tmp_path / "box.csv"), "--quiet"]) == 0
     (tmp_path / "bed.json").write_text(json.dumps(
         {"container": {"kind": "cylinder", "size_m": [diameter], "center_xy": mid.tolist()}}))
-    assert throats.main([str(bed), "--out", str(tmp_path / "cyl.csv"), "--quiet"]) == 0
+    assert throatlist.main([str(bed), "--out", str(tmp_path / "cyl.csv"), "--quiet"]) == 0
     assert solve.main([str(bed), "--stokes", "--quiet", "--axis", "z",
                        "--throats-csv", str(tmp_path / "solved.csv")]) == 0
     ids = {k: set(np.loadtxt(tmp_path / f"{k}.csv", delimiter=",", skiprows=1)[:, 6].astype(int))

@@ -1,5 +1,6 @@
 """Inertial network flow, network.curve and network.solve with inertia."""
 
+import dataclasses
 import json
 
 import numpy as np
@@ -7,7 +8,8 @@ import pytest
 
 from network import curve
 from network.conductance import expansion_coefficient
-from network.flow import conduit_flow, fit_curve, solve_inertial, solve_network
+from network.flow import (FlowOptions, SampleOptions, conduit_flow, fit_curve, solve_inertial,
+                          solve_network)
 from network.packing import default_packing_path, read_packing
 
 
@@ -35,8 +37,8 @@ def test_signed_flow_and_loss_coefficients():
 @pytest.fixture(scope="module")
 def scene():
     pk = read_packing(default_packing_path())
-    return solve_network(pk, inertia=True, porosity_points=0,
-                         curve_velocities_m_s=[1e-7, 0.027, 0.3])
+    return solve_network(pk, sample=SampleOptions(porosity_points=0),
+                         flow=FlowOptions(inertia=True, curve_velocities_m_s=[1e-7, 0.027, 0.3]))
 
 
 def test_stokes_limit_mass_balance_and_iterations(scene):
@@ -66,10 +68,10 @@ def test_parallel_chains_give_the_serial_curve():
     same tolerance as one chain: the pressures agree to 1e-9 and every pore balances."""
     pk = read_packing(default_packing_path())
     us = list(np.geomspace(0.005, 0.3, 8))
-    one = solve_network(pk, inertia=True, porosity_points=0, velocity_m_s=us[0],
-                        curve_velocities_m_s=us[1:])
-    two = solve_network(pk, inertia=True, porosity_points=0, velocity_m_s=us[0],
-                        curve_velocities_m_s=us[1:], inertial_workers=2)
+    flow = FlowOptions(inertia=True, velocity_m_s=us[0], curve_velocities_m_s=us[1:])
+    sample = SampleOptions(porosity_points=0)
+    one = solve_network(pk, sample=sample, flow=flow)
+    two = solve_network(pk, sample=sample, flow=dataclasses.replace(flow, inertial_workers=2))
     p1 = [p.dp_pa for p in one.inertial["points"]]
     p2 = [p.dp_pa for p in two.inertial["points"]]
     assert p2 == pytest.approx(p1, rel=1e-9)

@@ -48,7 +48,7 @@ def test_sample_permeability_does_not_depend_on_where_the_faces_fall(kind, phi, 
     """Sliding the sample box over a lattice moves the whole-sample value by 11-14 % (SC
     1.108 -> 1.228, FCC 0.882 -> 0.980); permeability_m2, read in the inset window with each
     throat weighted by the part of its face inside it, stays within 0.3 %."""
-    from network.flow import solve_network
+    from network.flow import FlowOptions, SampleOptions, solve_network
     from network.packing import lattice_packing
     from network.pores import Region, tessellate
     from network.validation import computed_lattice_permeability
@@ -61,8 +61,9 @@ def test_sample_permeability_does_not_depend_on_where_the_faces_fall(kind, phi, 
     ks, whole = [], []
     for o in (0.0, 0.137, 0.5):
         reg = Region(np.full(3, 1.0 + o), np.full(3, n_cells - 2 + o))
-        res = solve_network(pk, tessellation=t, region=reg, axis=0, viscosity_pa_s=1.0,
-                            porosity_points=0)
+        res = solve_network(pk, tessellation=t, axis=0,
+                            sample=SampleOptions(region=reg, porosity_points=0),
+                            flow=FlowOptions(viscosity_pa_s=1.0))
         assert res.sample_estimator == "inset"
         ks.append(res.permeability_m2 / exact)
         whole.append(res.permeability_whole_m2 / exact)
@@ -73,7 +74,7 @@ def test_sample_permeability_does_not_depend_on_where_the_faces_fall(kind, phi, 
 def test_random_sample_agrees_with_the_periodic_network():
     """The inset estimate of samples at several places in a random packing agrees with the same
     network made periodic to 3 %; the whole-sample value is 3-5 % low (docs/sample-boundary.md)."""
-    from network.flow import solve_network
+    from network.flow import FlowOptions, SampleOptions, solve_network
     from network.packing import periodic_copies
     from network.pores import Region, tessellate
 
@@ -86,7 +87,8 @@ def test_random_sample_agrees_with_the_periodic_network():
     t = tessellate(big)
     for shift in (0.0, 0.3):
         lo = np.full(3, (0.6 + shift) * side)
-        res = solve_network(big, tessellation=t, region=Region(lo, lo + 1.2 * side), axis=2,
-                            viscosity_pa_s=1.0, porosity_points=0)
+        res = solve_network(big, tessellation=t, axis=2, flow=FlowOptions(viscosity_pa_s=1.0),
+                            sample=SampleOptions(region=Region(lo, lo + 1.2 * side),
+                                                 porosity_points=0))
         assert res.permeability_m2 / truth == pytest.approx(1.0, abs=0.03)
         assert 0.93 < res.permeability_whole_m2 / truth < 0.99

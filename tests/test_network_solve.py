@@ -1,5 +1,7 @@
 """The network model end to end: invariances, isotropy, pruning, tie-breaking."""
 
+import dataclasses
+
 import numpy as np
 import pytest
 from scipy.sparse.linalg import spsolve
@@ -9,7 +11,8 @@ from network import Packing, tessellate
 from network.conductance import conduit_conductance
 from network.packing import default_packing_path, random_packing, read_packing
 from network.packing import lattice_packing
-from network.flow import solve_network
+from network.flow import (DEFAULT_VELOCITY_M_S, ConductanceOptions, FlowOptions, SampleOptions,
+                          solve_network)
 from network.pores import Region, default_region, prune_disconnected, select_sample
 
 MU = 1.932e-5
@@ -26,10 +29,14 @@ def small_bed():
     return random_packing(700, rng=4, periodic=True, solid_fraction=0.6)
 
 
-def run(pk, **kw):
-    kw.setdefault("conductance", area_conductance)
-    kw.setdefault("porosity_points", 0)
-    return solve_network(pk, **kw)
+def run(pk, *, axis="z", region=None, porosity=None, conductance=area_conductance,
+        merge_ties=True, velocity_m_s=DEFAULT_VELOCITY_M_S, solver=None):
+    """:func:`solve_network` with the stand-in conductance and no porosity estimate."""
+    return solve_network(
+        pk, axis=axis, solver=solver,
+        sample=SampleOptions(region=region, porosity=porosity, porosity_points=0),
+        conductance=ConductanceOptions(function=conductance, merge_ties=merge_ties),
+        flow=FlowOptions(velocity_m_s=velocity_m_s))
 
 
 def test_bcc_lattice_is_isotropic():
@@ -58,8 +65,9 @@ def test_bin_coordinates_do_not_move_the_permeability():
     a bin's survey frame gives them: the core's flux-plane areas cancelled to 1e-6 of their
     size there (k 0.2 % high); now the same k to 1e-7."""
     pk = read_packing(default_packing_path())
-    base = solve_network(pk, porosity_points=0)
-    far = solve_network(Packing(pk.centers + [1e5, -1e5, 5e4], pk.radii), porosity_points=0)
+    none = SampleOptions(porosity_points=0)
+    base = solve_network(pk, sample=none)
+    far = solve_network(Packing(pk.centers + [1e5, -1e5, 5e4], pk.radii), sample=none)
     assert far.permeability_m2 == pytest.approx(base.permeability_m2, rel=1e-7)
 
 
@@ -152,17 +160,19 @@ def test_region_validation():
 
 def test_conduit_model_hook(small_bed):
     """'conduit' dispatches to the conduit model with its pore bodies contracted."""
-    res = solve_network(small_bed, conductance_model="conduit", policy="shape-factor",
-                        porosity_points=0)
+    res = solve_network(small_bed, sample=SampleOptions(porosity_points=0),
+                        conductance=ConductanceOptions(model="conduit", policy="shape-factor"))
     assert res.conductance_model == "conduit" and res.check["ok"]
     assert res.solver["iterations"] < 150
 
 
-def test_unknown_model_and_policy(small_bed):
+def test_unknown_model_and_policy():
     with pytest.raises(ValueError, match="unknown conductance model"):
-        solve_network(small_bed, conductance_model="magic", porosity_points=0)
+        ConductanceOptions(model="magic")
     with pytest.raises(ValueError, match="unknown Q\\* policy"):
-        solve_network(small_bed, policy="guess", porosity_points=0)
+        ConductanceOptions(policy="guess")
+    # a custom conductance function overrides model and policy: they are not checked
+    assert ConductanceOptions(function=area_conductance, policy="guess").policy == "guess"
 
 
 def test_cylinder_sample(small_bed):
@@ -272,20 +282,36 @@ def test_core_permeability_of_a_lattice_does_not_drift_with_sample_size():
 
 
 def test_bad_options_are_refused_before_the_tessellation(small_bed, monkeypatch):
-    """Options are checked at the door: a bad policy, model or viscosity never
-    reaches the tessellation."""
+    """Options are checked at the door: a bad policy, model or viscosity is refused when its
+    option group is made, a bad axis or option group before the tessellation."""
     import network.flow._pipeline as pipeline
 
     def no_work(*a, **k):
         raise AssertionError("tessellated before the options were checked")
 
     monkeypatch.setattr(pipeline, "tessellate", no_work)
-    for kw, match in ((dict(policy="fast"), "unknown Q\\* policy 'fast'"),
-                      (dict(conductance_model="magic"), "unknown conductance model 'magic'"),
-                      (dict(viscosity_pa_s=-1.0), "viscosity_pa_s must be finite and > 0"),
-                      (dict(axis="w"), "axis must be one of")):
+    for make, match in ((lambda: ConductanceOptions(policy="fast"), "unknown Q\\* policy 'fast'"),
+                        (lambda: ConductanceOptions(model="magic"),
+                         "unknown conductance model 'magic'"),
+                        (lambda: FlowOptions(viscosity_pa_s=-1.0),
+                         "viscosity_pa_s must be finite and > 0"),
+                        (lambda: FlowOptions(curve_velocities_m_s=[0.1, 0.0]),
+                         "velocity_m_s must be finite and > 0"),
+                        (lambda: FlowOptions(inertial_workers=0),
+                         "inertial_workers must be an integer >= 1"),
+                        (lambda: SampleOptions(porosity_points=-1),
+                         "porosity_points must be an integer >= 0"),
+                        (lambda: SampleOptions(margin_m=0.0), "margin_m must be finite and > 0"),
+                        (lambda: solve_network(small_bed, axis="w"), "axis must be one of"),
+                        (lambda: solve_network(small_bed, flow=FlowOptions(inertia=True),
+                                               conductance=ConductanceOptions(model="thesis")),
+                         "inertia needs the conduit model")):
         with pytest.raises(ValueError, match=match):
-            solve_network(small_bed, **kw)
+            make()
+    with pytest.raises(TypeError, match="flow must be a FlowOptions"):
+        solve_network(small_bed, flow={"velocity_m_s": 0.1})
+    with pytest.raises(dataclasses.FrozenInstanceError):
+        FlowOptions().velocity_m_s = 1.0
 
 
 def test_threads_do_not_change_the_answer(small_bed):
@@ -299,7 +325,8 @@ def test_threads_do_not_change_the_answer(small_bed):
         assert np.array_equal(one.g, many.g, equal_nan=True)
         assert np.array_equal(one.qstar, many.qstar, equal_nan=True)
         assert many.stats["section_qstar_stats"] == one.stats["section_qstar_stats"]
-    kw = dict(conductance_model="conduit", policy="table-only", porosity_points=20_000)
+    kw = dict(conductance=ConductanceOptions(model="conduit", policy="table-only"),
+              sample=SampleOptions(porosity_points=20_000))
     serial = solve_network(small_bed, threads=1, **kw)
     threaded = solve_network(small_bed, threads=2, **kw)
     assert threaded.porosity == serial.porosity and threaded.porosity_std == serial.porosity_std
@@ -338,10 +365,10 @@ def test_spheres_apart_from_the_bed_are_left_out_of_the_default_sample(caplog):
     far = [[0.01, 0.01, 2.0], [0.5, 0.5, 0.05], [-1.0, 0.02, 0.02]]
     escaped = Packing(np.vstack([pk.centers, far]), np.append(pk.radii, [0.003] * 3))
     with caplog.at_level("WARNING", logger="network.pores._region"):
-        res = solve_network(escaped, porosity_points=0)
+        res = solve_network(escaped, sample=SampleOptions(porosity_points=0))
     assert "3 sphere(s) lie apart from the bed" in caplog.text
     assert "#3001, #3002, #3003" in caplog.text
-    base = solve_network(pk, porosity_points=0)
+    base = solve_network(pk, sample=SampleOptions(porosity_points=0))
     assert res.permeability_m2 == pytest.approx(base.permeability_m2, rel=1e-3)
     # the same box, up to the margin (1.5 mean diameters, the three among them: 8e-7 m)
     assert default_region(escaped).lo == pytest.approx(default_region(pk).lo, abs=1e-6)

@@ -117,12 +117,14 @@ def test_site_coordinates_give_the_centred_answer():
     """A packing offset by 1e6 m (site coordinates) gives the permeability of the same packing
     near the origin (before the shift to the bounding-box centre, Qhull lost 2933 of the 3000
     bundled-scene spheres at this offset and the sample held no pore)."""
-    from network import random_packing, solve_network
+    from network import ConductanceOptions, SampleOptions, random_packing, solve_network
 
     pk = random_packing(600, rng=2, solid_fraction=0.57)
     far = Packing(pk.centers + 1e6, pk.radii)
-    a = solve_network(pk, policy="shape-factor", porosity_points=0)
-    b = solve_network(far, policy="shape-factor", porosity_points=0)
+    opts = dict(sample=SampleOptions(porosity_points=0),
+                conductance=ConductanceOptions(policy="shape-factor"))
+    a = solve_network(pk, **opts)
+    b = solve_network(far, **opts)
     assert a.n_throats == b.n_throats
     assert abs(b.permeability_m2 / a.permeability_m2 - 1) < 1e-6
 

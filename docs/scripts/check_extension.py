@@ -26,7 +26,7 @@ import numpy as np
 import cache._lookup as lookup_module
 from cache import lookup_qstar
 from fit_deep_overlap import DATA, bed_windows, outside_g1     # beside this script
-from network.flow import solve_network
+from network.flow import ConductanceOptions, solve_network
 from network.packing import read_packing
 from throats import deep_overlap, shape_factor_qstar
 
@@ -53,7 +53,8 @@ def permeability(pk, grids, db=None):
     kept = lookup_module.EXTENSION_GRIDS
     try:
         lookup_module.EXTENSION_GRIDS = grids
-        return solve_network(pk, axis="z", policy="table-only", db=db).permeability_m2
+        return solve_network(pk, axis="z",
+                             conductance=ConductanceOptions(db=db)).permeability_m2
     finally:
         lookup_module.EXTENSION_GRIDS = kept
 

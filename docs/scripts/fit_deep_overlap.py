@@ -31,7 +31,7 @@ from pathlib import Path
 import numpy as np
 
 from cache import load_grid_table, lookup_qstar
-from network.flow import solve_network
+from network.flow import ConductanceOptions, solve_network
 from network.packing import read_packing
 from network.pores import default_region, merge_pores, select_sample, tessellate
 from throats import contact_type, deep_overlap, shape_factor_qstar
@@ -111,7 +111,7 @@ def check(db, workers):
     out = {"windows": int(len(q_fe)), "before": errors(old_estimate(r, s), q_fe),
            "after": errors(shape_factor_qstar(r, s), q_fe)}
     pk = read_packing(path)
-    k = {pol: solve_network(pk, axis="z", policy="table-only", db=d).permeability_m2
+    k = {pol: solve_network(pk, axis="z", conductance=ConductanceOptions(db=d)).permeability_m2
          for pol, d in (("table", None), ("fe_windows", db))}
     out["permeability_m2"] = k
     out["permeability_error"] = k["table"] / k["fe_windows"] - 1.0

@@ -12,7 +12,7 @@ import tempfile
 import time
 from pathlib import Path
 
-from ..flow import solve_network
+from ..flow import ConductanceOptions, SampleOptions, solve_network
 from ..packing import random_packing
 from ._common import qstar_sources
 from ._table import copy_table, default_table
@@ -31,8 +31,9 @@ def policies(n, policy_list, db, seed, workers, models=("conduit", "thesis")) ->
         copy_table(base, db_used)
         t0 = time.perf_counter()
         try:
-            res = solve_network(pk, axis="z", policy=pol, db=db_used, workers=workers,
-                                porosity_points=0, conductance_model=model)
+            res = solve_network(pk, axis="z", sample=SampleOptions(porosity_points=0),
+                                conductance=ConductanceOptions(model=model, policy=pol,
+                                                               db=db_used, workers=workers))
             rows.append({"conductance_model": model, "policy": pol,
                          "permeability_m2": res.permeability_m2,
                          "seconds": time.perf_counter() - t0,

@@ -19,7 +19,7 @@ from pathlib import Path
 
 import numpy as np
 
-from ..flow import solve_network
+from ..flow import ConductanceOptions, solve_network
 from ..packing import periodic_copies, random_packing, read_packing, write_packing_csv
 from .._cli import available_cores
 from ._common import qstar_sources
@@ -69,8 +69,8 @@ def run_one(path: Path, policy: str, db, repeats: int, trace: bool = True,
         t0 = time.perf_counter()
         pk = read_packing(path)
         t_read = time.perf_counter() - t0
-        res = solve_network(pk, axis="z", policy=policy, db=db, threads=available_cores(),
-                            trace_memory=False, conductance_model=model)
+        res = solve_network(pk, axis="z", threads=available_cores(), trace_memory=False,
+                            conductance=ConductanceOptions(model=model, policy=policy, db=db))
         wall = time.perf_counter() - t0
         if best is None or wall < best["wall_s"]:
             best = {"wall_s": wall, "read_s": t_read, "stages_s": dict(res.timings_s),
@@ -83,8 +83,8 @@ def run_one(path: Path, policy: str, db, repeats: int, trace: bool = True,
     # one more pass with tracemalloc for per-stage traced peaks (slower; not timed)
     if trace:
         pk = read_packing(path)
-        res = solve_network(pk, axis="z", policy=policy, db=db, threads=available_cores(),
-                            trace_memory=True, conductance_model=model)
+        res = solve_network(pk, axis="z", threads=available_cores(), trace_memory=True,
+                            conductance=ConductanceOptions(model=model, policy=policy, db=db))
         best["traced_peak_mb"] = res.timings_s.get("peak_memory_mb", {})
     best["max_rss_mb"] = max(walls_rss, resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024.0)
     best["n_spheres"] = pk.n

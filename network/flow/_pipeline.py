@@ -14,6 +14,7 @@ we solve once with :math:`\Delta P = 1` Pa between inlet and outlet pores, obtai
 
 from __future__ import annotations
 
+import dataclasses
 import logging
 import time
 import tracemalloc
@@ -21,9 +22,8 @@ from typing import Callable
 
 import numpy as np
 
-from .._air import MU_AIR_PA_S, RHO_AIR_KG_M3, check_density, check_positive, check_viscosity
 from .._deferred import beside
-from ..conductance import (KERNEL_MIN_THROATS, check_model, check_policy, conduit_law, has_grid,
+from ..conductance import (KERNEL_MIN_THROATS, conduit_law, has_grid,
                            load_conduit_kernel, throat_conductance)
 from ..packing import Packing
 from ..pores import (Region, Tessellation, axis_index, default_region, merge_pores,
@@ -32,6 +32,8 @@ from ._darcy import core_permeability, darcy_permeability
 from ._amg import import_pyamg
 from ._inertial import solve_inertial
 from ._linear import solve_fixed_pressure
+from ._options import (DEFAULT_DEPTH_M, DEFAULT_VELOCITY_M_S, ConductanceOptions, FlowOptions,
+                       SampleOptions)
 from ._result import FlowResult
 
 __all__ = ["solve_network", "solve_axes", "DEFAULT_VELOCITY_M_S", "DEFAULT_DEPTH_M",
@@ -40,31 +42,16 @@ __all__ = ["solve_network", "solve_axes", "DEFAULT_VELOCITY_M_S", "DEFAULT_DEPTH
 
 log = logging.getLogger(__name__)
 
-#: Superficial air velocity of the thesis's low-flow case, m/s (m³ s⁻¹ m⁻²).
-DEFAULT_VELOCITY_M_S = 0.013
-#: Bed depth of the thesis's comparison, m.
-DEFAULT_DEPTH_M = 0.25
 
 #: Name of the per-conduit inertial law in the JSON (``inertial_law``): the conduit window law
 #: of :func:`network.conductance.conduit_law` (``docs/inertial-flow.md``).
 INERTIAL_LAW = "window"
 
 
-def solve_network(packing: Packing, *, axis="z", region: Region | None = None,
-                  margin: float | None = None, cylinder: bool = False,
-                  conductance_model: str = "conduit", policy: str = "table-only",
-                  viscosity_pa_s: float = MU_AIR_PA_S,
-                  velocity_m_s: float = DEFAULT_VELOCITY_M_S, depth_m: float = DEFAULT_DEPTH_M,
-                  rtol: float = 1e-3, db=None, workers: int = 1, progress: bool = False,
+def solve_network(packing: Packing, *, axis="z", sample: SampleOptions | None = None,
+                  conductance: ConductanceOptions | None = None, flow: FlowOptions | None = None,
                   tessellation: Tessellation | None = None, solver: Callable | None = None,
-                  porosity_points: int = 200_000, conductance: Callable | None = None,
-                  trace_memory: bool = False, merge_ties: bool = True,
-                  porosity: tuple | None = None, container: dict | None = None,
-                  qstar_fn: Callable | None = None, model_options: dict | None = None,
-                  core_margin_m: float | None = None, inertia: bool = False,
-                  density_kg_m3: float = RHO_AIR_KG_M3,
-                  curve_velocities_m_s=None,
-                  inertial_workers: int = 1, threads: int = 1) -> FlowResult:
+                  threads: int = 1, trace_memory: bool = False) -> FlowResult:
     """Permeability and pressure drop of a packing by the Delaunay network model.
 
     Parameters
@@ -73,86 +60,50 @@ def solve_network(packing: Packing, *, axis="z", region: Region | None = None,
         Centres and radii, m.
     axis : {'x', 'y', 'z'}
         Flow direction (default 'z').
-    region : Region, optional
-        Sample box/cylinder; default :func:`network.default_region` with ``margin``.
-    margin : float, optional, m
-        Wall margin of the default region (default 1.5 mean diameters).
-    cylinder : bool
-        Use the inscribed cylinder of the default box.
-    container : dict, optional
-        The packing's container (:func:`network.read_container`), for the default region.
-    conductance_model : {'conduit', 'thesis'}
-        Throat conductance model (default 'conduit', :mod:`network.conductance`; 'thesis' is
-        Eq. 3.41 with L = 2r̄, kept to reproduce the thesis).
-    policy : {'shape-factor', 'table-only', 'table+fe', 'fe-only'}
-        Q* source (see :mod:`network.conductance`); default 'table-only' (the table, the
-        shape-factor estimate where it cannot answer, never FE).
-    viscosity_pa_s, velocity_m_s, depth_m : float
-        μ (1.932e-5 Pa·s), superficial velocity (0.013 m/s), bed depth (0.25 m).
-    rtol, db, workers, progress
-        Passed to the Q* lookup.
+    sample : SampleOptions, optional
+        Region, margins and porosity (default :class:`SampleOptions()`: the interior box 1.5
+        mean diameters in from the packing's extent, 200 000 Monte-Carlo points).
+    conductance : ConductanceOptions, optional
+        Model, Q* policy and table (default: the conduit model, table-only).
+    flow : FlowOptions, optional
+        Air, velocity, bed depth and the inertial solve (default: the thesis's air at
+        0.013 m/s over 0.25 m, Stokes only).
     tessellation : Tessellation, optional
         Reuse a tessellation of ``packing`` (e.g. for the three axes).
     solver : callable, optional
         ``solver(A, b) -> x`` instead of pyamg (tests pass ``spsolve``).
-    porosity_points : int
-        Monte-Carlo points for the porosity (0 skips it: NaN, or ``porosity`` as given). The
-        porosity reported is that of the region ``permeability_m2`` is measured in: the inset
-        window (:func:`inset_window`) when the sample is wide enough for one, else the sample;
-        the sample's is ``porosity_sample``.
-    conductance : callable, optional
-        ``conductance(tessellation, throat_ids) -> g`` overriding model and policy (tests).
-    trace_memory : bool
-        Record the peak traced memory of each stage (slower; used by the benchmark).
-    porosity : (float, float), optional
-        Precomputed (porosity, standard error) of the region (e.g. from another axis).
-    merge_ties : bool
-        Join exactly co-spherical tetrahedra (and slivers) into one pore body
-        (:func:`network.tie_groups`) so lattices do not depend on Qhull's tie-breaking
-        (default True; random packings have no exact ties and are unchanged).
-    qstar_fn : callable, optional
-        ``qstar_fn(radii (N,3), sides (N,3)) -> (N,)`` Q* instead of the policy (validation
-        cases with exact FE of lattice sections).
-    model_options : dict, optional
-        Options of the conduit model (e.g. ``{"n_sections": 8}``).
-    core_margin_m : float, optional, m
-        Margin of the core permeability: default 2 mean diameters, reported only when the
-        core is 5 diameters wide; given, the core estimate is always made (and its failure
-        raised), as the lattice validation cases need.
-    inertia : bool
-        Also solve the nonlinear network (:mod:`network.flow._inertial`, conduit model only)
-        at ``velocity_m_s`` and at ``curve_velocities_m_s``; the result's ``inertial`` holds
-        the points (default False: Stokes only).
-    density_kg_m3 : float
-        ρ of the inertial loss (default 1.20 kg/m³).
-    curve_velocities_m_s : sequence of float, optional
-        More superficial velocities (m/s, > 0) for the resistance curve.
-    inertial_workers : int
-        Processes for the nonlinear solves (``workers`` of
-        :func:`network.flow.solve_inertial`: parallel continuation chains of at least 4
-        velocities each; default 1).
     threads : int
         Threads (default 1): the porosity runs beside the tessellation (Qhull releases the
         GIL) and the conduit conductances in blocks on ``threads`` threads; the result does
         not depend on it.
+    trace_memory : bool
+        Record the peak traced memory of each stage (slower; used by the benchmark).
 
     Returns
     -------
     FlowResult
     """
-    # every option is checked before any work (a bad policy is refused before the tessellation)
+    # every option is checked before any work: the option groups check their own values when
+    # made (a bad policy is refused before the tessellation), the rest here
+    s_opt = SampleOptions() if sample is None else sample
+    c_opt = ConductanceOptions() if conductance is None else conductance
+    f_opt = FlowOptions() if flow is None else flow
+    for name, value, kind in (("sample", s_opt, SampleOptions),
+                              ("conductance", c_opt, ConductanceOptions),
+                              ("flow", f_opt, FlowOptions)):
+        if not isinstance(value, kind):
+            raise TypeError(f"{name} must be a {kind.__name__}, got {type(value).__name__}")
+    region, margin, cylinder = s_opt.region, s_opt.margin_m, s_opt.cylinder
+    container, core_margin_m = s_opt.container, s_opt.core_margin_m
+    porosity_points, porosity = s_opt.porosity_points, s_opt.porosity
+    conductance_model, policy, rtol, db = c_opt.model, c_opt.policy, c_opt.rtol, c_opt.db
+    workers, progress, merge_ties = c_opt.workers, c_opt.progress, c_opt.merge_ties
+    model_options, qstar_fn, conductance = c_opt.model_options, c_opt.qstar_fn, c_opt.function
+    viscosity_pa_s, velocity_m_s, depth_m = f_opt.viscosity_pa_s, f_opt.velocity_m_s, f_opt.depth_m
+    inertia, density_kg_m3 = f_opt.inertia, f_opt.density_kg_m3
+    curve_u, inertial_workers = list(f_opt.curve_velocities_m_s), f_opt.inertial_workers
     ax = axis_index(axis)
     axis = "xyz"[ax]
-    viscosity_pa_s = check_viscosity(viscosity_pa_s)
-    velocity_m_s = check_positive("velocity_m_s", velocity_m_s)
-    depth_m = check_positive("depth_m", depth_m)
-    if conductance is None:
-        check_model(conductance_model)
-        check_policy(policy)
-    if core_margin_m is not None:
-        core_margin_m = check_positive("core_margin_m", core_margin_m)
-    density_kg_m3 = check_density(density_kg_m3)
-    curve_u = [check_positive("velocity_m_s", u) for u in (curve_velocities_m_s or [])]
     if inertia and (conductance is not None or conductance_model != "conduit"):
         raise ValueError("inertia needs the conduit model (its window and body areas); "
                          f"got {conductance_model if conductance is None else 'custom'}")
@@ -419,7 +370,8 @@ class _Stage:
         return False
 
 
-def solve_axes(packing: Packing, regions: dict, **options) -> list[FlowResult]:
+def solve_axes(packing: Packing, regions: dict, *, sample: SampleOptions | None = None,
+               tessellation: Tessellation | None = None, **options) -> list[FlowResult]:
     """:func:`solve_network` along several axes, sharing one tessellation and the porosity.
 
     Parameters
@@ -427,23 +379,30 @@ def solve_axes(packing: Packing, regions: dict, **options) -> list[FlowResult]:
     packing : Packing
     regions : dict
         ``{axis: Region}`` in solve order (e.g. from :func:`network.pores.sample_region`).
+    sample : SampleOptions, optional
+        Its ``region`` and ``porosity`` are set per axis.
+    tessellation : Tessellation, optional
+        Reused for every axis (made here once where several axes are solved).
     **options
-        Passed to :func:`solve_network` (not ``axis``, ``region``, ``porosity``).
+        ``conductance``, ``flow``, ``solver``, ``threads``, ``trace_memory`` of
+        :func:`solve_network`.
 
     Returns
     -------
     list of FlowResult
         One per axis; the porosity is measured once per distinct region.
     """
+    sample = SampleOptions() if sample is None else sample
     if not regions:
         raise ValueError("no axis to solve")
-    if len(regions) > 1 and options.get("tessellation") is None:
-        options["tessellation"] = tessellate(packing)      # one tessellation for every axis
+    if len(regions) > 1 and tessellation is None:
+        tessellation = tessellate(packing)      # one tessellation for every axis
     results, porosity_of = [], {}
     for axis, reg in regions.items():
         key = (tuple(reg.lo), tuple(reg.hi), reg.radius)
-        res = solve_network(packing, axis=axis, region=reg, porosity=porosity_of.get(key),
-                            **options)
+        res = solve_network(packing, axis=axis, sample=dataclasses.replace(
+            sample, region=reg, porosity=porosity_of.get(key)), tessellation=tessellation,
+            **options)
         porosity_of.setdefault(key, (res.porosity_sample, res.porosity_sample_std))
         results.append(res)
     return results

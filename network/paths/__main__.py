@@ -42,7 +42,8 @@ from .._cli import (CliParser, add_air, add_packing, bad_input, check_common, ch
 from . import (bed_depth, branched_table, face_graph, plot_paths, pore_pressure_array,
                pressure_along_path, random_entry_points, trace_paths)
 from ..conductance import POLICIES
-from ..flow import DEFAULT_DEPTH_M, asabe_d272_gradient, ergun_gradient, inset_window, solve_network
+from ..flow import (DEFAULT_DEPTH_M, ConductanceOptions, FlowOptions, SampleOptions,
+                    asabe_d272_gradient, ergun_gradient, inset_window, solve_network)
 from ..packing import UNITS, Packing, random_packing
 from ..pores import (NoInteriorError, Region, axis_index, default_region, region_porosity,
                      tessellate)
@@ -413,15 +414,14 @@ def _pressure_along(args, x, r, source, tess, graph, paths):
     # sample: 1.5 mean diameters from the side walls (less in a thin bin), 4 mean diameters
     # (the thesis's 0.026 m) from the floor and from the highest centre, so a loose top surface
     # still leaves outlet pores
-    ax = "xyz".index(args.axis)
-    d = 2.0 * r.mean()
-    lo, hi = x.min(axis=0), x.max(axis=0)
+    d, lo, hi = 2.0 * r.mean(), x.min(axis=0), x.max(axis=0)
     m = np.minimum(1.5 * d, 0.2 * (hi - lo))
-    m[ax] = 4.0 * d
+    m["xyz".index(args.axis)] = 4.0 * d
     res = solve_network(Packing(x, r, source), axis=args.axis, tessellation=tess,
-                        policy=args.policy, velocity_m_s=args.velocity[0], porosity_points=0,
-                        depth_m=args.depth, viscosity_pa_s=args.viscosity,
-                        region=Region(lo + m, hi - m))
+                        sample=SampleOptions(region=Region(lo + m, hi - m), porosity_points=0),
+                        conductance=ConductanceOptions(policy=args.policy),
+                        flow=FlowOptions(velocity_m_s=args.velocity[0], depth_m=args.depth,
+                                         viscosity_pa_s=args.viscosity))
     # the solver's own pore bodies (merged tetrahedra): its pore_ids are their labels
     p_all = pore_pressure_array(tess.n_pores, res.pore_ids, res.pressure_pa, res.pore_groups)
     grad = res.pressure_gradient_pa_per_m

@@ -24,7 +24,7 @@ from pathlib import Path
 
 import numpy as np
 
-from ..flow import solve_network
+from ..flow import ConductanceOptions, FlowOptions, solve_network
 from ..packing import Packing, random_packing
 
 __all__ = ["BAND_OFFSETS", "fit_log_slope", "band_gradients", "slope_at", "pack_band",
@@ -130,9 +130,10 @@ def pack_band(packing: Packing, porosity: float, *, velocities_m_s, axis: str = 
             sf = float(np.clip(WALL_OFFSET - porosity + step, 0.30, 0.63))
             p = random_packing(packing.n_grains, diameter_range_m=drange, solid_fraction=sf,
                                aspect=aspect, rng=int(seed))
-            r = solve_network(p, axis=axis, viscosity_pa_s=viscosity_pa_s, velocity_m_s=us[0],
-                              inertia=True, density_kg_m3=density_kg_m3, db=db,
-                              curve_velocities_m_s=us[1:])
+            r = solve_network(p, axis=axis, conductance=ConductanceOptions(db=db),
+                              flow=FlowOptions(viscosity_pa_s=viscosity_pa_s, velocity_m_s=us[0],
+                                               inertia=True, density_kg_m3=density_kg_m3,
+                                               curve_velocities_m_s=us[1:]))
             pts = r.curve_points()
             if not all(q["converged"] for q in pts):
                 raise RuntimeError(f"band packing seed {seed}, solid fraction {sf:.3f}: the "

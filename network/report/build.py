@@ -15,8 +15,8 @@ import numpy as np
 
 from .._cli import available_cores
 from .._grains import D272, d272_velocity_range
-from ..flow import (INERTIAL_LAW, asabe_d272_gradient, ergun_gradient, fit_curve, inset_window,
-                    solve_network)
+from ..flow import (INERTIAL_LAW, FlowOptions, SampleOptions, asabe_d272_gradient, ergun_gradient,
+                    fit_curve, inset_window, solve_network)
 from ..packing import read_container
 from ..pores import region_porosity, sample_region
 from .band import BAND_OFFSETS, band_gradients, measured_band, pack_band, slope_at
@@ -38,11 +38,11 @@ KEYS = ["velocity_m_s", "reynolds_particle", "pressure_gradient_pa_per_m",
 def _solve(o: ReportOptions, packing, container, axis, us, porosity=None):
     region, us = sample_region(packing, box=o.sample_box_m, margin=o.margin_m, container=container,
                                axis=axis), sorted(us)
-    return solve_network(packing, axis=axis, region=region, viscosity_pa_s=o.viscosity_pa_s,
-                         velocity_m_s=us[0], depth_m=o.depth_m, inertia=True,
-                         density_kg_m3=o.density_kg_m3, curve_velocities_m_s=us[1:],
-                         porosity=porosity,
-                         inertial_workers=available_cores(), threads=available_cores())
+    flow = FlowOptions(viscosity_pa_s=o.viscosity_pa_s, velocity_m_s=us[0], depth_m=o.depth_m,
+                       inertia=True, density_kg_m3=o.density_kg_m3, curve_velocities_m_s=us[1:],
+                       inertial_workers=available_cores())
+    return solve_network(packing, axis=axis, sample=SampleOptions(region=region, porosity=porosity),
+                         flow=flow, threads=available_cores())
 
 
 def _fits(o: ReportOptions, pts, porosity, d32):

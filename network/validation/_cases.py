@@ -12,7 +12,7 @@ import math
 
 import numpy as np
 
-from ..flow import solve_network
+from ..flow import ConductanceOptions, FlowOptions, SampleOptions, solve_network
 from ..packing import Packing, lattice_packing, periodic_copies, random_packing
 from ..pores import Region, tessellate
 
@@ -92,12 +92,13 @@ def _network_permeability(tess, region, *, model, policy, qstar_fn, n_sections, 
     The one pipeline (:func:`network.solve_network`) with viscosity 1, no porosity estimate,
     and the core read ``margin`` in from every face (``estimator='core'``).
     """
-    res = solve_network(tess.packing, tessellation=tess, region=region, axis=axis,
-                        conductance_model=model, policy=policy, qstar_fn=qstar_fn,
-                        model_options={"n_sections": n_sections} if model == "conduit" else None,
-                        viscosity_pa_s=1.0, db=db, rtol=rtol, workers=workers,
-                        porosity_points=0,
-                        core_margin_m=float(margin) if estimator == "core" else None)
+    sample = SampleOptions(region=region, porosity_points=0,
+                           core_margin_m=float(margin) if estimator == "core" else None)
+    conductance = ConductanceOptions(
+        model=model, policy=policy, qstar_fn=qstar_fn, db=db, rtol=rtol, workers=workers,
+        model_options={"n_sections": n_sections} if model == "conduit" else None)
+    res = solve_network(tess.packing, tessellation=tess, axis=axis, sample=sample,
+                        conductance=conductance, flow=FlowOptions(viscosity_pa_s=1.0))
     return res.permeability_core_m2 if estimator == "core" else res.permeability_whole_m2
 
 

@@ -1,11 +1,12 @@
-"""python -m network.throats as a new user: lossless lengths, bad input exits 2
-with one ``error:`` line and writes nothing, --help covers every option."""
+"""python -m network.throatlist (and its contract name network.throats) as a new user: lossless
+lengths, bad input exits 2 with one ``error:`` line and writes nothing, --help covers every
+option."""
 
 import numpy as np
 import pytest
 
 import network
-from network import throats as throats_cli
+from network import throatlist as throats_cli
 
 
 @pytest.fixture(scope="module")
@@ -57,3 +58,20 @@ def test_help_explains_every_option(capsys):
             assert action.help and action.option_strings[0] in text, action.dest
             shown = action.default not in (None, False)      # the formatter appends it
             assert shown or "default" in action.help or "required" in action.help, action.dest
+
+
+def test_the_contract_name_is_the_same_command(bed, tmp_path, capsys):
+    """``python -m network.throats`` (the throat-export contract's name) writes the same file
+    and names itself in its error lines."""
+    from network import throats
+
+    a, b = tmp_path / "a.csv", tmp_path / "b.csv"
+    assert throats_cli.main([str(bed), "--out", str(a), "--quiet"]) == 0
+    assert throats.main([str(bed), "--out", str(b), "--quiet"]) == 0
+    assert a.read_bytes() == b.read_bytes()
+    capsys.readouterr()
+    assert throats.main([str(bed), "--out", str(tmp_path / "no" / "c.csv")]) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and err.startswith("error: ")
+    assert throats.build_parser(throats.PROG).prog == "python -m network.throats"
+
