@@ -139,7 +139,7 @@ def pack_grains(container, template, *, material=SOYBEAN, porosity=0.408, n_grai
     ``size_cv`` spreads the grains' sizes: grain g is the template scaled by
     :math:`f_g = 1 + c\,z_g`, :math:`z_g` standard normal cut at ±2.5 (``c`` = ``size_cv`` in
     [0, 0.3), the coefficient of variation of a kernel's axes); the grain count uses the mean
-    volume :math:`V_t\,\overline{f^3}`. 0 (default) draws nothing: the same packing as before.
+    volume :math:`V_t\,\overline{f^3}`. 0 (default) draws nothing: every grain is its template.
     Returns (sphere centres (N, 3), radii (N,), grain_id (N,), grain table dict, summary dict).
     """
     if not (np.isfinite(deposition_friction) and deposition_friction >= 0):

@@ -21,7 +21,7 @@ CPU seconds beside wall seconds on a shared two-core machine):
 
 1. :func:`lean_imports` registers ``numpy.f2py`` and ``numpy.testing`` with the standard
    library's :class:`importlib.util.LazyLoader` (the module object exists, its code runs on the
-   first attribute access: ``from numpy.testing import ...`` works as before; ``numpy.ma`` is
+   first attribute access: ``from numpy.testing import ...`` works as ever; ``numpy.ma`` is
    left to load, :data:`LAZY_NUMPY`), replaces SciPy's ``xp_capabilities`` (where its array-API
    layer has one) by one that leaves functions and their docstrings as they are (the support
    tables feed SciPy's own test suite and documentation only), and registers pyamg and

@@ -131,7 +131,7 @@ def test_table_policies_use_values_already_stored_in_the_db(heldout, tmp_path):
     assert list(res.source) == ["exact"] * 10 + ["interp"] * 14
     np.testing.assert_array_equal(res.qstar[:10], stored.qstar)
     np.testing.assert_array_equal(res.error_estimate[:10], stored.error_estimate)
-    np.testing.assert_array_equal(res.qstar[10:], interp[10:])     # the rest: as before
+    np.testing.assert_array_equal(res.qstar[10:], interp[10:])     # the rest: interpolated
     assert np.max(np.abs(interp[:10] / stored.qstar - 1)) > 1e-4    # it mattered
     mixed = cache.lookup_qstar(r, s, db=db, policy="table+fe", rtol=1.0, solver=_no_fe)
     assert list(mixed.source) == ["exact"] * 10 + ["interp"] * 14

@@ -159,7 +159,7 @@ def test_grain_id_roundtrip_csv_and_npz(tmp_path):
     assert back.n_grains == 5 and back.n == 10
     np.savez(tmp_path / "g.npz", centers=c, radii=r, grain_id=g)
     np.testing.assert_array_equal(read_packing(tmp_path / "g.npz").grain_id, g)
-    # the old four-column file still reads, as one grain per sphere
+    # a four-column file (no grain ids) reads as one grain per sphere
     write_packing_csv(Packing(c, r), tmp_path / "s.csv")
     assert read_packing(tmp_path / "s.csv").grain_id is None
 

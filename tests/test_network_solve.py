@@ -228,7 +228,7 @@ def test_cylindrical_container_from_companion_json(tmp_path, caplog):
 def test_sample_reaching_a_flat_wall_stays_finite(monkeypatch):
     """A sample box out to the walls of a closed bin: the tessellation has no walls, and the
     flat tetrahedra along them (empty spheres far wider than a grain) have huge windows. They
-    are left out of the sample; kept, they made a channel with k many orders too high."""
+    are left out of the sample; kept, they make a channel with k many orders too high."""
     import network.pores._sample as smp
     from network.pores import Region
 
@@ -244,7 +244,7 @@ def test_sample_reaching_a_flat_wall_stays_finite(monkeypatch):
     k_in = run(pk, axis="z", region=inner).permeability_whole_m2
     k_full = run(pk, axis="z", region=full).permeability_whole_m2
     assert 0.5 < k_full / k_in < 2.0
-    monkeypatch.setattr(smp, "OUTSIDE_BED_DIAMETERS", np.inf)   # keep them: the old behaviour
+    monkeypatch.setattr(smp, "OUTSIDE_BED_DIAMETERS", np.inf)   # kept, they channel
     k_kept = run(pk, axis="z", region=full).permeability_whole_m2
     assert k_kept / k_in > 10
 

@@ -104,8 +104,8 @@ def test_a_porosity_dem_pack_cannot_reach_exits_2(tmp_path, monkeypatch, capsys)
 
 
 def test_default_run_and_explicit_move_use_the_bundled_bed(tmp_path, monkeypatch, capsys):
-    """No --seed, no --porosity: the bundled bed, as before (nothing packed, no beds folder);
-    a porosity within 0.005 of its own 0.4114 (0.412) too; --move-along-band keeps today's
+    """No --seed, no --porosity: the bundled bed (nothing packed, no beds folder); a porosity
+    within 0.005 of its own 0.4114 (0.412) too; --move-along-band keeps the
     fast move for a far porosity (here --no-band: the report says it had no slope to move
     by); --packing is never packed anew, and says so."""
     monkeypatch.chdir(tmp_path)

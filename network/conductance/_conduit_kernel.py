@@ -33,7 +33,7 @@ interp_point = None
 #: SHA-256 (first 16 hex digits) of cache/_kernel.py, whose functions numba compiles into
 #: :func:`conduit_rows`: numba's disk cache of this module checks this file's own time stamp
 #: only, so an edit of cache/_kernel.py must change this line too, or a stale machine code
-#: keeps the old interpolation (a test compares the digest)
+#: keeps interpolating the previous source (a test compares the digest)
 INTERP_SOURCE_SHA256 = "13b0f24e7ee4054c"
 _COMPILED: list = []
 # one compiler at a time: the conductance blocks' threads may ask together first
