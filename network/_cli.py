@@ -192,9 +192,9 @@ def load_packing(args):
     """(path, packing in metres) of ``args.packing`` (bundled scene if None) in ``args.units``;
     the scale warning, if any, as one stderr line, and first a ``note:`` progress line when
     the Q* tables are used for the first time on this machine (:func:`first_run_note`). A
-    ``--depth`` thinner than the largest sphere is refused (ValueError). A companion JSON
-    whose container is of an
-    unknown kind or malformed is refused here, before any work (:func:`read_container`)."""
+    ``--depth`` thinner than the largest sphere of a packing at a grain's scale is refused
+    (ValueError). A companion JSON whose container is of an unknown kind or malformed is
+    refused here, before any work (:func:`read_container`)."""
     note = first_run_note(getattr(args, "policy", None))
     if note:
         log.info("note: %s", note)
@@ -203,13 +203,13 @@ def load_packing(args):
     check_three_dimensional(packing.centers, str(path))
     read_container(path)
     depth = getattr(args, "depth", None)
-    if isinstance(depth, float) and packing.n and depth < 2.0 * float(packing.radii.max()):
+    msg = scale_warning(packing)
+    if msg:                 # a packing in another unit, or dimensionless: its scale is the issue
+        warn(msg)
+    elif isinstance(depth, float) and packing.n and depth < 2.0 * float(packing.radii.max()):
         raise ValueError(f"--depth {depth:g} m is thinner than one grain of {path} (its largest "
                          f"sphere alone is {2e3 * float(packing.radii.max()):.3g} mm across): "
                          "give the bed depth in metres")
-    msg = scale_warning(packing)
-    if msg:
-        warn(msg)
     return path, packing
 
 
