@@ -284,3 +284,30 @@ def test_janssen_makes_the_deep_grain_denser(wheat):
                     (750.0, 8.0, 0.5, 0.5))
     e = prof(np.array([0.0, 1.0, 5.0]))
     assert e[0] == pytest.approx(0.415) and np.all(np.diff(e) < 0)
+
+
+def test_the_law_from_a_report_json_is_the_bundled_construction(wheat, tmp_path):
+    """--report: a network.report JSON built from the same curves and band gives the same law
+    as the bundled files (the horizontal gradients divided by the shift factor the report
+    applied), and a report of another grain is refused."""
+    from network.bin._material import DATA
+
+    an = json.loads((DATA / "anisotropy_wheat.json").read_text())
+    band = json.loads((DATA / "band_wheat.json").read_text())
+    f = 0.97
+    rep = {"grain": "wheat", "packing": "bed.csv", "porosity_packing": an["porosity"],
+           "viscosity_pa_s": an["viscosity_pa_s"], "air_density_kg_m3": an["density_kg_m3"],
+           "points": [{"velocity_m_s": u, "converged": True, "porosity_shift_factor": f,
+                       "pressure_gradient_packing_pa_per_m": gz,
+                       "pressure_gradient_horizontal_pa_per_m": f * gx}
+                      for u, gz, gx in zip(an["velocities_m_s"], an["vertical_pa_per_m"],
+                                           an["horizontal_pa_per_m"])],
+           "band": {"velocities_m_s": band["velocities_m_s"], "beds": band["beds"]}}
+    path = tmp_path / "r.json"
+    path.write_text(json.dumps(rep))
+    mat = network_material("wheat", viscosity_pa_s=MU, density_kg_m3=RHO, report=str(path))
+    assert mat.k_coef == pytest.approx(wheat.k_coef, rel=1e-12)
+    assert mat.beta_coef == pytest.approx(wheat.beta_coef, rel=1e-12)
+    assert mat.anisotropy == pytest.approx(wheat.anisotropy, rel=1e-12)
+    with pytest.raises(ValueError, match="a report of wheat, not of --grain soybean"):
+        network_material("soybean", viscosity_pa_s=MU, density_kg_m3=RHO, report=str(path))

@@ -53,6 +53,10 @@ def build_parser() -> CliParser:
                     help="network: k_v, k_h, beta from the network's porosity band and "
                          "curves (grains with bundled band data: wheat); d272: the standard's "
                          "Shedd constants (loose fill, isotropic)")
+    ap.add_argument("--report", default=None, metavar="FILE",
+                    help="the network law from a python -m network.report --json file of the "
+                         "grain (its bed's curves in z and x, its porosity band) instead of the "
+                         "bundled data: any grain the report covers")
     ap.add_argument("--diameter", type=float, required=True, help="bin diameter, m, > 0")
     ap.add_argument("--depth", type=float, required=True,
                     help="eave depth: grain depth at the wall, m, > 0")
@@ -178,7 +182,7 @@ def _check(args) -> dict:
         raise ValueError(f"--fan {args.fan}: no static pressure above 0")
     figure = None if args.no_figure else (args.figure or f"bin_{key}.png")
     inputs = [(f"--{o.replace('_', '-')}", getattr(args, o)) for o in
-              ("porosity_profile", "compaction", "fan") if getattr(args, o)]
+              ("porosity_profile", "compaction", "fan", "report") if getattr(args, o)]
     check_outputs(json=args.json_out, vtk=args.vtk, figure=figure, inputs=inputs)
     if figure is not None:
         check_plot("--figure", figure)
@@ -195,6 +199,10 @@ def _check(args) -> dict:
         kw["compaction"] = compaction
         kw["janssen"] = (rho_p * (1 - loose), geom.diameter_m, args.wall_friction,
                          args.lateral_ratio)
+    if args.report is not None:
+        if args.law != "network":
+            raise ValueError("--report gives the network law: not with --law d272")
+        kw["report"] = args.report
     make = network_material if args.law == "network" else d272_material
     material = make(key, **kw)
     return {"grain": key, "geom": geom, "material": material, "airflow": airflow, "fan": fan,

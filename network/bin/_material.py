@@ -202,7 +202,8 @@ class Material:
             out["ln_k_v"] = {"intercept": self.k_coef[0], "slope_per_porosity": self.k_coef[1]}
             out["ln_beta_v"] = {"intercept": self.beta_coef[0],
                                 "slope_per_porosity": self.beta_coef[1]}
-            out["band_porosity_range"] = list(self.band_range)
+            out["band_porosity_range"] = (None if self.band_range is None
+                                          else list(self.band_range))
         if self.d272 is not None:
             out["d272_a_pa_s2_m3"], out["d272_b_s_m"] = self.d272
         return out
@@ -214,43 +215,101 @@ def _forchheimer(u, g, mu, rho):
     return 1.0 / ik, beta
 
 
+def fit_network_law(*, velocities_m_s, vertical_pa_per_m, horizontal_pa_per_m, porosity,
+                    viscosity_pa_s, density_kg_m3, band_velocities_m_s=None, band_beds=None):
+    """The network law's constants from a bed's curves and its porosity band.
+
+    Parameters
+    ----------
+    velocities_m_s, vertical_pa_per_m, horizontal_pa_per_m : (n,) array_like
+        The bed's network gradients (Pa/m) in z and x at n >= 2 velocities (m/s).
+    porosity : float
+        The bed's porosity ε_p.
+    viscosity_pa_s, density_kg_m3 : float
+        The air of those solves (and of the band's).
+    band_velocities_m_s : (m,) array_like, optional
+    band_beds : sequence of dict, optional
+        Beds with ``porosity`` and ``pressure_gradient_pa_per_m`` (m,); None: no porosity
+        dependence (κ_1 = b_1 = 0).
+
+    Returns
+    -------
+    ((κ0, κ1), (b0, b1), (ε min, ε max) of the band or None, k_h/k_v, note)
+    """
+    u = np.asarray(velocities_m_s, dtype=float)
+    mu, rho = float(viscosity_pa_s), float(density_kg_m3)
+    kz, bz = _forchheimer(u, np.asarray(vertical_pa_per_m, float), mu, rho)
+    kx, bx = _forchheimer(u, np.asarray(horizontal_pa_per_m, float), mu, rho)
+    if not all(np.isfinite(v) and v > 0 for v in (kz, bz, kx, bx)):
+        raise ValueError(f"the bed's curves give no positive Forchheimer fit (k {kz:.3g}, "
+                         f"{kx:.3g} m^2; beta {bz:.3g}, {bx:.3g} 1/m)")
+    k1 = b1 = 0.0
+    rng, how = None, "no porosity band: the law holds at the bed's porosity only"
+    if band_beds:
+        ub = np.asarray(band_velocities_m_s, dtype=float)
+        eps, lk, lb = [], [], []
+        for bed in band_beds:
+            k, beta = _forchheimer(ub, np.array(bed["pressure_gradient_pa_per_m"], float),
+                                   mu, rho)
+            eps.append(float(bed["porosity"]))
+            lk.append(math.log(k))
+            lb.append(math.log(beta))
+        k1, _ = np.polyfit(eps, lk, 1)
+        b1, _ = np.polyfit(eps, lb, 1)
+        rng = (min(eps), max(eps))
+        how = (f"the slopes of ln k_v and ln beta_v in porosity over the {len(eps)} band beds "
+               f"(Forchheimer fit per bed): {k1:.3f}, {b1:.3f}")
+    e_p = float(porosity)
+    k0, b0 = math.log(kz) - k1 * e_p, math.log(bz) - b1 * e_p
+    a = kx / kz
+    note = (f"network law: {how}; anchored at the bed's vertical fit (porosity {e_p:.4f}, "
+            f"k_v {kz:.4g} m^2, beta_v {bz:.4g} 1/m); k_h/k_v = {a:.4f} from its fits in x and "
+            f"z; the tensor law's beta_h/beta_v = {a**-1.5:.4f}, the network's own "
+            f"{bx / bz:.4f}")
+    return (float(k0), float(k1)), (float(b0), float(b1)), rng, float(a), note
+
+
 def _band_fit(grain: str):
-    """((κ0, κ1), (b0, b1), (ε min, ε max), anisotropy, note) from the bundled band and
-    anisotropy files, or None without a band file."""
-    path = DATA / f"band_{grain}.json"
-    if not path.is_file():
+    """:func:`fit_network_law` of the bundled band and anisotropy files, or None without."""
+    path, apath = DATA / f"band_{grain}.json", DATA / f"anisotropy_{grain}.json"
+    if not (path.is_file() and apath.is_file()):
         return None
-    band = json.loads(path.read_text())
-    mu, rho = 1.932e-5, 1.20          # the air of the band's solves (its 'source')
-    u = np.array(band["velocities_m_s"], dtype=float)
-    eps, lk, lb = [], [], []
-    for bed in band["beds"]:
-        k, beta = _forchheimer(u, np.array(bed["pressure_gradient_pa_per_m"], float), mu, rho)
-        eps.append(bed["porosity"])
-        lk.append(math.log(k))
-        lb.append(math.log(beta))
-    k1, k0 = np.polyfit(eps, lk, 1)
-    b1, b0 = np.polyfit(eps, lb, 1)
-    a, note_a = 1.0, "no horizontal curve bundled: isotropic"
-    apath = DATA / f"anisotropy_{grain}.json"
-    if apath.is_file():
-        an = json.loads(apath.read_text())
-        ua = np.array(an["velocities_m_s"], float)
-        kz, bz = _forchheimer(ua, np.array(an["vertical_pa_per_m"], float),
-                              an["viscosity_pa_s"], an["density_kg_m3"])
-        kx, bx = _forchheimer(ua, np.array(an["horizontal_pa_per_m"], float),
-                              an["viscosity_pa_s"], an["density_kg_m3"])
-        # anchored at the bundled bed, as network.report moves its bed along the band
-        e_p = float(an["porosity"])
-        k0, b0 = math.log(kz) - k1 * e_p, math.log(bz) - b1 * e_p
-        a = kx / kz
-        note_a = (f"anchored at the bundled bed's vertical fit (porosity {e_p:.4f}, "
-                  f"network/data/{apath.name}); k_h/k_v = {a:.4f} from its fits in x and z; "
-                  f"the tensor law's beta_h/beta_v = {a**-1.5:.4f}, the network's own "
-                  f"{bx / bz:.4f}")
-    note = (f"network law: the slopes of ln k_v and ln beta_v in porosity over the {len(eps)} "
-            f"beds of network/data/{path.name} (Forchheimer fit per bed); {note_a}")
-    return (float(k0), float(k1)), (float(b0), float(b1)), (min(eps), max(eps)), a, note
+    band, an = json.loads(path.read_text()), json.loads(apath.read_text())
+    k, b, rng, a, note = fit_network_law(
+        velocities_m_s=an["velocities_m_s"], vertical_pa_per_m=an["vertical_pa_per_m"],
+        horizontal_pa_per_m=an["horizontal_pa_per_m"], porosity=an["porosity"],
+        viscosity_pa_s=an["viscosity_pa_s"], density_kg_m3=an["density_kg_m3"],
+        band_velocities_m_s=band["velocities_m_s"], band_beds=band["beds"])
+    return k, b, rng, a, note + f" (network/data/{path.name}, network/data/{apath.name})"
+
+
+def report_fit(path, grain: str):
+    """:func:`fit_network_law` of a ``network.report --json`` file: its bed's curves in z and x
+    at the bed's own porosity (the report's horizontal gradients divided by its porosity
+    shift factor) and its band's beds. ValueError naming the file and what is missing."""
+    try:
+        r = json.loads(Path(path).read_text())
+        pts = [q for q in r["points"] if q["converged"] and q.get("converged_horizontal", True)]
+        u = [q["velocity_m_s"] for q in pts]
+        gz = [q["pressure_gradient_packing_pa_per_m"] for q in pts]
+        gx = [q["pressure_gradient_horizontal_pa_per_m"] / q["porosity_shift_factor"]
+              for q in pts]
+        e_p, mu, rho = r["porosity_packing"], r["viscosity_pa_s"], r["air_density_kg_m3"]
+        band = r.get("band")
+        rgrain = r["grain"]
+    except (ValueError, KeyError, TypeError, ZeroDivisionError) as exc:
+        raise ValueError(f"--report {path}: not a network.report JSON ({type(exc).__name__}: "
+                         f"{exc})") from None
+    if rgrain != grain:
+        raise ValueError(f"--report {path} is a report of {rgrain}, not of --grain {grain}")
+    if len(u) < 2:
+        raise ValueError(f"--report {path}: fewer than two converged velocities")
+    k, b, rng, a, note = fit_network_law(
+        velocities_m_s=u, vertical_pa_per_m=gz, horizontal_pa_per_m=gx, porosity=e_p,
+        viscosity_pa_s=mu, density_kg_m3=rho,
+        band_velocities_m_s=None if band is None else band["velocities_m_s"],
+        band_beds=None if band is None else band["beds"])
+    return k, b, rng, a, note + f" (network.report's JSON {path}; its bed {r['packing']})", e_p
 
 
 def _profile(grain, porosity, profile, compaction, janssen):
@@ -282,15 +341,26 @@ def _density(grain, particle_density):
 
 def network_material(grain: str, *, viscosity_pa_s: float, density_kg_m3: float,
                      porosity=None, profile=None, compaction=None, janssen=None,
-                     particle_density=None) -> Material:
-    """The network's law for ``grain`` (band data needed, ValueError naming the file without)."""
-    fit = _band_fit(grain)
-    if fit is None:
-        raise ValueError(f"no porosity band of {grain}'s own beds is bundled "
-                         f"(network/data/band_{grain}.json; bundled: wheat), so the network law "
-                         "has no k(porosity) for it: use --law d272")
-    kc, bc, rng, a, note = fit
+                     particle_density=None, report=None) -> Material:
+    """The network's law for ``grain``: from the bundled band and curves, or from a
+    ``network.report --json`` file (``report``); ValueError saying what to run without either.
+    """
     prof = _profile(grain, porosity, profile, compaction, janssen)
+    if report is not None:
+        kc, bc, rng, a, note, e_p = report_fit(report, grain)
+        if rng is None and not (prof.is_uniform and abs(prof.porosity[0] - e_p) < 5e-4):
+            raise ValueError(f"--report {report} has no porosity band (--no-band): the law "
+                             f"holds at its bed's porosity {e_p:.4f} only; give --porosity "
+                             f"{e_p:.4f} or a report with its band")
+    else:
+        fit = _band_fit(grain)
+        if fit is None:
+            raise ValueError(
+                f"no porosity band of {grain}'s own beds is bundled (network/data/band_"
+                f"{grain}.json; bundled: wheat): run python -m network.report --grain {grain} "
+                "--json r.json (its band packs sphere beds, minutes) and give --report r.json, "
+                "or use --law d272")
+        kc, bc, rng, a, note = fit
     loose = requested_porosity(grain, None)[0]
     return Material("network", grain, viscosity_pa_s, density_kg_m3,
                     _density(grain, particle_density), a, prof, kc, bc, None, loose, rng, note)
