@@ -311,3 +311,17 @@ def test_the_law_from_a_report_json_is_the_bundled_construction(wheat, tmp_path)
     assert mat.anisotropy == pytest.approx(wheat.anisotropy, rel=1e-12)
     with pytest.raises(ValueError, match="a report of wheat, not of --grain soybean"):
         network_material("soybean", viscosity_pa_s=MU, density_kg_m3=RHO, report=str(path))
+
+
+def test_a_newton_failure_is_exit_1_naming_the_pressure(monkeypatch, capsys):
+    """Newton's method stopped before it converges (no iterations allowed): one error line
+    naming the static pressure, exit 1."""
+    import functools
+
+    monkeypatch.setattr(BinProblem, "solve", functools.partialmethod(BinProblem.solve,
+                                                                     maxiter=0))
+    code = main(["--diameter", "8", "--depth", "5", "--top", "peaked", "--pressure", "250",
+                 "--elements", "1500", "--no-figure", "-q"])
+    err = capsys.readouterr().err.strip().splitlines()
+    assert code == 1
+    assert len(err) == 1 and "did not converge at a static pressure of 250 Pa" in err[0]

@@ -29,6 +29,10 @@ import numpy as np
 
 __all__ = ["Duct", "BinGeometry", "Mesh", "mesh_bin", "mesh_rz_polygon", "ROUND_DUCT_AXIS"]
 
+#: growth of the element size with the distance from a duct (m per m): h = h_duct + 0.15 dist
+DUCT_GRADING = 0.15
+#: the end cap's edge: the duct size divided by this
+CAP_REFINE = 8.0
 #: height of a round duct's axis above the floor, in duct diameters (0.5 would be tangent)
 ROUND_DUCT_AXIS = 0.45
 TOPS = ("flat", "peaked", "inverted")
@@ -254,7 +258,7 @@ def _mesh_rz(geom: BinGeometry, size_m: float) -> Mesh:
                            ["plenum", "closed", "surface", "closed"], size_m)
 
 
-def _mesh_3d(geom: BinGeometry, size_m: float) -> Mesh:
+def _mesh_3d(geom: BinGeometry, size_m: float, duct_size_m: float) -> Mesh:
     gmsh = _gmsh()
     occ = gmsh.model.occ
     r, d = geom.radius_m, geom.depth_m
@@ -267,19 +271,20 @@ def _mesh_3d(geom: BinGeometry, size_m: float) -> Mesh:
         elif geom.top == "inverted":
             cone = occ.addCone(0, 0, d, 0, 0, -h, r, 0.0)
             body, _ = occ.cut(body, [(3, cone)])
-        tools = []
+        tools, cap_x = [], []
         for duct in geom.ducts:
             half = math.sqrt(r**2 - duct.offset_m**2)
             x0 = -half - 0.1 * r
             x1 = -half + duct.length_m
             if duct.length_m >= 2 * half * (1 - 1e-9):
                 x1 = half + 0.1 * r
+            else:
+                cap_x.append(x1)
             tools.append((3, occ.addCylinder(x0, duct.offset_m, duct.axis_height_m(), x1 - x0,
                                              0, 0, duct.diameter_m / 2)))
         if tools:
             body, _ = occ.cut(body, tools)
         occ.synchronize()
-        fields = []
         duct_faces = []
         surfaces = gmsh.model.getEntities(2)
         kinds = {}
@@ -288,19 +293,35 @@ def _mesh_3d(geom: BinGeometry, size_m: float) -> Mesh:
             if kinds[tag] == "plenum":
                 duct_faces.append(tag)
         if duct_faces:
-            dmin = min(du.diameter_m for du in geom.ducts)
-            near = min(size_m, dmin / 5)
+            near = min(size_m, duct_size_m)
             f = gmsh.model.mesh.field
-            fd = f.add("Distance")
-            f.setNumbers(fd, "SurfacesList", duct_faces)
-            ft = f.add("Threshold")
-            f.setNumber(ft, "InField", fd)
-            f.setNumber(ft, "SizeMin", near)
-            f.setNumber(ft, "SizeMax", size_m)
-            f.setNumber(ft, "DistMin", 0.1 * dmin)
-            f.setNumber(ft, "DistMax", dmin + 4 * size_m)
-            f.setAsBackgroundMesh(ft)
-            fields.append(ft)
+
+            def graded(kind, tags, h0):
+                fd = f.add("Distance")
+                f.setNumbers(fd, kind, tags)
+                ft = f.add("Threshold")
+                f.setNumber(ft, "InField", fd)
+                f.setNumber(ft, "SizeMin", h0)
+                f.setNumber(ft, "SizeMax", size_m)
+                f.setNumber(ft, "DistMin", 0.0)
+                f.setNumber(ft, "DistMax", max(size_m - h0, 0.0) / DUCT_GRADING + 1e-9)
+                return ft
+
+            fields = [graded("SurfacesList", duct_faces, near)]
+            # the circle where a duct's closed end cap meets its perforated surface: a
+            # Dirichlet-Neumann corner of 270 degrees on the air's side, where the pressure
+            # gradient is singular (r^(-2/3)); refined to a third of the duct size
+            tol = 1e-6 * geom.diameter_m
+            edges = []
+            for _, c in gmsh.model.getEntities(1):
+                x0, _, _, x1, _, _ = gmsh.model.getBoundingBox(1, c)
+                if x1 - x0 < tol and any(abs(x0 - e) < 1e3 * tol for e in cap_x):
+                    edges.append(c)
+            if edges:
+                fields.append(graded("CurvesList", edges, near / CAP_REFINE))
+            fmin = f.add("Min")
+            f.setNumbers(fmin, "FieldsList", fields)
+            f.setAsBackgroundMesh(fmin)
             gmsh.option.setNumber("Mesh.MeshSizeExtendFromBoundary", 0)
             gmsh.option.setNumber("Mesh.MeshSizeFromPoints", 0)
             gmsh.option.setNumber("Mesh.MeshSizeFromCurvature", 0)
@@ -358,12 +379,22 @@ def default_size(geom: BinGeometry, elements: int) -> float:
     return (4.6 * geom.grain_volume_m3 / elements) ** (1.0 / 3.0)
 
 
-def mesh_bin(geom: BinGeometry, size_m: float) -> Mesh:
+def duct_size(geom: BinGeometry, size_m: float) -> float:
+    """Element size on the ducts, m: a tenth of the narrowest duct's diameter, at most
+    ``size_m``."""
+    return min([size_m] + [d.diameter_m / 10 for d in geom.ducts])
+
+
+def mesh_bin(geom: BinGeometry, size_m: float, *, duct_size_m: float | None = None) -> Mesh:
     """The bin's mesh with its plenum and surface nodes: r-z triangles when axisymmetric,
-    else tetrahedra (gmsh, OpenCASCADE booleans for the cone and the ducts)."""
+    else tetrahedra (gmsh, OpenCASCADE booleans for the cone and the ducts), refined to
+    ``duct_size_m`` (default :func:`duct_size`) on the ducts."""
     if not (np.isfinite(size_m) and size_m > 0):
         raise ValueError(f"--mesh-size must be finite and > 0, got {size_m!r}")
-    mesh = _mesh_rz(geom, size_m) if geom.axisymmetric else _mesh_3d(geom, size_m)
+    if duct_size_m is None:
+        duct_size_m = duct_size(geom, size_m)
+    mesh = (_mesh_rz(geom, size_m) if geom.axisymmetric
+            else _mesh_3d(geom, size_m, duct_size_m))
     if mesh.plenum.size == 0 or mesh.surface.size == 0:
         raise RuntimeError(f"the mesh has {mesh.plenum.size} plenum and {mesh.surface.size} "
                            "surface nodes: the boundary was not recognised")
