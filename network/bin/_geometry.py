@@ -82,12 +82,11 @@ class BinGeometry:
             a = self.peak_angle_deg
             if not (np.isfinite(a) and 0 < a < 90):
                 raise ValueError(f"--peak-angle must be in (0, 90) degrees, got {a!r}")
-            if self.top == "inverted" and self.radius_m * math.tan(math.radians(a)) \
-                    >= 0.95 * self.depth_m:
+            drop = self.radius_m * math.tan(math.radians(a))
+            if self.top == "inverted" and drop >= 0.95 * self.depth_m:
                 raise ValueError(
-                    f"--top inverted at {a:g} degrees drops {self.radius_m * math.tan(math.radians(a)):.3g} m "
-                    f"at the centre, not less than 95 % of --depth {self.depth_m:g} m: the cone "
-                    "would reach the floor")
+                    f"--top inverted at {a:g} degrees drops {drop:.3g} m at the centre, not less "
+                    f"than 95 % of --depth {self.depth_m:g} m: the cone would reach the floor")
         if self.floor == "duct" and not self.ducts:
             raise ValueError("--floor duct needs at least one --duct DIAMETER LENGTH OFFSET")
         if self.floor == "full" and self.ducts:

@@ -127,7 +127,7 @@ def closed_form_radial_airflow(pressure_pa, *, inner_radius_m, outer_radius_m, l
     >>> q = closed_form_radial_airflow(100.0, inner_radius_m=0.1, outer_radius_m=1.0,
     ...     length_m=1.0, viscosity_pa_s=1.0, permeability_m2=1.0, beta_per_m=0.0,
     ...     density_kg_m3=1.0)
-    >>> round(q, 6), round(float(2 * np.pi * 100.0 / np.log(10.0)), 6)  # Darcy: 2 pi L k P/(mu ln 10)
+    >>> round(q, 6), round(float(2 * np.pi * 100.0 / np.log(10.0)), 6)  # 2 pi L k P/(mu ln 10)
     (272.875271, 272.875271)
     """
     s = 1.0 / (2 * np.pi * length_m)

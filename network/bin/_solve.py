@@ -25,7 +25,6 @@ tolerance by construction.
 from __future__ import annotations
 
 import logging
-import math
 from dataclasses import dataclass
 
 import numpy as np
