@@ -52,6 +52,7 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.spatial import cKDTree
 
+from ._clump_pack import bed_porosities, union_porosity_in_box
 from ._contacts import restitution_coefficient
 from ._rigid import quat_to_matrix, random_quaternions
 from .clumps import ClumpSimulation
@@ -430,8 +431,6 @@ def poured_bed_summary(sim, template, container, record):
     grain diameter wide over the interior box), ``porosity_by_depth`` (10 layers from the floor
     to ``surface_m`` over the interior box) and, for a spout, ``angle_of_repose``
     (:func:`angle_of_repose`, from one spout radius plus one grain diameter out)."""
-    from ._clump_pack import bed_porosities, union_porosity_in_box
-
     xs = sim.sphere_centers()
     r = sim.radii.copy()
     out = bed_porosities(xs, r, template, container, float(np.mean(sim.volume_m3)))

@@ -9,9 +9,8 @@ import numpy as np
 import pytest
 
 import throats
-from cache import lookup_qstar, shape_keys, signature
+from cache import lookup_qstar, open_store, shape_keys, signature
 from cache._signature import SIDE_SUM_SLACK, near_side_sums, side_sum
-from cache._store import open_store
 
 RNG = np.random.default_rng(7)
 

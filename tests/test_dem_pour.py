@@ -9,11 +9,9 @@ import math
 import numpy as np
 import pytest
 
-from dem import Container, Material
-from dem._load import janssen_stress, load_bed
-from dem._pour import (AIR_DENSITY_KG_M3, DRAG_COEFFICIENT, FillOptions, _grown, angle_of_repose,
-                       default_rate, entry_speed, orientation_order, porosity_by_depth, pour_grains,
-                       terminal_velocity)
+from dem import Container, FillOptions, Material, janssen_stress, load_bed, pour_grains
+from dem._pour import (AIR_DENSITY_KG_M3, DRAG_COEFFICIENT, _grown, angle_of_repose, default_rate,
+                       entry_speed, orientation_order, porosity_by_depth, terminal_velocity)
 from dem._rigid import random_quaternions
 from dem.clumps import ClumpSimulation
 from dem.pack import main

@@ -49,8 +49,8 @@ LAYERS = {
         {"flow"},
         {"paths"},
         {"validation"},
-        {"__init__", "_cli", "solve", "throats", "curve", "report", "bench", "benchmarks",
-         "__main__"},
+        {"__init__", "_cli", "solve", "throats", "throatlist", "curve", "report", "bin", "bench",
+         "benchmarks", "__main__"},
     ],
 }
 MAX_LINES = 450

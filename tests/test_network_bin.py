@@ -3,13 +3,14 @@ system curve, its mass balance, the tensor law, and the command's contract."""
 
 from __future__ import annotations
 
+import dataclasses
 import json
 
 import numpy as np
 import pytest
 
 from network.report.system import system_rows
-from network.bin import (BinGeometry, BinProblem, ForchheimerLaw, SheddLaw,
+from network.bin import (BinGeometry, BinProblem, ForchheimerLaw, PorosityProfile, SheddLaw,
                          closed_form_radial_airflow, d272_material, mesh_bin, mesh_rz_polygon,
                          network_material)
 from network.bin.__main__ import main
@@ -106,9 +107,6 @@ def test_a_flat_bed_on_a_full_floor_is_the_reports_system_curve(law):
 def test_a_flat_bed_with_a_porosity_profile_integrates_the_1d_law(wheat, tmp_path):
     """A denser bed with depth: P = integral of g(U, eps(h)) dh (trapezoid on 20 001 points),
     to the discretisation error of element-wise porosity (1e-4 at this mesh)."""
-    from network.bin._material import PorosityProfile
-    import dataclasses
-
     prof = PorosityProfile(np.array([0.0, 4.0]), np.array([0.42, 0.38]), "test")
     mat = dataclasses.replace(wheat, profile=prof)
     geom = BinGeometry(6.0, 4.0)

@@ -30,6 +30,8 @@ from dataclasses import dataclass
 import numpy as np
 import scipy.sparse.linalg as spla
 
+from ..flow._amg import one_blas_thread, seeded_numpy_random
+
 __all__ = ["BinProblem", "Solution", "NewtonFailure"]
 
 log = logging.getLogger(__name__)
@@ -151,9 +153,7 @@ class BinProblem:
             return spla.spsolve(Jii.tocsc(), rhs)
         import pyamg
 
-        from ..flow._amg import _seeded_numpy_random, one_blas_thread
-
-        with one_blas_thread(), _seeded_numpy_random():
+        with one_blas_thread(), seeded_numpy_random():
             if self._ml is None or self._cg_iterations > 40:
                 self._ml = pyamg.smoothed_aggregation_solver(
                     Jii, symmetry="symmetric", max_coarse=500,

@@ -15,6 +15,7 @@ import math
 
 import numpy as np
 
+from ..report.system import curve_range, operating_point
 from ._solve import NewtonFailure
 
 __all__ = ["solve_checked", "system_curve", "pressure_for_airflow", "fan_operating_point"]
@@ -68,8 +69,6 @@ def _dense(q, p, n=400):
 
 def fan_operating_point(problem, curve, fan_q, fan_p, *, rtol=1e-9, maxiter=40):
     """(solution at the operating point, None) or (None, message with both ranges)."""
-    from ..report.system import curve_range, operating_point
-
     q = np.array([s.inflow_m3_s for s in curve])
     p = np.array([s.pressure_pa for s in curve])
     sq, sp = _dense(q, p)

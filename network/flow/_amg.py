@@ -68,7 +68,7 @@ def import_pyamg() -> None:
 
 
 @contextlib.contextmanager
-def _seeded_numpy_random(seed: int = 0):
+def seeded_numpy_random(seed: int = 0):
     """NumPy's legacy global generator seeded for the block, its state restored after.
     pyamg's spectral-radius estimates (the prolongation smoother's weight) start Arnoldi from
     ``np.random.rand``: unseeded, two setups of one matrix differ in the last bits, and so
@@ -209,7 +209,7 @@ class AMGSolver:
             return self._ml, 0.0
         from pyamg.aggregation import smoothed_aggregation_solver
         t0 = time.perf_counter()
-        with one_blas_thread(), _seeded_numpy_random():
+        with one_blas_thread(), seeded_numpy_random():
             # B = D^(1/2) 1 is the scaled Laplacian's exact null vector away from the
             # Dirichlet rows: pyamg's default Gauss-Seidel improvement of it (4 sweeps, a
             # quarter of the setup) leaves the iterations unchanged (29 -> 30 at 20 000
