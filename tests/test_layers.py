@@ -1,4 +1,4 @@
-"""The code's architecture, read with ``ast``: layer order, no cycles, small modules.
+"""The code's architecture, read with ``ast``: layer order, no cycles, long modules flagged.
 
 Rules:
 
@@ -14,12 +14,15 @@ Rules:
 * inside ``network`` only the ``conductance`` layer imports ``cache``;
 * no import of a project module inside a function (matplotlib and other optional libraries may
   stay lazy); no import of another module's ``_private`` name;
-* no library module over ``MAX_LINES`` lines, no module docstring over ``MAX_DOC_LINES`` lines.
+* a library module over ``MAX_LINES`` lines or with a module docstring over ``MAX_DOC_LINES``
+  lines is named in a warning: modules are cut by concept, and the line counts only flag a
+  module to look at.
 """
 
 from __future__ import annotations
 
 import ast
+import warnings
 from pathlib import Path
 
 import pytest
@@ -238,18 +241,23 @@ def test_no_import_cycles(package):
 
 
 @pytest.mark.parametrize("package", PACKAGES)
-def test_modules_are_small(package):
-    bad = []
+def test_long_modules_are_flagged(package):
+    """Modules are cut by concept, not to fit a line count: a module over ``MAX_LINES`` lines or
+    with a module docstring over ``MAX_DOC_LINES`` lines is named in a ``UserWarning`` (a prompt
+    to look for a second concept in it), never a failure."""
+    long = []
     for module, path, _ in _modules(package):
         text = path.read_text()
         n = text.count("\n")
         if n > MAX_LINES:
-            bad.append(f"{path.relative_to(ROOT)}: {n} lines (> {MAX_LINES})")
+            long.append(f"{path.relative_to(ROOT)}: {n} lines (> {MAX_LINES})")
         doc = ast.get_docstring(ast.parse(text), clean=False)
         if doc and doc.count("\n") + 1 > MAX_DOC_LINES:
-            bad.append(f"{path.relative_to(ROOT)}: module docstring {doc.count(chr(10)) + 1} "
-                       f"lines (> {MAX_DOC_LINES})")
-    assert not bad, "\n".join(bad)
+            long.append(f"{path.relative_to(ROOT)}: module docstring {doc.count(chr(10)) + 1} "
+                        f"lines (> {MAX_DOC_LINES})")
+    if long:
+        warnings.warn(f"long modules in {package}: " + "; ".join(long), UserWarning,
+                      stacklevel=1)
 
 
 def test_the_rules_see_a_violation(tmp_path):
