@@ -10,7 +10,8 @@ from __future__ import annotations
 
 import pytest
 
-from network.flow import ergun_gradient, inset_window, kozeny_carman_gradient, solve_network
+from network.flow import (SampleOptions, ergun_gradient, inset_window, kozeny_carman_gradient,
+                          solve_network)
 from network.packing import default_packing_path, read_packing
 from network.pores import region_porosity, sample_region
 
@@ -19,7 +20,7 @@ from network.pores import region_porosity, sample_region
 def scene():
     packing = read_packing(default_packing_path())
     region = sample_region(packing, axis="z")
-    return packing, region, solve_network(packing, axis="z", region=region)
+    return packing, region, solve_network(packing, axis="z", sample=SampleOptions(region=region))
 
 
 def test_the_window_porosity_is_paired_with_the_window_k(scene):
@@ -53,5 +54,5 @@ def test_a_sample_too_narrow_for_the_window_keeps_the_sample_pair(scene):
     c = 0.5 * (region.lo + region.hi)
     small = type(region)(c - [3 * d, 3 * d, 4 * d], c + [3 * d, 3 * d, 4 * d])
     assert inset_window(small, 2, d) is None
-    res = solve_network(packing, axis="z", region=small, inertia=False)
+    res = solve_network(packing, axis="z", sample=SampleOptions(region=small))
     assert res.sample_estimator == "whole" and res.porosity == res.porosity_sample
