@@ -126,7 +126,7 @@ def build_parser() -> CliParser:
     ap.add_argument("--yade", action="store_true",
                     help="with --per-packing: also time YADE's FlowEngine on the same packings "
                          "here (needs the yade program; docs/scripts/yade_flowengine.py)")
-    ap.add_argument("--baseline", metavar="DIR", default=None,
+    ap.add_argument("--baseline", metavar="COMMIT|DIR", default=None,
                     help="with --per-packing: a commit of this checkout (extracted for the run) "
                          "or a source checkout, whose command runs right after each --stokes "
                          "run of ours: the paired speed-up on this host")
