@@ -137,6 +137,10 @@ def test_units_mm_gives_the_same_paths(bed, tmp_path, capsys):
     ([SCENE, "--plot", "no/dir/p.png"], "--plot no/dir/p.png: folder no/dir does not exist"),
     ([SCENE, "--json", "no/dir/p.json"], "folder no/dir does not exist"),
     ([SCENE, "--axis", "q"], "invalid choice: 'q'"),
+    ([SCENE, "--grain", "wheat"], "--grain wheat: network/data/soybean_default.csv is a bed of "
+                                  "soybean"),
+    (["--standin", "0.05", "0.05", "0.05", "--grain", "wheat"],
+     "--grain wheat: the stand-in (--standin) has soybean's diameters"),
 ])
 def test_bad_options_exit_2(argv, words, capsys):
     assert main(argv) == 2

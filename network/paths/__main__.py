@@ -222,7 +222,7 @@ def _grain(args):
     (its diameters); a packing's comes from its companion JSON or ``--grain``
     (``network._grains.packing_grain``); ValueError when ``--grain`` contradicts either."""
     if not args.standin:
-        return packing_grain(args.packing, args.grain)
+        return packing_grain(args.packing, args.grain) if args.packing else None
     if args.grain is not None and grain_key(args.grain) != "soybean":
         raise ValueError(f"--grain {args.grain}: the stand-in (--standin) has soybean's "
                          "diameters; give --grain soybean, or a packing of "
@@ -272,8 +272,8 @@ def _main(args) -> int:
     t0 = time.perf_counter()
     with bad_input():
         _check_options(args)
-        x, r, source = _read(args)
         grain = _grain(args)
+        x, r, source = _read(args)
         t_read = time.perf_counter() - t0
         xy = _entries(args, x, r)
         region = None if args.no_branched else _interior(args, x, r, source)
