@@ -340,3 +340,24 @@ def test_the_grain_library_copies_agree_with_dem_grains():
         assert mu_w == g.wall_friction_steel.value
     for name, (angle, _) in ANGLE_OF_REPOSE.items():
         assert re.search(rf"phi_r {angle:g}\b", grain(name).internal_friction_deg.note)
+
+
+def test_the_vtk_file_holds_the_mesh_and_its_fields(tmp_path):
+    """--vtk: a legacy unstructured grid whose counts match the JSON's mesh, with the nodal
+    pressure (the plenum's value at its nodes) and the four cell fields."""
+    vtk, js = tmp_path / "b.vtk", tmp_path / "b.json"
+    code = main(["--diameter", "6", "--depth", "3", "--pressure", "100", "--elements", "400",
+                 "--no-figure", "--no-refinement-check", "-q", "--vtk", str(vtk),
+                 "--json", str(js)])
+    assert code == 0
+    lines = vtk.read_text().splitlines()
+    mesh = json.loads(js.read_text())["mesh"]
+    head = {ln.split()[0]: ln.split() for ln in lines if ln[:1].isalpha()}
+    assert head["POINTS"][1] == str(mesh["nodes"]) and head["CELLS"][1] == str(mesh["elements"])
+    assert head["CELL_DATA"][1] == str(mesh["elements"])
+    names = [ln.split()[1] for ln in lines if ln.startswith(("SCALARS", "VECTORS"))]
+    assert names == ["pressure_pa", "velocity_m_s", "porosity", "airflow_m3_per_min_t",
+                     "underaerated"]
+    i = lines.index("SCALARS pressure_pa double 1") + 2
+    p = np.array(lines[i:i + mesh["nodes"]], dtype=float)
+    assert p.max() == 100.0 and p.min() == 0.0
