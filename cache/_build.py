@@ -338,6 +338,6 @@ def precompute_grid(store, spec, *, rtol=1e-3, solver=None, solver_version=None,
     d = spec.to_dict()
     d.update(rtol=float(rtol), solver_version=str(solver_version))
     store.put_grid(spec.name, d)
-    r, s = spec.node_shapes()
+    r, s = getattr(spec, "solve_shapes", spec.node_shapes)()
     return precompute_throats(store, r, s, rtol=rtol, solver=solver, solver_version=solver_version,
                               **kwargs)

@@ -5,9 +5,10 @@ Policies
 ==============  ===============================================================================
 ``table-only``  an exact hit where ``db`` stores the shape (an FE solve with tolerance
                 <= ``rtol``), else interpolation in the grid table for every row it covers,
-                with its error estimate; rows it cannot serve go to the shipped extension grid
-                (:mod:`cache._orbits`), then to the shape-factor estimate
-                (``source='shape-factor'``).  Never runs FE.
+                with its error estimate; rows it cannot serve go to the shipped extension grids
+                (:mod:`cache._orbits`; the deep pairs of grain beds: :mod:`cache._pair`), then
+                to the shape-factor estimate (``source='shape-factor'``; 'closed', Q* = 0, where
+                the disks cover the triangle).  Never runs FE.
 ``table+fe``    as ``table-only``, but every interpolated row whose error estimate exceeds
                 ``rtol`` is solved by FE (``throats.solve_fem``) and stored.
 ``fe-only``     exact hits, FE for the rest (stored); no interpolation.
@@ -38,6 +39,7 @@ from . import _build
 from ._build import precompute_throats, resolve_solver
 from ._derived import derived_path, load_derived, save_derived
 from ._interp import GridSpec, GridTable
+from ._pair import PairSpec, PairTable
 from ._orbits import DEFAULT_GRID, EXTENSION_GRIDS, compact, expand
 from ._exact import (CLOSED, EXACT, FAILED, FE, INTERP, SHAPE_FACTOR, SOURCES, assign_exact,
                      exact_rows, stored_first)
@@ -94,6 +96,18 @@ _TABLES: dict = {}
 _TABLES_LOCK = threading.RLock()
 
 
+def spec_from_dict(d):
+    """The grid spec a stored or exported dict describes: a :class:`cache._pair.PairSpec` when
+    its ``kind`` is 'pair', else a :class:`GridSpec`."""
+    return (PairSpec if d.get("kind") == PairSpec.kind else GridSpec).from_dict(d)
+
+
+def grid_table(spec, qstar, fe_error=None, **kwargs):
+    """The interpolation table of ``spec``: :class:`cache._pair.PairTable` on a pair grid,
+    else :class:`GridTable` (same arguments)."""
+    return (PairTable if isinstance(spec, PairSpec) else GridTable)(spec, qstar, fe_error, **kwargs)
+
+
 def grid_from_store(store, name, solver_version):
     """The :class:`GridTable` of grid ``name`` in ``store`` for ``solver_version`` (None if absent).
 
@@ -103,7 +117,7 @@ def grid_from_store(store, name, solver_version):
     spec_d = store.grid(name)
     if spec_d is None:
         return None
-    spec = GridSpec.from_dict(spec_d)
+    spec = spec_from_dict(spec_d)
     rtol = float(spec_d.get("rtol", 1e-3))
     nr, ns = spec.node_shapes()
     keys = shape_keys(signature(nr, ns))
@@ -118,10 +132,13 @@ def grid_from_store(store, name, solver_version):
     q[hit] = np.where(st == "closed", 0.0, np.where(st == "ok", qq, np.nan))
     fe[hit] = rows["error_estimate"][same][idx[hit]]
     valid, _ = throats.validate_throats(nr, ns)
+    if hasattr(spec, "needed"):
+        valid &= spec.needed()
+        q[~spec.needed()] = np.nan
     n_missing = int(np.sum(valid & ~hit))
     logger.info("grid %r from %s: %d of %d nodes solved, %d valid nodes missing", name, store.path,
                 int(np.isfinite(q).sum()), len(q), n_missing)
-    table = GridTable(spec, q, fe)
+    table = grid_table(spec, q, fe)
     table.n_missing = n_missing
     return table
 
@@ -133,7 +150,7 @@ def export_grid(store, name, path, *, solver_version, orbits=False):
     if table is None:
         raise ValueError(f"{store.path} holds no grid named {name!r} (grids: {store.grid_names()})")
     spec = dict(store.grid(name))
-    values = {"qstar": table.qstar, "fe_error": table.fe_error}
+    values = {"qstar": getattr(table, "fe_qstar", table.qstar), "fe_error": table.fe_error}
     if orbits:
         values = dict(zip(("orbit_qstar", "orbit_fe_error"), compact(table.spec, *values.values())))
     np.savez_compressed(path, spec=json.dumps(spec), solver_version=str(solver_version), **values)
@@ -144,7 +161,7 @@ def read_grid_file(path):
     """(GridSpec, solver version, ``values()``) of an exported grid ``.npz`` (either form of
     :func:`export_grid`); ``values()`` reads the node Q* and FE errors, (``spec.shape``) each."""
     z = np.load(path, allow_pickle=False)
-    spec = GridSpec.from_dict(json.loads(str(z["spec"])))
+    spec = spec_from_dict(json.loads(str(z["spec"])))
 
     def values():
         if "orbit_qstar" in z:
@@ -234,11 +251,11 @@ def _load_shipped(name, solver_version):
             rows = load_derived(saved, spec.shape)
             if rows is None:
                 qstar, fe_error = values()
-                table = GridTable(spec, qstar, fe_error)
+                table = grid_table(spec, qstar, fe_error)
                 if saved is not None:
                     save_derived(saved, dict(table.derived(), qstar=qstar, fe_error=fe_error))
             else:
-                table = GridTable(spec, rows["qstar"], rows["fe_error"], derived=rows)
+                table = grid_table(spec, rows["qstar"], rows["fe_error"], derived=rows)
             table.n_missing = 0
             table.single = name not in EXTENSION_GRIDS  # served to few rows: no float32 pass
             _TABLES[key] = table
@@ -434,8 +451,12 @@ def _settle(r, s, rows, q, err, src, msg, stats, *, db, policy, rtol, workers, p
 
 
 def _shape_factor_rows(r, s, rows, q, err, src):
+    """The shape-factor estimate for ``rows`` (in place); a row whose disks cover its triangle
+    (open area 0, where the estimate is 0) is 'closed' with Q* = 0 and error 0, as the FE
+    solver reports it (``throats.solve_fem``), not an estimate."""
     if not len(rows):
         return
     q[rows] = throats.shape_factor_qstar(r[rows], s[rows])
-    err[rows] = np.nan
-    src[rows] = SHAPE_FACTOR
+    closed = q[rows] == 0
+    err[rows] = np.where(closed, 0.0, np.nan)
+    src[rows] = np.where(closed, CLOSED, SHAPE_FACTOR)

@@ -27,7 +27,7 @@ __all__ = ["DEFAULT_GRID", "EXTENSION_GRIDS", "compact", "expand", "orbit_repres
 DEFAULT_GRID = "g1"
 
 #: grids shipped to serve, in this order, the rows the default grid cannot (``cache/data``)
-EXTENSION_GRIDS = ("x1", "d1")
+EXTENSION_GRIDS = ("x1", "d1", "p1")
 
 
 def table_coverage() -> str:
@@ -38,6 +38,9 @@ def table_coverage() -> str:
     parts = []
     for name in (DEFAULT_GRID,) + EXTENSION_GRIDS:
         g = GRIDS[name]
+        if hasattr(g, "describe"):
+            parts.append(g.describe())
+            continue
         parts.append(f"{name}: gaps {g.gap_nodes[0]:g} to {g.gap_nodes[-1]:g}, radius "
                      f"deviations to {g.rho_nodes[-1]:g}")
     return "; ".join(parts) + " (mean radii)"

@@ -363,7 +363,8 @@ def _extension(n, seed, version):
     """Each extension grid and the shape-factor estimate against FE (rtol 1e-4) on ``n`` random
     shapes in the grid's box that g1 and the grids before it do not serve (:func:`table_routes`):
     radii r̄(1 + ρ) with ρ1, ρ2 uniform over the grid's radius axis (all three > 0.2 r̄), gaps
-    uniform over its gap axis, vertices in a random order."""
+    uniform over its gap axis (a deep-pair grid: ln l12, δ13 and τ uniform over its axes),
+    vertices in a random order."""
     rng = np.random.default_rng(seed + 1)
     out, pair = {}, {(0, 1): 0, (0, 2): 1, (1, 2): 2}
     for name in EXTENSION_GRIDS:
@@ -378,6 +379,11 @@ def _extension(n, seed, version):
             g = rng.uniform(g_lo, g_hi, (8 * n, 3))
             ss = np.column_stack([rr[:, 0] + rr[:, 1] + g[:, 0], rr[:, 0] + rr[:, 2] + g[:, 1],
                                   rr[:, 1] + rr[:, 2] + g[:, 2]])
+            if hasattr(ext.spec, "log_side_nodes"):    # a deep-pair grid: its own coordinates
+                ls, tau = ext.spec.log_side_nodes, ext.spec.tau_nodes
+                l12 = np.exp(rng.uniform(ls[0], ls[-1], 8 * n))
+                l13 = rr[:, 0] + rr[:, 2] + g[:, 1]
+                ss = np.column_stack([l12, l13, l13 - rng.uniform(tau[0], tau[-1], 8 * n) * l12])
             p = rng.permutation(3)                 # any vertex order: the lookup reorders
             cols = [pair[tuple(sorted((p[a], p[b])))] for a, b in ((0, 1), (0, 2), (1, 2))]
             rr, ss = rr[:, p], ss[:, cols]

@@ -57,7 +57,9 @@ def test_coverage_names_each_shipped_grid_in_lookup_order():
     # the warning for windows outside every table names these ranges (network's conduit model)
     assert cache.table_coverage() == (
         "g1: gaps -0.2 to 2.2, radius deviations to 0.25; x1: gaps -0.2 to 4.6, radius "
-        "deviations to 0.375; d1: gaps -2.2 to 2.2, radius deviations to 0.5 (mean radii)")
+        "deviations to 0.375; d1: gaps -2.2 to 2.2, radius deviations to 0.5; p1: deep pairs "
+        "of side 0.05 to 2.7, third sphere's gap -0.2 to 2.6, |tau| to 0.9, radius deviations "
+        "to 0.4 (mean radii)")
 
 
 def test_lookup_order_keeps_the_shape_puts_the_odd_radius_third_for_every_vertex_order():
@@ -118,7 +120,7 @@ def test_rows_g1_serves_keep_their_bits(tmp_path):
     inside = np.asarray(alone.source) == "interp"
     assert inside.mean() > 0.9 and both.stats.get("n_interp_extension", 0) <= (~inside).sum()
     np.testing.assert_array_equal(both.qstar[inside], alone.qstar[inside])
-    assert EXTENSION_GRIDS == ("x1", "d1")
+    assert EXTENSION_GRIDS == ("x1", "d1", "p1")
     assert all(shipped_grid_path(name).exists() for name in EXTENSION_GRIDS)
 
 
@@ -142,12 +144,15 @@ def test_deep_grid_serves_deep_overlaps_against_fe(name, tmp_path):
     assert throats.shape_factor_qstar(r, s)[0] < 0.85 * fe       # what the estimate gave
 
 
-def test_the_deepest_overlaps_stay_with_the_estimate(tmp_path):
+def test_the_deepest_overlaps_go_to_the_pair_grid(tmp_path):
     # a wheat window overlapping by 1.59 r̄: d1's cell there has corners of three collinear
-    # centres (no triangle), so it is not served and the estimate's deep class answers
+    # centres (no triangle), so d1 does not serve it; the deep-pair grid p1 does, against FE
     r, s = np.array([[0.790151, 1.104925, 1.104925]]), np.array([[2.110816, 2.339809, 0.621037]])
     res = lookup_qstar(r, s, policy="table-only", db=tmp_path / "t.sqlite")
-    assert list(res.source) == ["shape-factor"] and res.stats["n_shape_factor_deep"] == 1
+    assert list(res.source) == ["interp"] and res.stats["n_interp_p1"] == 1
+    assert res.stats["n_shape_factor_deep"] == 0
+    fe = throats.solve_fem(r, s, rtol=1e-4).qstar[0]
+    assert res.qstar[0] == pytest.approx(fe, rel=0.02)
 
 
 def test_table_routes_follow_the_lookup():

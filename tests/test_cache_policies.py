@@ -162,15 +162,17 @@ def test_invalid_rows_fail_alone(heldout, tmp_path):
 
 def test_table_only_counts_the_estimates_deep_overlap_rows(tmp_path):
     # outside g1's gap range (-0.2 r̄): deep overlaps of two spheres of one grain, served by the
-    # extension grid d1 where its cell is whole; where not (a corner of three collinear
-    # centres, the last row: a wheat window overlapping by 1.59 r̄) the estimate answers with
-    # its own constants and the row is counted apart; an in-range shape is served by g1
-    r = np.ones((4, 3))
+    # extension grid d1 where its cell is whole, else by the deep-pair grid p1 (the fourth row:
+    # a wheat window overlapping by 1.59 r̄, whose d1 cell has a corner of three collinear
+    # centres); a deep pair whose third sphere lies beyond p1's gaps (the last row, 3.4 r̄) takes
+    # the estimate with its own constants and is counted apart; an in-range shape is g1's
+    r = np.ones((5, 3))
     r[3] = [0.790151, 1.104925, 1.104925]
     s = np.array([[1.5, 2.3, 2.3], [0.9, 2.3, 2.3], [2.1, 2.1, 2.1],
-                  [2.110816, 2.339809, 0.621037]])
+                  [2.110816, 2.339809, 0.621037], [0.6, 5.4, 5.4]])
     res = cache.lookup_qstar(r, s, policy="table-only", db=tmp_path / "t.sqlite")
-    assert list(res.source) == ["interp", "interp", "interp", "shape-factor"]
-    assert res.stats["n_interp_d1"] == 2 and res.stats["n_interp_extension"] == 2
+    assert list(res.source) == ["interp", "interp", "interp", "interp", "shape-factor"]
+    assert res.stats["n_interp_d1"] == 2 and res.stats["n_interp_p1"] == 1
+    assert res.stats["n_interp_extension"] == 3
     assert res.stats["n_shape_factor"] == 1 and res.stats["n_shape_factor_deep"] == 1
-    assert throats.deep_overlap(r, s).tolist() == [True, True, False, True]
+    assert throats.deep_overlap(r, s).tolist() == [True, True, False, True, True]
