@@ -25,8 +25,10 @@ in the slab the stream fills in that time, :math:`h = v_0\tau` thick, starting o
 radius above the surface (the highest sphere of the grains not falling at entry speed; under
 the spout, within its footprint). A grain placed at height :math:`s` above the slab's bottom
 gets the speed it has there on its fall, :math:`\sqrt{v_0^2 - 2 g s}` (so every grain reaches
-the surface at :math:`v_0`). Rain: the footprint is the whole cross-section; spout: a disk of
-the spout's diameter about the axis.
+the surface at :math:`v_0`). A batch that does not fit its slab (a dense stream from a narrow
+spout) is spread over a slab up to 8 times thicker, at most the drop height (the mean rate is
+kept). Rain: the footprint is the whole cross-section; spout: a disk of the spout's diameter
+about the axis.
 
 **Rate.** The default mass flow makes the surface rise one grain diameter :math:`d_v` in the
 time of a landed grain's first rebound flight, :math:`t_f = 2 e v_0 / g` (grain-grain
@@ -148,7 +150,8 @@ def default_rate(area_m2, diameter_m, density_kg_m3, porosity, restitution, spee
 
 def batch_interval(speed_m_s, bounding_radius_m, drop_height_m):
     """Time between two batches of the stream, s: the stream fills a slab 8 bounding radii thick
-    (``speed * tau``), at most half the drop height."""
+    (``speed * tau``), at most half the drop height (:func:`pour_grains` rounds it to whole
+    check intervals of steps)."""
     return min(8 * bounding_radius_m, 0.5 * drop_height_m) / speed_m_s
 
 
@@ -212,6 +215,20 @@ def _place(n, kind, size, z_lo, thickness, rb, old_x, rng, tries=200):
         raise ValueError(f"the stream is too dense to enter: {n} grains do not fit a slab "
                          f"{thickness:.3g} m thick over the footprint; lower the rate or widen the spout")
     return placed
+
+
+def _place_stream(n, kind, size, z_lo, thickness, rb, old_x, rng, drop_height_m):
+    """:func:`_place`, in a slab up to 8 times thicker (at most the drop height) when the batch
+    does not fit: a dense stream (a narrow spout) is spread over a longer stretch of its fall;
+    each batch still carries the mass of one batch interval, so the mean rate is kept."""
+    t = thickness
+    while True:
+        try:
+            return _place(n, kind, size, z_lo, t, rb, old_x, rng)
+        except ValueError:
+            if t >= min(8 * thickness, drop_height_m):
+                raise
+            t = min(2 * t, 8 * thickness, drop_height_m)
 
 
 def _grown(sim, template, x_new, v_new, q_new):
@@ -288,13 +305,20 @@ def pour_grains(container, template, *, material, fill=FillOptions(), n_grains, 
         rate, rate_source = float(fill.rate_kg_s), "given"
     m_grain = rho * template.volume_m3
     kind, size, spout_d = _footprint(container, fill, template)
+    if min(np.atleast_1d(size)) <= 0:
+        raise ValueError(f"the container ({', '.join(f'{v:g}' for v in container.size_m)} m across) is narrower "
+                         f"than a {template.name} grain ({2 * rb:.4g} m across its bounding sphere)")
     area_in = 4 * size[0] * size[1] if kind == "box" else math.pi * size**2
-    tau = batch_interval(v0, rb, fill.drop_height_m)
+    # the sphere engine's step (ClumpSimulation: its lightest sphere); batches every whole number
+    # of check intervals, so progress and checks fall on the same steps as a plain run
+    dt = 0.25 * math.sqrt(fill.mass_scale * rho * 4 / 3 * math.pi * float(template.radii.min()) ** 3
+                          / max(material.kn_n_m, material.ks_n_m))
+    steps_per_batch = check_every * max(1, round(batch_interval(v0, rb, fill.drop_height_m) / dt / check_every))
+    tau = steps_per_batch * dt
     per_batch = rate * tau / m_grain
     walls = container.walls(lid=False)
     sim = None
     carry, inserted, batches = 0.0, 0, 0
-    steps_per_batch = None
     while inserted < n_grains:
         carry += per_batch
         k = min(int(carry), n_grains - inserted)
@@ -306,7 +330,7 @@ def pour_grains(container, template, *, material, fill=FillOptions(), n_grains, 
                 surface, old = 0.0, np.empty((0, 3))
             else:
                 surface, old = _surface_for_entry(sim, kind, size, rb, v0), sim.X
-            x_new = _place(k, kind, size, surface + rb, v0 * tau, rb, old, rng)
+            x_new = _place_stream(k, kind, size, surface + rb, v0 * tau, rb, old, rng, fill.drop_height_m)
             s = x_new[:, 2] - (surface + rb)
             v_new = np.zeros((k, 3))
             v_new[:, 2] = -np.sqrt(np.maximum(v0**2 - 2 * G * s, 0.0))
@@ -315,7 +339,6 @@ def pour_grains(container, template, *, material, fill=FillOptions(), n_grains, 
                 sim = ClumpSimulation([template], np.zeros(k, int), x_new, q_new, np.ones(k), walls, material,
                                       mass_scale=fill.mass_scale)
                 sim.V[:] = v_new
-                steps_per_batch = max(1, int(round(tau / sim.dt)))
             else:
                 sim = _grown(sim, template, x_new, v_new, q_new)
             inserted += k
