@@ -114,14 +114,20 @@ def _check(args):
                        ("--seed", args.seed, 0)):
         if v < lo:
             raise ValueError(f"{opt} must be >= {lo}, got {v}")
+    core = network.core
+    core.check_count("--n-fe", args.n_fe, 1_000_000)
+    core.check_count("--n-extension", args.n_extension, 1_000_000, 0)
+    core.check_count("--n-batch", args.n_batch, 100_000_000)
+    core.check_count("--repeat", args.repeat, core.MAX_REPEATS)
     try:
         rtols = [float(v) for v in args.rtols.split(",") if v.strip()]
     except ValueError:
         rtols = []
     if not rtols or not all(math.isfinite(v) and 0 < v < 1 for v in rtols):
         raise ValueError(f"--rtols {args.rtols}: give comma-separated numbers, each in (0, 1)")
-    check_output(args.out, "--out")
     db = Path(args.db) if args.db else default_db_path()
+    check_output(args.out, "--out", inputs=[("--db", db)] + (
+        [("--reference", args.reference)] if args.reference else []))
     if db.is_dir():
         raise ValueError(f"--db {db}: is a folder, give a table file")
     if db.exists():
@@ -140,7 +146,7 @@ def _check(args):
         if rp.is_dir():
             raise ValueError(f"--reference {rp}: is a folder, give an .npz file")
         if not rp.exists():
-            check_output(rp, "--reference")              # written once its FE solves finish
+            check_output(rp, "--reference", inputs=[("--db", db)])   # written after its FE
             return db, rtols, None
         try:
             z = np.load(rp)

@@ -31,11 +31,12 @@ import sys
 import numpy as np
 
 import throats
+from network.core import MAX_WORKERS, check_count
 from throats.solve import OneLineParser, check_output, run_interruptible
 
 from ._csvio import read_throat_csv, row_problems, write_csv
 from ._interp import GRIDS
-from ._lookup import POLICIES, lookup_qstar
+from ._lookup import POLICIES, default_db_path, lookup_qstar
 from ._store import CacheFileError
 
 
@@ -83,14 +84,14 @@ def _main(argv):
     try:
         if not 0 < args.rtol < 1:
             raise ValueError(f"--rtol must be in (0, 1), got {args.rtol}")
-        if args.workers < 1:
-            raise ValueError(f"--workers must be >= 1, got {args.workers}")
+        check_count("--workers", args.workers, MAX_WORKERS)
         if args.grid is not None and args.grid not in GRIDS:
             raise ValueError(f"--grid {args.grid}: no such grid; the grids are "
                              f"{', '.join(GRIDS)}")
-        check_output(args.out)
+        check_output(args.out, inputs=[("--csv", args.csv),
+                                       ("--db", args.db or default_db_path())])
         if args.db is not None and not os.path.isfile(args.db):
-            check_output(args.db, "--db")      # to be created: its folder must exist, writable
+            check_output(args.db, "--db", inputs=[("--csv", args.csv)])   # to be created
         header, rows, radii, sides = read_throat_csv(args.csv, errors)
         res = lookup_qstar(radii, sides, db=args.db, policy=args.policy, rtol=args.rtol,
                            workers=args.workers, progress=not args.quiet, grid=args.grid)

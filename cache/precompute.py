@@ -34,6 +34,7 @@ import sqlite3
 import sys
 
 import throats
+from network.core import MAX_WORKERS, check_count
 from throats.solve import OneLineParser, check_output, run_interruptible
 
 from ._build import precompute_grid, precompute_throats, resolve_solver
@@ -91,16 +92,19 @@ def _check(args):
     """Every option and the CSV, before anything is written: ValueError/OSError."""
     if not 0 < args.rtol < 1:
         raise ValueError(f"--rtol must be in (0, 1), got {args.rtol}")
+    check_count("--workers", args.workers, MAX_WORKERS)
+    check_count("--batch-size", args.batch_size, 1_000_000)
     if args.workers < 1 or args.batch_size < 1:
         raise ValueError(f"--workers and --batch-size must be >= 1, got {args.workers} and "
                          f"{args.batch_size}")
     if args.max_hours is not None and not args.max_hours > 0:
         raise ValueError(f"--max-hours must be > 0, got {args.max_hours}")
-    check_output(args.db, "--db")
+    csv_in = [("--csv", args.csv)] if args.csv else []
+    check_output(args.db, "--db", inputs=csv_in)
     if args.export:
         if not args.grid:
             raise ValueError("--export needs --grid")
-        check_output(args.export, "--export")
+        check_output(args.export, "--export", inputs=csv_in + [("--db", args.db)])
     elif args.orbits:
         raise ValueError("--orbits needs --export")
     if not args.csv:

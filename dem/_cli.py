@@ -16,16 +16,21 @@ import math
 import sys
 import time
 
-from network.core import (EXIT_BAD_INPUT, EXIT_FAILED, CliError, CliParser, bad_input,
-                          check_output_list, run)
+from network.core import (EXIT_BAD_INPUT, EXIT_FAILED, MAX_REPEATS, MAX_SPHERES, MAX_WORKERS,
+                          CliError, CliParser, bad_input, check_count, check_output_list, run)
 
 from ._container import SCENES, Container
 from ._integrate import DemInstabilityError
 from ._perf import tune_malloc
 
 __all__ = ["EXIT_BAD_INPUT", "EXIT_FAILED", "EXIT_UNSTABLE", "run_main", "progress_printer",
-           "resolve_container", "check_output", "check_seed", "OneLineParser"]
+           "resolve_container", "check_output", "check_output_list", "check_seed",
+           "check_count", "check_counts", "OneLineParser", "MAX_STEPS", "MAX_SPHERES",
+           "MAX_WORKERS", "MAX_REPEATS"]
 
+#: Most steps a ``--max-steps``/``--steps``/``--settle-steps`` may ask for (a billion steps
+#: of a few thousand particles is days of computing: a larger number is a slip)
+MAX_STEPS = 10**9
 #: A simulation that went unstable: a failed computation (exit 1).
 EXIT_UNSTABLE = EXIT_FAILED
 #: What an interrupted dem command says was kept.
@@ -108,6 +113,17 @@ def check_output(path, option="--out", inputs=()) -> None:
     ``inputs`` (``(what, path)`` pairs): :func:`network.core.check_output_list`, missing
     folders made on writing."""
     check_output_list([(option, path)], inputs, make_folders=True)
+
+
+def check_counts(args) -> None:
+    """ValueError naming the option when a count of a dem command is out of its bounds
+    (:func:`network.core.check_count`): particles and grains up to ``MAX_SPHERES``, steps up
+    to :data:`MAX_STEPS`, threads up to ``MAX_WORKERS``, packings up to 100."""
+    for opt, high in (("n_particles", MAX_SPHERES), ("n_grains", MAX_SPHERES),
+                      ("max_steps", MAX_STEPS), ("sediment_steps", MAX_STEPS),
+                      ("settle_steps", MAX_STEPS), ("threads", MAX_WORKERS),
+                      ("max_packings", 100)):
+        check_count("--" + opt.replace("_", "-"), getattr(args, opt, None), high)
 
 
 def check_seed(seed, option="--seed") -> None:

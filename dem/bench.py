@@ -31,7 +31,8 @@ from pathlib import Path
 
 import numpy as np
 
-from ._cli import EXIT_FAILED, OneLineParser, check_output, run_main
+from ._cli import (EXIT_FAILED, MAX_REPEATS, MAX_SPHERES, MAX_STEPS, MAX_WORKERS, OneLineParser,
+                   check_count, check_output_list, run_main)
 from ._container import Container, make_simulation
 from ._procedures import PackOptions, RunOptions, pack_bed
 from .clumps import ClumpSimulation
@@ -225,15 +226,16 @@ def _parser():
 
 def _check_args(args) -> None:
     """ValueError naming the option for any bad value or combination, before any work."""
-    def positive(opt, vals):
+    def positive(opt, vals, high=MAX_SPHERES):
         for v in vals:
             if v is not None and v < 1:
                 raise ValueError(f"{opt} must be >= 1, got {v}")
+            check_count(opt, v, high)
 
     positive("--n", args.n or [])
-    positive("--repeat", [args.repeat])
-    positive("--steps", [args.steps])
-    positive("--threads", [args.threads])
+    positive("--repeat", [args.repeat], MAX_REPEATS)
+    positive("--steps", [args.steps], MAX_STEPS)
+    positive("--threads", [args.threads], MAX_WORKERS)
     positive("--grains", args.grains or [])
     positive("--grain-pack", [args.grain_pack])
     for v in args.scales or []:
@@ -248,9 +250,8 @@ def _check_args(args) -> None:
         raise ValueError(f"--n: the sphere rates only, not with {modes[0]}")
     if args.scales and not args.mass_scale_study:
         raise ValueError("--scales: only with --mass-scale-study")
-    if args.study:
-        check_output(Path(args.study) / "study.json", "--study")
-    check_output(args.json, "--json")
+    outputs = [("--study", Path(args.study) / "study.json")] if args.study else []
+    check_output_list(outputs + [("--json", args.json)], make_folders=True)
     folder = Path(args.json).parent
     if not folder.is_dir():
         raise ValueError(f"--json {args.json}: folder {folder} does not exist")

@@ -36,7 +36,7 @@ from pathlib import Path
 import numpy as np
 from network.core import check_physical_porosity, reach_text, recorded_reach
 
-from ._cli import (EXIT_FAILED, check_output, check_seed, progress_printer, resolve_container,
+from ._cli import (EXIT_FAILED, check_counts, check_output, check_seed, progress_printer, resolve_container,
                    run_main)
 from ._container import SCENE_DEFAULTS, SCENES, default_measure_spheres
 from ._material import Material
@@ -287,14 +287,16 @@ def _procedure_options(args):
 
 def _check_outputs(args):
     """ValueError naming --out when the packing, its JSON summary or (--grain) its grain table
-    cannot be written, before any work."""
-    check_output(args.out)
+    cannot be written or is the --grain template file, before any work."""
+    inputs = [("--grain", Path(args.grain))] if args.grain is not None and Path(
+        str(args.grain)).is_file() else []
+    check_output(args.out, inputs=inputs)
     files = [summary_path(args.out)] + ([grains_path(args.out)] if args.grain is not None else [])
     for f in files:
         if f.resolve() == Path(args.out).resolve():
             raise ValueError(f"--out {args.out}: the packing would overwrite its own {f.name}; "
                              "give a .csv name")
-        check_output(f, f"--out {args.out}: companion")
+        check_output(f, f"--out {args.out}: companion", inputs=inputs)
 
 
 _POUR_ONLY = (("--drop-height", "drop_height"), ("--rate", "rate"), ("--spout-diameter", "spout_diameter"),
@@ -467,6 +469,7 @@ def _pack(args) -> int:
     check_seed(args.seed)
     if args.max_steps is not None and args.max_steps < 1:
         raise ValueError(f"--max-steps must be >= 1, got {args.max_steps}")
+    check_counts(args)
     fill = _fill_options(args)
     _check_outputs(args)
     if args.porosity is not None:       # a porosity no bed has: refused before any packing

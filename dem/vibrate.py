@@ -22,11 +22,11 @@ from pathlib import Path
 
 import numpy as np
 
-from ._cli import check_seed, progress_printer, resolve_container, run_main
+from ._cli import check_counts, check_output_list, check_seed, progress_printer, resolve_container, run_main
 from ._container import SCENES
 from ._integrate import DemInstabilityError
 from ._material import Material
-from ._io import read_packing, write_packing
+from ._io import read_packing, summary_path, write_packing
 from ._procedures import RunOptions
 from ._vibrate import SETTLE_RUN, VibrationOptions, intensity_g, vibrate_bed
 from .study import run_study
@@ -95,8 +95,23 @@ def _amplitudes(args):
     return amps
 
 
+def _check_files(args, out, amps) -> None:
+    """ValueError naming --out when a file the run writes in ``out`` (each amplitude's packing,
+    summary and snapshots, the series) cannot be written or is the input packing or its JSON
+    summary (:func:`network.core.check_output_list`), before any work."""
+    names = []
+    for amp in amps:
+        tag = f"vib_{amp * 1e3:g}mm"
+        names += [f"{tag}.csv", f"{tag}.json"] + [f"{tag}_t{t:g}.csv" for t in args.snapshots]
+    names += ["series.json"] if len(amps) > 1 else []
+    inputs = [("the packing", Path(args.packing)),
+              ("the packing's JSON summary", summary_path(args.packing))]
+    check_output_list([("--out", out / n) for n in names], inputs, make_folders=True)
+
+
 def _vibrate(args) -> int:
     check_seed(args.seed)
+    check_counts(args)
     amps = _amplitudes(args)
     if args.study:
         if args.packing:
@@ -117,6 +132,7 @@ def _vibrate(args) -> int:
                                    rest_tol=args.rest_tol if args.rest_tol > 0 and amp == amps[0] else None)
                   for amp in amps]                      # every option checked before any work
     out = Path(args.out or "vibration_out")
+    _check_files(args, out, amps)
     out.mkdir(parents=True, exist_ok=True)
     rows = []
     for amp, vibration in zip(amps, vibrations):

@@ -17,7 +17,8 @@ import os
 from pathlib import Path
 
 from ._air import MU_AIR_PA_S, P_ATM_PA, RHO_AIR_KG_M3, check_positive
-from .core import (EXIT_BAD_INPUT, EXIT_FAILED, EXIT_OK, CliError, CliParser, bad_input,
+from .core import (EXIT_BAD_INPUT, EXIT_FAILED, EXIT_OK, MAX_WORKERS, CliError, CliParser,
+                   bad_input, check_count,
                    check_output_list, check_outputs, check_writable_folder, computing, finish,
                    progress_log, run, warn)
 from .conductance import first_run_note
@@ -184,8 +185,7 @@ def check_common(args) -> None:
     if getattr(args, "margin", None) is not None and not args.margin >= 0:
         raise ValueError(f"--margin must be >= 0 (packing units), got {args.margin!r}")
     for name in ("workers", "threads"):
-        if getattr(args, name, 1) < 1:
-            raise ValueError(f"--{name} must be >= 1, got {getattr(args, name)!r}")
+        check_count(f"--{name}", getattr(args, name, None), MAX_WORKERS)
 
 
 def load_packing(args):

@@ -45,6 +45,7 @@ from pathlib import Path
 
 from ._cli import (EXIT_OK, CliParser, bad_input, check_outputs, check_writable_folder, computing,
                    run)
+from .core import MAX_REPEATS, MAX_SPHERES, MAX_WORKERS, check_count
 from .benchmarks import (REF_LATTICE_CASES, REF_RANDOM_POROSITIES, baseline_source, has_grid,
                          inertial_lines, inertial_speed, inertial_validation, lattice_case,
                          machine, per_packing, policies, policy_lines, references,
@@ -144,10 +145,12 @@ def main(argv=None) -> int:
     return code
 
 
-def _at_least(option: str, values, low) -> None:
+def _at_least(option: str, values, low, high=None) -> None:
     for v in values:
         if v is not None and v < low:
             raise ValueError(f"{option} must be >= {low}, got {v}")
+        if high is not None:
+            check_count(option, v, high, low)
 
 
 def _porosities(option: str, values) -> None:
@@ -173,17 +176,16 @@ def _check(args) -> None:
     if len(alone) > 1:
         raise ValueError(f"{' and '.join(alone)} exclude each other: each runs alone "
                          "(see --help)")
-    if args.inertial_workers is not None and args.inertial_workers < 1:
-        raise ValueError(f"--inertial-workers must be >= 1, got {args.inertial_workers}")
+    check_count("--inertial-workers", args.inertial_workers, MAX_WORKERS)
     if (args.yade or args.baseline) and not args.per_packing:
         raise ValueError("--yade and --baseline go with --per-packing (and not --inertial)")
     if args.references_only and args.skip_references:
         raise ValueError("--references-only and --skip-references exclude each other")
-    _at_least("--ref-repeats", [args.ref_repeats], 1)
-    _at_least("--workers", [args.workers], 1)
+    _at_least("--ref-repeats", [args.ref_repeats], 1, MAX_REPEATS)
+    _at_least("--workers", [args.workers], 1, MAX_WORKERS)
     for opt in ("--sizes", "--policy-spheres", "--inertial-spheres", "--ref-spheres"):
         value = getattr(args, opt[2:].replace("-", "_"))
-        _at_least(opt, value if isinstance(value, list) else [value], MIN_SPHERES)
+        _at_least(opt, value if isinstance(value, list) else [value], MIN_SPHERES, MAX_SPHERES)
     _at_least("--seed", [args.seed], 0)
     _at_least("--ref-seed", [args.ref_seed], 0)
     if not (math.isfinite(args.timeout) and args.timeout > 0):
@@ -202,14 +204,14 @@ def _check(args) -> None:
         args.sizes = [5000, 20000] if args.per_packing else [5000, 20000, 100000]
     if args.repeats is None:
         args.repeats = 7 if args.per_packing else 2
-    _at_least("--repeats", [args.repeats], 1)
+    _at_least("--repeats", [args.repeats], 1, MAX_REPEATS)
 
 
 def _main(args) -> int:
     with bad_input():
         _check(args)
         if not args.one:
-            check_outputs(json=args.json_out)
+            check_outputs(json=args.json_out, inputs=[("--db", args.db)])
             args.workdir = Path(args.workdir or Path.home() / ".cache" / "grainflow" / "bench")
             _check_workdir(args.workdir)
         if args.baseline:   # the last check: a commit is extracted here, removed by per_packing

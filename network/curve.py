@@ -51,29 +51,62 @@ KEYS = ["velocity_m_s", "reynolds_particle", "pressure_gradient_pa_per_m",
         "apparent_permeability_m2", "converged"]
 
 
+#: Most velocities one run solves (``--velocities``): a curve is drawn well by a dozen
+MAX_VELOCITIES = 200
+#: What ``--velocities`` takes, for its messages
+VELOCITY_FORMS = ("a comma-separated list (0.01,0.05,0.1) or start:stop:n, n log-spaced points "
+                  "from start to stop (0.01:0.3:8), m/s")
+
+
 def parse_velocities(text: str) -> list[float]:
-    """``'a,b,c'`` or ``'start:stop:n'`` (n log-spaced points) → velocities, m/s (> 0).
+    """``'a,b,c'`` or ``'start:stop:n'`` (n log-spaced points) → velocities, m/s (> 0), each once
+    (a repeated value is solved once), at most :data:`MAX_VELOCITIES`; ValueError saying which
+    form is expected.
 
     >>> parse_velocities("0.01:1:3")
     [0.01, 0.1, 1.0]
+    >>> parse_velocities("0.1, 0.01, 0.1")
+    [0.1, 0.01]
     """
-    try:
-        if ":" in text:
-            a, b, n = text.split(":")
-            start, stop = check_positive("--velocities start", a), check_positive(
-                "--velocities stop", b)
-            if int(n) < 1:
-                raise ValueError(f"--velocities needs n >= 1, got {n!r}")
-            vals = [float(v) for v in np.geomspace(start, stop, int(n))]
-        else:
-            vals = [float(v) for v in text.split(",") if v.strip()]
-    except ValueError as exc:
-        raise ValueError(f"--velocities {text!r}: {exc}") from exc
+    where = f"--velocities {text!r}"
+    if ":" in text:
+        parts = [p.strip() for p in text.split(":")]
+        if len(parts) != 3:
+            raise ValueError(f"{where}: {len(parts)} parts; give {VELOCITY_FORMS}")
+        ends = []
+        for name, part in zip(("start", "stop"), parts):
+            try:
+                ends.append(float(part))
+            except ValueError:
+                raise ValueError(f"{where}: {name} {part!r} is not a number; give "
+                                 f"{VELOCITY_FORMS}") from None
+            check_positive(f"--velocities {name}", ends[-1])
+        try:
+            n = int(parts[2])
+        except ValueError:
+            raise ValueError(f"{where}: n {parts[2]!r} is not a whole number of points; give "
+                             f"{VELOCITY_FORMS}") from None
+        if not 1 <= n <= MAX_VELOCITIES:
+            raise ValueError(f"{where}: n must be 1 to {MAX_VELOCITIES} points, got {n}")
+        vals = [float(v) for v in np.geomspace(ends[0], ends[1], n)]
+    else:
+        vals = []
+        for part in (p.strip() for p in text.split(",")):
+            if not part:
+                continue
+            try:
+                vals.append(float(part))
+            except ValueError:
+                raise ValueError(f"{where}: {part!r} is not a number; give "
+                                 f"{VELOCITY_FORMS}") from None
     if not vals:
-        raise ValueError(f"--velocities {text!r} is empty")
+        raise ValueError(f"{where} is empty; give {VELOCITY_FORMS}")
     for v in vals:
         check_positive(f"--velocities value {v!r}", v)
-    return [round(v, 15) for v in vals]
+    vals = list(dict.fromkeys(round(v, 15) for v in vals))       # each velocity solved once
+    if len(vals) > MAX_VELOCITIES:
+        raise ValueError(f"{where}: {len(vals)} velocities, at most {MAX_VELOCITIES}")
+    return vals
 
 
 def build_parser() -> CliParser:

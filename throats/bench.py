@@ -237,8 +237,7 @@ def main(argv=None) -> int:
 def _main(argv):
     args = _parser().parse_args(argv)
     try:
-        if args.n < 1:
-            raise ValueError(f"--n must be >= 1, got {args.n}")
+        network.core.check_count("--n", args.n, network.core.MAX_SPHERES)
         if args.seed < 0:
             raise ValueError(f"--seed must be >= 0, got {args.seed}")
         for rt in args.rtols:

@@ -36,7 +36,7 @@ import time
 
 import numpy as np
 
-from network.core import read_table
+from network.core import MAX_WORKERS, check_output_list, read_table
 
 from ._area import open_area
 from ._geometry import contact_type, mean_radius, validate_throats
@@ -57,22 +57,11 @@ class OneLineParser(argparse.ArgumentParser):
         raise SystemExit(2)
 
 
-def check_output(path, option="--out"):
-    """ValueError naming ``option`` if ``path`` cannot be written: a folder, a missing folder,
-    a folder where no file can be made (probed by creating and removing a temporary file there,
-    since ``os.access`` says yes to root even on ``/proc``), an existing file not writable."""
-    folder = os.path.dirname(os.path.abspath(path))
-    if os.path.isdir(path):
-        raise ValueError(f"{option} {path} is a folder, not a file")
-    if not os.path.isdir(folder):
-        raise ValueError(f"{option} {path}: folder {folder} does not exist")
-    try:
-        tempfile.TemporaryFile(dir=folder, prefix=".grainflow-").close()
-    except OSError as exc:
-        raise ValueError(f"{option} {path}: folder {folder} is not writable "
-                         f"({exc.strerror or exc})") from None
-    if os.path.exists(path) and not os.access(path, os.W_OK):
-        raise ValueError(f"{option} {path}: file exists and is not writable")
+def check_output(path, option="--out", inputs=()):
+    """ValueError naming ``option`` if ``path`` cannot be written (a folder, a missing folder, a
+    folder that takes no new file, an existing file not writable) or is one of ``inputs``
+    (``(option, path)`` pairs): :func:`network.core.check_output_list`."""
+    check_output_list([(option, path)], inputs)
 
 
 def _parser():
@@ -184,8 +173,8 @@ def _main(argv):
     args = parser.parse_args(argv)
     if not (0 < args.rtol < 1):
         parser.error(f"--rtol must be in (0, 1), got {args.rtol}")
-    if args.workers < 1:
-        parser.error(f"--workers must be >= 1, got {args.workers}")
+    if not 1 <= args.workers <= MAX_WORKERS:
+        parser.error(f"--workers must be 1 to {MAX_WORKERS}, got {args.workers}")
     if args.radii is not None:
         if args.sides is None:
             parser.error("--radii needs --sides L12 L13 L23")
@@ -209,7 +198,7 @@ def _main(argv):
     if not args.out:
         parser.error("--csv needs --out OUT.csv")
     try:
-        check_output(args.out)
+        check_output(args.out, inputs=[("--csv", args.csv)])
         rows, fields, vals, parse_err = _read_csv(args.csv)
     except (OSError, ValueError) as exc:
         msg = f"{exc.strerror}: {exc.filename}" if isinstance(exc, OSError) else exc

@@ -13,8 +13,8 @@ SciPy's ``sparse`` and ``spatial`` load on first use (grain checks only), never 
 ``import dem`` pays for NumPy alone here. Nothing here imports another layer of ``network``.
 """
 
-from ._cli import (EXIT_BAD_INPUT, EXIT_FAILED, EXIT_OK, CliError, CliParser, bad_input,
-                   check_output_list, check_outputs, check_writable_folder, computing, finish,
+from ._cli import (EXIT_BAD_INPUT, EXIT_FAILED, EXIT_OK, MAX_REPEATS, MAX_SPHERES, MAX_WORKERS,
+                   CliError, CliParser, bad_input, check_count, check_output_list, check_outputs, check_writable_folder, computing, finish,
                    progress_log, run, same_file, warn)
 from ._io import (FORMATS, UNITS, default_packing_path, read_container, read_packing,
                   read_summary, summary_path, write_packing_csv, write_summary)
@@ -33,4 +33,5 @@ __all__ = ["EXIT_BAD_INPUT", "EXIT_FAILED", "EXIT_OK", "FORMATS", "KEPLER_POROSI
            "default_packing_path", "finish", "grain_volumes", "progress_log", "reach_text",
            "read_container", "read_packing", "read_summary", "recorded_reach", "run", "same_file",
            "scale_warning", "summary_path", "validate_spheres", "warn", "write_packing_csv",
-           "write_summary", "read_text", "read_table", "split_fields", "delimiter_of"]
+           "write_summary", "read_text", "read_table", "split_fields", "delimiter_of",
+           "check_count", "MAX_WORKERS", "MAX_SPHERES", "MAX_REPEATS"]

@@ -24,7 +24,8 @@ from pathlib import Path
 
 __all__ = ["EXIT_OK", "EXIT_FAILED", "EXIT_BAD_INPUT", "CliError", "CliParser", "bad_input",
            "computing", "run", "warn", "progress_log", "finish", "check_outputs",
-           "check_output_list", "check_writable_folder", "same_file"]
+           "check_output_list", "check_writable_folder", "same_file", "check_count",
+           "MAX_WORKERS", "MAX_SPHERES", "MAX_REPEATS"]
 
 EXIT_OK, EXIT_FAILED, EXIT_BAD_INPUT = 0, 1, 2
 #: a number, negative ones and exponents included: argparse's own pattern misses ``-1.8e-5``
@@ -216,6 +217,31 @@ def _flush() -> None:
 
 
 
+#: Largest ``--workers``/``--threads`` any command takes (far above any machine's cores: a
+#: larger number is a typing slip, and each worker is a process or a thread started)
+MAX_WORKERS = 1024
+#: Largest count of spheres, particles or grains a command is asked to make or take
+MAX_SPHERES = 10_000_000
+#: Largest ``--repeat(s)`` of a benchmark
+MAX_REPEATS = 1000
+
+
+def check_count(option: str, value, high: int, low: int = 1) -> None:
+    """ValueError naming ``option`` unless ``value`` (None: not given) is a whole number in
+    ``low``..``high``: every count or size option is bounded before any work.
+
+    >>> check_count("--workers", 4, MAX_WORKERS)
+    >>> check_count("--workers", 10**6, MAX_WORKERS)
+    Traceback (most recent call last):
+    ...
+    ValueError: --workers must be 1 to 1024, got 1000000
+    """
+    if value is None:
+        return
+    if isinstance(value, bool) or int(value) != value or not low <= value <= high:
+        raise ValueError(f"{option} must be {low} to {high}, got {value}")
+
+
 def check_outputs(*, inputs=(), **paths) -> None:
     """ValueError unless every given output path (``option=path``; None skipped) can be
     written: see :func:`check_output_list` (``inputs``: ``(what, path)`` pairs)."""
@@ -234,7 +260,7 @@ def same_file(a, b) -> bool:
         return False
 
 
-def check_output_list(pairs, inputs=(), *, make_folders: bool = False) -> None:
+def check_output_list(pairs, inputs=(), *, make_folders: bool = False, others=()) -> None:
     """ValueError naming the option unless every output can be written and none is an input.
 
     Parameters
@@ -247,6 +273,8 @@ def check_output_list(pairs, inputs=(), *, make_folders: bool = False) -> None:
     make_folders : bool
         Missing folders are made when the output is written (the nearest existing folder must
         take a new file); otherwise the output's folder must exist.
+    others : iterable of (option, path)
+        Outputs checked by another call (under other folder rules), compared with these.
 
     Each output must not be a folder, its folder must take a new file (tried: a temporary
     file made and removed, which ``os.access`` cannot tell for root or a read-only mount), an
@@ -255,6 +283,7 @@ def check_output_list(pairs, inputs=(), *, make_folders: bool = False) -> None:
     """
     seen = [(what, p) for what, p in inputs if p is not None]
     n_inputs = len(seen)
+    seen += [(what, p) for what, p in others if p is not None]
     for opt, p in pairs:
         if p is None:
             continue

@@ -8,7 +8,7 @@ on (3, M) component rows.
 """
 
 from ._merge import PoreMerge, circumspheres, merge_pores
-from ._porosity import region_porosity
+from ._porosity import OverlapError, region_porosity
 from ._region import (AXES, MIN_INTERIOR_DIAMETERS, OUTSIDE_BED_DIAMETERS, NoInteriorError,
                       Region, axis_index, check_inside_bed, default_region, sample_region)
 from ._simplex import column_norm, cross_components
@@ -21,4 +21,5 @@ __all__ = ["AXES", "MIN_INTERIOR_DIAMETERS", "OUTSIDE_BED_DIAMETERS", "QHULL_OPT
            "PoreMerge", "Region", "SampleNetwork", "Tessellation", "axis_index", "body_centroids",
            "check_inside_bed", "circumspheres", "column_norm", "cross_components",
            "default_region", "merge_pores", "prune_disconnected", "region_porosity", "sample_region", "sample_throats",
-           "select_sample", "tessellate", "tie_groups", "EmptySampleError", "NoInteriorError"]
+           "select_sample", "tessellate", "tie_groups", "EmptySampleError", "NoInteriorError",
+           "OverlapError"]

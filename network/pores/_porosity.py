@@ -30,13 +30,39 @@ import numpy as np
 
 from .._deferred import spatial
 
-__all__ = ["region_porosity", "POROSITY_METHODS", "disk_rectangle_area", "circle_lens_area",
+__all__ = ["region_porosity", "POROSITY_METHODS", "MAX_EXACT_ERROR", "OverlapError", "disk_rectangle_area", "circle_lens_area",
            "sphere_region_volume"]
 
 log = logging.getLogger(__name__)
 
 #: Porosity methods of :func:`region_porosity`.
 POROSITY_METHODS = ("exact", "monte-carlo")
+#: Largest error bound of the exact porosity taken (its pairwise lens correction misses what
+#: three or more spheres share): above it the spheres overlap too much to be separate grains
+MAX_EXACT_ERROR = 0.1
+
+
+class OverlapError(ValueError):
+    """Spheres of different grains overlap so much that the bed is no packing of separate
+    grains (typically multi-sphere grains written without their ``grain_id`` column): an input
+    fault (``bad_input``: exit 2 in a CLI), with a sentence saying what to give."""
+
+    bad_input = True
+
+    def __init__(self, packing, porosity, error, tree):
+        c, r = packing.centers, packing.radii
+        g = np.arange(packing.n) if packing.grain_id is None else packing.grain_id
+        pairs = tree.query_pairs(2.0 * float(r.max()), output_type="ndarray")
+        i, j = pairs[:, 0], pairs[:, 1]
+        deep = (g[i] != g[j]) & (np.linalg.norm(c[i] - c[j], axis=1)
+                                 < r[i] + r[j] - 0.2 * np.minimum(r[i], r[j]))
+        n = np.unique(np.concatenate([i[deep], j[deep]])).size
+        super().__init__(
+            f"{packing.source + ': ' if packing.source else ''}{n} of {packing.n} spheres "
+            f"overlap a sphere of another grain by more than a fifth of its radius (the "
+            f"porosity comes out {porosity:.3g} +- {error:.2g}): this is no packing of separate "
+            f"grains. If its spheres make multi-sphere grains, give each grain's spheres one "
+            f"id in a grain_id column")
 #: Gauss-Legendre nodes per smooth piece of a cut sphere.
 _NODES = 16
 
@@ -281,6 +307,8 @@ def region_porosity(packing, region, axis: int, *, method: str = "exact",
         method = "monte-carlo"
     if method == "exact":
         eps, err = _exact(packing, region, int(axis), tree)
+        if not 0 < eps < 1 or err > MAX_EXACT_ERROR:
+            raise OverlapError(packing, eps, err, tree)
         log.info("region porosity %.5f (error < %.1e, exact sphere-region volumes)", eps, err)
     else:
         eps, err = _monte_carlo(packing, region, int(axis), tree, n_points, rng)

@@ -85,7 +85,10 @@ log = logging.getLogger(__name__)
 
 class NoInteriorError(ValueError):
     """The packing leaves no default interior sample: ``reason`` says why, ``advice`` (the
-    CLIs' options) what to give instead; the message is both."""
+    CLIs' options) what to give instead; the message is both. An input fault (``bad_input``:
+    exit 2 in every command, also where it is found while computing)."""
+
+    bad_input = True
 
     def __init__(self, reason: str, advice: str, sep: str = "; "):
         super().__init__(f"{reason}{sep}{advice}")

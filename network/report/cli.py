@@ -15,8 +15,8 @@ from pathlib import Path
 import numpy as np
 
 from .._cli import (CliError, CliParser, add_air, add_sample, bad_input, check_common,
-                    check_outputs, check_plot, computing, load_packing, packing_inputs,
-                    progress_log, run, sample_box_m, warn_curve)
+                    check_output_list, check_outputs, check_plot, computing, load_packing,
+                    packing_inputs, progress_log, run, sample_box_m, warn_curve)
 from .._grains import BED, D272, grains_with_d272, packing_grain
 from ..curve import DEFAULT_VELOCITIES, parse_velocities
 from ..flow import DEFAULT_DEPTH_M
@@ -24,7 +24,7 @@ from ..packing import UNITS
 from .band import BAND_OFFSETS
 from .bed import add_bed_options, bed_json, plan_bed, prepare_bed
 from .build import build_report
-from .figures import write_figures, write_html
+from .figures import FIGURES, write_figures, write_html
 from .options import ReportOptions, grain_key
 from .porosity import (bundled_grains, bundled_packing, check_reachable, packing_meta,
                        reach_record, requested_porosity)
@@ -155,7 +155,8 @@ def _check(args) -> dict:
         if args.diameter is None and args.floor_area is None:
             raise ValueError("--fan needs the bin: --diameter (round) or --floor-area")
         fan = read_fan(args.fan)
-    check_outputs(json=args.json_out, html=args.html, inputs=packing_inputs(args))
+    inputs = packing_inputs(args) + ([("--fan", args.fan)] if args.fan is not None else [])
+    check_outputs(json=args.json_out, html=args.html, inputs=inputs)
     if args.plot_dir is not None and not Path(args.plot_dir).is_dir():
         raise ValueError(f"--plot-dir {args.plot_dir}: not an existing folder")
     if args.html or args.plot_dir:
@@ -167,6 +168,10 @@ def _check(args) -> dict:
             raise ValueError(f"{plot_dir} exists and is not a folder: give --plot-dir or "
                              "--no-figures")
         check_plot("the figures (or give --no-figures)")
+    if plot_dir is not None:          # the figure files it names itself
+        check_output_list([("--plot-dir", Path(plot_dir) / f"report_{n}.png") for n in FIGURES],
+                          inputs, make_folders=True,
+                          others=[("--json", args.json_out), ("--html", args.html)])
     return {"grain": key, "particle_density": rho_p, "particle_density_source": rho_src,
             "airflow": airflow, "fan": fan, "velocities": parse_velocities(args.velocities),
             "porosity": target, "porosity_source": why, "reachable": reach,
