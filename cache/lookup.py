@@ -84,6 +84,8 @@ def _main(argv):
     try:
         if not 0 < args.rtol < 1:
             raise ValueError(f"--rtol must be in (0, 1), got {args.rtol}")
+        if args.workers < 1:
+            raise ValueError(f"--workers must be >= 1, got {args.workers}")
         check_count("--workers", args.workers, MAX_WORKERS)
         if args.grid is not None and args.grid not in GRIDS:
             raise ValueError(f"--grid {args.grid}: no such grid; the grids are "

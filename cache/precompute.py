@@ -92,11 +92,11 @@ def _check(args):
     """Every option and the CSV, before anything is written: ValueError/OSError."""
     if not 0 < args.rtol < 1:
         raise ValueError(f"--rtol must be in (0, 1), got {args.rtol}")
-    check_count("--workers", args.workers, MAX_WORKERS)
-    check_count("--batch-size", args.batch_size, 1_000_000)
     if args.workers < 1 or args.batch_size < 1:
         raise ValueError(f"--workers and --batch-size must be >= 1, got {args.workers} and "
                          f"{args.batch_size}")
+    check_count("--workers", args.workers, MAX_WORKERS)
+    check_count("--batch-size", args.batch_size, 1_000_000)
     if args.max_hours is not None and not args.max_hours > 0:
         raise ValueError(f"--max-hours must be > 0, got {args.max_hours}")
     csv_in = [("--csv", args.csv)] if args.csv else []
