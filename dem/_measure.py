@@ -2,9 +2,9 @@ r"""Porosity and coordination measurements on sphere packings.
 
 * Local porosity in measurement spheres (thesis B1–B5, PFC3D ``measure``): exact
   sphere–sphere lens volumes.
-* Porosity of a box or cylinder region: spheres wholly inside count fully; the part of a
-  sphere cut by the region boundary inside it by a quadrature split at every kink
-  (:mod:`dem._cut_volume`: within 2e-6 of a sphere's volume).
+* Porosity of a box or vertical cylinder region: the project's one estimator,
+  :func:`network.core.region_porosity` (exact sphere-region volumes, overlapping pairs'
+  lenses counted once), on the region as :class:`network.core.Region` (:meth:`Region.to_core`).
 * Coordination numbers: neighbours within a cutoff distance (thesis: 1.05 d_max) and
   true contacts (overlap > −tol).
 """
@@ -16,7 +16,8 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.spatial import cKDTree
 
-from ._cut_volume import cut_volume
+from network.core import Packing, region_porosity
+from network.core import Region as CoreRegion
 
 __all__ = [
     "Region",
@@ -125,28 +126,26 @@ class Region:
             dxy = self.radius - rho
         return np.minimum(dxy, dz)
 
+    def to_core(self) -> CoreRegion:
+        """The same region as the project's :class:`network.core.Region` (a cylinder along z
+        about ``center_xy``)."""
+        lo, hi = np.asarray(self.lo, float), np.asarray(self.hi, float)
+        if self.kind == "box":
+            return CoreRegion(lo, hi)
+        cx, cy, rad = float(self.center_xy[0]), float(self.center_xy[1]), float(self.radius)
+        return CoreRegion([cx - rad, cy - rad, lo[2]], [cx + rad, cy + rad, hi[2]], radius=rad)
+
     def to_dict(self):
         return {"kind": self.kind, "lo": list(map(float, self.lo)), "hi": list(map(float, self.hi)),
                 "radius": float(self.radius), "center_xy": list(map(float, self.center_xy))}
 
 
-def porosity_in_region(centers, radii, region, *, chunk=256):
-    """Porosity of a Region, 1 − (solid volume inside)/(region volume).
-
-    Spheres wholly inside count fully; those cut by the boundary by
-    :func:`dem._cut_volume.cut_volume` (within 2e-6 of a sphere's volume each).
-    """
-    centers = np.asarray(centers, dtype=float)
-    radii = np.asarray(radii, dtype=float)
-    sd = region.signed_distance(centers)
-    full = sd >= radii
-    cut = np.flatnonzero((sd > -radii) & ~full)
-    solid = float(sphere_volume(radii[full]).sum())
-    for s in range(0, len(cut), chunk):
-        k = cut[s : s + chunk]
-        solid += float(np.sum(cut_volume(centers[k], radii[k], region.kind, region.lo, region.hi,
-                                         region.radius, region.center_xy)))
-    return 1.0 - solid / region.volume
+def porosity_in_region(centers, radii, region):
+    """Porosity of a Region, 1 − (solid volume inside)/(region volume): the project's one
+    estimator, :func:`network.core.region_porosity` (exact volumes of the spheres the region
+    cuts, overlapping pairs' lenses counted once), along z."""
+    packing = Packing(np.asarray(centers, dtype=float), np.asarray(radii, dtype=float))
+    return region_porosity(packing, region.to_core(), 2)[0]
 
 
 #: relative distance within which two spheres touch for :func:`coordination_numbers`: spheres

@@ -1,11 +1,11 @@
-"""dem's region porosity: the volume of a sphere cut by a box or a cylinder (dem._cut_volume)
-against exact volumes, and a whole region against network's exact sphere-region porosity."""
+"""dem's region porosity is the project's one estimator (network.core.region_porosity) on dem's
+vertical box and cylinder regions: exact against closed forms, with a cylinder about any axis
+point (center_xy), and the region's own volume."""
 
 import numpy as np
 import pytest
 
 from dem import Container, Region, generate_spheres, porosity_in_region
-from dem._cut_volume import cut_volume
 
 V1 = 4.0 / 3.0 * np.pi
 
@@ -14,51 +14,37 @@ def cap(h):
     return np.pi * h * h * (3.0 - h) / 3.0             # unit sphere, cap of height h
 
 
-@pytest.mark.parametrize("axis", [0, 1, 2])
-def test_a_plane_cut_gives_the_cap(axis):
-    # the point count this replaced was off by up to 4.5 % of the sphere
-    t = np.linspace(-0.99, 0.99, 67)
-    got = []
-    for ti in t:
-        lo = np.full(3, -10.0)
-        lo[axis] = ti
-        got.append(cut_volume(np.zeros((1, 3)), [1.0], "box", lo, np.full(3, 10.0))[0])
-    assert np.max(np.abs(np.array(got) - cap(1.0 - t))) < 2e-6 * V1
+@pytest.mark.parametrize("z_floor", [-0.99, -0.4, 0.0, 0.55, 0.99])
+def test_a_box_floor_cuts_the_cap(z_floor):
+    box = Region("box", (-10.0, -10.0, z_floor), (10.0, 10.0, 10.0))
+    eps = porosity_in_region(np.zeros((1, 3)), [1.0], box)
+    assert (1 - eps) * box.volume == pytest.approx(cap(1.0 - z_floor), abs=5e-9 * V1)  # 16 nodes
 
 
-def test_octant_edge_and_a_sphere_about_a_cylinder_axis():
-    c0, one = np.zeros((1, 3)), [1.0]
-    assert cut_volume(c0, one, "box", [0, 0, 0], [5, 5, 5])[0] == pytest.approx(V1 / 8, abs=1e-8)
-    assert cut_volume(c0, one, "box", [0, 0, -5], [5, 5, 5])[0] == pytest.approx(V1 / 4, abs=1e-8)
-    for rad in (0.3, 0.6, 0.95, 1.5):                  # V = 4/3 pi (1 - (1 - R^2)^1.5)
-        exact = V1 * (1.0 - max(1.0 - rad * rad, 0.0) ** 1.5)
-        got = cut_volume(c0, one, "cylinder", [0, 0, -5], [0, 0, 5], radius=rad)[0]
-        assert got == pytest.approx(exact, abs=1e-7)
-    # a sphere half-way through the cylinder wall and cut by its floor: the two halves add up
-    c = np.array([[0.9, 0.3, 0.2]])
-    inner = cut_volume(c, one, "cylinder", [0, 0, 0], [0, 0, 5], radius=1.0)[0]
-    lower = cut_volume(c, one, "cylinder", [0, 0, -5], [0, 0, 0], radius=1.0)[0]
-    whole = cut_volume(c, one, "cylinder", [0, 0, -5], [0, 0, 5], radius=1.0)[0]
-    assert inner + lower == pytest.approx(whole, abs=1e-7)
+@pytest.mark.parametrize("rad", [0.3, 0.6, 0.95, 1.5])
+def test_a_cylinder_about_an_off_origin_axis_cuts_the_sphere_exactly(rad):
+    """V = 4/3 pi (1 - (1 - R^2)^1.5) of a unit sphere centred on the cylinder's axis, the axis
+    at (0.7, -0.2) as center_xy places it."""
+    cyl = Region("cylinder", (0, 0, -5), (0, 0, 5), radius=rad, center_xy=(0.7, -0.2))
+    eps = porosity_in_region(np.array([[0.7, -0.2, 0.3]]), [1.0], cyl)
+    exact = V1 * (1.0 - max(1.0 - rad * rad, 0.0) ** 1.5)
+    assert (1 - eps) * cyl.volume == pytest.approx(exact, abs=1e-7)
 
 
-def test_region_porosity_against_network_exact():
-    # non-overlapping spheres (random sequential addition): the two packages' region porosities
-    # of a box and a cylinder cut through the spheres agree to the quadrature's 1e-6 level
-    from network.packing import Packing
-    from network.pores import Region as NetRegion, region_porosity
-
+def test_random_spheres_box_and_cylinder_add_up():
+    """Non-overlapping spheres: the solid in a box is the sum of the solid in two halves cut
+    at any height, for a box and for a cylinder alike."""
     cont = Container("box", (0.04, 0.04), 0.04)
     c, r = generate_spheres(cont, 180, 0.0025, 0.0035, np.random.default_rng(5))
     lo, hi = np.array([0.0031, 0.0047, 0.0052]), np.array([0.0343, 0.0298, 0.0361])
-    mine = porosity_in_region(c, r, Region("box", tuple(lo), tuple(hi)))
-    theirs, err = region_porosity(Packing(c, r), NetRegion(lo, hi), 2)
-    assert mine == pytest.approx(theirs, abs=2e-6 + err)
     mid = 0.5 * (lo + hi)
-    mine = porosity_in_region(c, r, Region("cylinder", (0, 0, lo[2]), (0, 0, hi[2]),
-                                           radius=0.011, center_xy=(mid[0], mid[1])))
-    theirs, err = region_porosity(Packing(c, r), NetRegion(lo, hi, radius=0.011), 2)
-    assert mine == pytest.approx(theirs, abs=2e-6 + err)
+    for kw in ({"kind": "box"}, {"kind": "cylinder", "radius": 0.011,
+                                  "center_xy": (mid[0], mid[1])}):
+        def solid(z0, z1):
+            reg = Region(lo=(lo[0], lo[1], z0), hi=(hi[0], hi[1], z1), **kw)
+            return (1 - porosity_in_region(c, r, reg)) * reg.volume
+        assert solid(lo[2], hi[2]) == pytest.approx(solid(lo[2], 0.02) + solid(0.02, hi[2]),
+                                                    rel=1e-9)
 
 
 def test_interior_keeps_a_small_square_box_off_its_walls():

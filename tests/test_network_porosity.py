@@ -5,7 +5,7 @@ import pytest
 
 from network import Packing, random_packing
 from network.pores import Region, region_porosity
-from network.pores._porosity import circle_lens_area, disk_rectangle_area, sphere_region_volume
+from network.core._porosity import circle_lens_area, disk_rectangle_area, sphere_region_volume
 
 V1 = 4.0 / 3.0 * np.pi
 

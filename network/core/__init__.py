@@ -18,6 +18,8 @@ from ._cli import (EXIT_BAD_INPUT, EXIT_FAILED, EXIT_OK, MAX_REPEATS, MAX_SPHERE
                    progress_log, run, same_file, warn)
 from ._io import (FORMATS, UNITS, default_packing_path, read_container, read_packing,
                   read_summary, summary_path, write_packing_csv, write_summary)
+from ._porosity import MAX_EXACT_ERROR, POROSITY_METHODS, OverlapError, region_porosity
+from ._region import AXES, Region, axis_index
 from ._text import delimiter_of, read_table, read_text, split_fields
 from ._packing import (MIN_SPHERES, PLAUSIBLE_DIAMETER_M, DegeneratePackingError, Packing,
                        check_grains, check_three_dimensional, grain_volumes, scale_warning,
@@ -34,4 +36,6 @@ __all__ = ["EXIT_BAD_INPUT", "EXIT_FAILED", "EXIT_OK", "FORMATS", "KEPLER_POROSI
            "read_container", "read_packing", "read_summary", "recorded_reach", "run", "same_file",
            "scale_warning", "summary_path", "validate_spheres", "warn", "write_packing_csv",
            "write_summary", "read_text", "read_table", "split_fields", "delimiter_of",
-           "check_count", "MAX_WORKERS", "MAX_SPHERES", "MAX_REPEATS"]
+           "check_count", "MAX_WORKERS", "MAX_SPHERES", "MAX_REPEATS", "AXES", "Region",
+           "axis_index", "region_porosity", "OverlapError", "POROSITY_METHODS",
+           "MAX_EXACT_ERROR"]

@@ -53,6 +53,9 @@ class Packing:
             raise ValueError(f"centers must have shape (N, 3), got {c.shape}")
         if r.shape != (c.shape[0],):
             raise ValueError(f"radii must have shape ({c.shape[0]},), got {r.shape}")
+        # read-only copies: the caller's arrays stay as they were (writable: the DEM moves them)
+        c = c.copy() if c.flags.writeable else c
+        r = r.copy() if r.flags.writeable else r
         c.setflags(write=False)
         r.setflags(write=False)
         object.__setattr__(self, "centers", c)

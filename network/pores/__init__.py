@@ -8,7 +8,7 @@ on (3, M) component rows.
 """
 
 from ._merge import PoreMerge, circumspheres, merge_pores
-from ._porosity import OverlapError, region_porosity
+from ..core import OverlapError, region_porosity
 from ._region import (AXES, MIN_INTERIOR_DIAMETERS, OUTSIDE_BED_DIAMETERS, NoInteriorError,
                       Region, axis_index, check_inside_bed, default_region, sample_region)
 from ._simplex import column_norm, cross_components

@@ -30,8 +30,8 @@ import numpy as np
 
 from .._deferred import spatial
 
-__all__ = ["region_porosity", "POROSITY_METHODS", "MAX_EXACT_ERROR", "OverlapError", "disk_rectangle_area", "circle_lens_area",
-           "sphere_region_volume"]
+__all__ = ["region_porosity", "POROSITY_METHODS", "MAX_EXACT_ERROR", "OverlapError",
+           "disk_rectangle_area", "circle_lens_area", "sphere_region_volume"]
 
 log = logging.getLogger(__name__)
 
