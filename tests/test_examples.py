@@ -48,3 +48,13 @@ def test_quickstart_runs_and_its_numbers_hold(capsys):
     assert res.permeability_m2 == pytest.approx(4.2284e-8, rel=1e-4)   # the README's value
     assert "permeability     4.2284e-08 m2" in out
     assert "pressure drop    1.485 Pa over 0.25 m at 0.013 m/s" in out
+
+
+def test_readme_indexes_every_docs_page_and_names_no_missing_one():
+    """The README's documentation index lists each page of docs/, and every docs/ path the README
+    names exists."""
+    readme = (ROOT / "README.md").read_text(encoding="utf-8")
+    pages = {p.relative_to(ROOT).as_posix() for p in (ROOT / "docs").glob("*.md")}
+    named = set(re.findall(r"docs/[A-Za-z0-9_./-]+\.(?:md|py|png)", readme))
+    assert pages - named == set()
+    assert {p for p in named if not (ROOT / p).exists()} == set()
