@@ -104,6 +104,26 @@ def test_a_flat_bed_on_a_full_floor_is_the_reports_system_curve(law):
         assert row["airflow_m3_s"] == pytest.approx(sol.inflow_m3_s, rel=1e-12)
 
 
+def test_a_bin_mesh_ignores_the_gmsh_options_another_mesher_left():
+    """gmsh's options are global to the process: second-order elements, a size factor and a
+    coarser size integration left by another mesher (the throats' meshes set all three) leave
+    a bin's mesh node for node the same."""
+    import gmsh
+
+    geom = BinGeometry(6.0, 4.0)
+    alone = mesh_bin(geom, 0.3)
+    try:
+        for name, value in (("Mesh.ElementOrder", 2), ("Mesh.MeshSizeFactor", 0.5),
+                            ("Mesh.LcIntegrationPrecision", 1e-3)):
+            gmsh.option.setNumber(name, value)
+        after = mesh_bin(geom, 0.3)
+    finally:
+        gmsh.option.restoreDefaults()
+    assert after.cells.shape == alone.cells.shape == (3, alone.n_elements)
+    np.testing.assert_array_equal(after.cells, alone.cells)
+    np.testing.assert_array_equal(after.points, alone.points)
+
+
 def test_a_flat_bed_with_a_porosity_profile_integrates_the_1d_law(wheat, tmp_path):
     """A denser bed with depth: P = integral of g(U, eps(h)) dh (trapezoid on 20 001 points),
     to the discretisation error of element-wise porosity (1e-4 at this mesh)."""

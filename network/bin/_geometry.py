@@ -181,10 +181,14 @@ class Mesh:
 
 
 def _gmsh():
+    """gmsh, initialised, with an empty model and every option at gmsh's default (another
+    mesher in the process, the throats' second-order triangles, leaves its own options set:
+    a bin mesh depends on none of them), quiet and on one thread."""
     import gmsh
 
     if not gmsh.isInitialized():
         gmsh.initialize(readConfigFiles=False, interruptible=False)
+    gmsh.option.restoreDefaults()
     gmsh.option.setNumber("General.Terminal", 0)
     gmsh.option.setNumber("General.NumThreads", 1)
     gmsh.clear()
