@@ -129,3 +129,13 @@ def test_cache_lookup_reads_a_utf16_throat_list(tmp_path, capsys):
                             "--policy", "shape-factor", "--quiet"])
     err = capsys.readouterr().err
     assert rc == 2 and f"--csv {tmp_path / 'bad.csv'}: row 2: byte 0xe9 is not UTF-8" in err
+
+
+@pytest.mark.parametrize("style", STYLES)
+def test_network_bin_profiles_read_what_spreadsheets_write(tmp_path, style):
+    from network.bin._material import read_profile
+
+    f = tmp_path / "profile.csv"
+    f.write_bytes(_sheet([["depth_m", "porosity"], ["0", "0.42"], ["2", "0.39"]], style))
+    x, y = read_profile(f)
+    assert x.tolist() == [0.0, 2.0] and y.tolist() == [0.42, 0.39]

@@ -29,7 +29,6 @@ between its rows, held beyond them) or Janssen's vertical stress with a porosity
 
 from __future__ import annotations
 
-import csv
 import json
 import math
 from dataclasses import dataclass
@@ -38,6 +37,7 @@ from pathlib import Path
 import numpy as np
 
 from .._grains import BED, D272
+from ..core import read_table
 from ..report.porosity import requested_porosity
 from ._law import ForchheimerLaw, SheddLaw
 
@@ -85,21 +85,21 @@ class PorosityProfile:
 
 def read_profile(path, option: str = "--porosity-profile") -> tuple[np.ndarray, np.ndarray]:
     """Two columns of a CSV with a header (depth_m,porosity or stress_pa,porosity): x ascending
-    from >= 0, y in (0, 1); ValueError naming the file and row."""
+    from >= 0, y in (0, 1); read as spreadsheets write it (:func:`network.core.read_table`);
+    ValueError naming the option, the file and the row."""
     xs, ys = [], []
-    with open(path, newline="") as f:
-        rows = list(csv.reader(f))
-    if not rows:
-        raise ValueError(f"{option} {path}: empty file")
+    try:
+        head, rows = read_table(path, option, what="a porosity profile")
+    except ValueError as e:
+        if "empty file" not in str(e):
+            raise
+        raise ValueError(f"{option} {path}: empty file") from None
     want = ("depth_m", "porosity") if option == "--porosity-profile" else ("stress_pa",
                                                                           "porosity")
-    head = [c.strip() for c in rows[0]]
-    if head != list(want):
+    if [h.lower() for h in head] != list(want):
         raise ValueError(f"{option} {path}: header must be {','.join(want)}, got "
                          f"{','.join(head)}")
-    for i, row in enumerate(rows[1:], start=2):
-        if not row or all(not c.strip() for c in row):
-            continue
+    for i, row in rows:
         if len(row) != 2:
             raise ValueError(f"{option} {path} row {i}: {len(row)} values, the header has 2")
         try:

@@ -202,7 +202,13 @@ def _read(args):
     if not args.packing:
         raise ValueError("give PACKING or --standin LX LY LZ")
     _, pk = load_packing(args)
+    args.grain_id = pk.grain_id            # every later Packing of this bed keeps its grains
     return np.asarray(pk.centers), np.asarray(pk.radii), str(args.packing)
+
+
+def _packing(args, x, r, source: str = "") -> Packing:
+    """The bed as a Packing again, with the grain ids :func:`_read` found (None: spheres)."""
+    return Packing(x, r, source, grain_id=getattr(args, "grain_id", None))
 
 
 def _entries(args, x, r):
@@ -256,7 +262,7 @@ def _main(args) -> int:
         graph = tess = None
         t1 = time.perf_counter()
         if need_graph or args.pressure:
-            tess = tessellate(Packing(x, r, source))
+            tess = tessellate(_packing(args, x, r, source))
             graph = face_graph(tess)
         t_graph = time.perf_counter() - t1
     paths, t_kind = [], {}
@@ -343,7 +349,7 @@ def _interior(args, x, r, source):
     """The default interior sample, whose porosity enters Ergun (:func:`_table_4_5`), found
     before any work; ValueError when the bed has none."""
     try:
-        return default_region(Packing(x, r), axis=args.axis)
+        return default_region(_packing(args, x, r), axis=args.axis)
     except NoInteriorError as exc:
         raise ValueError(f"{source}: {exc.reason}; network.paths needs an interior sample for "
                          "the Ergun porosity of its Table 4.5 (--no-branched skips it)") from exc
@@ -392,7 +398,7 @@ def _table_4_5(args, x, r, branched, region):
     exact porosity of the sample's inset window where its k is measured), so both commands
     print one Ergun value for one bed."""
     depth, velocities = args.depth, args.velocity
-    pk, ax = Packing(x, r), axis_index(args.axis)    # porosity where network.solve's k is:
+    pk, ax = _packing(args, x, r), axis_index(args.axis)    # porosity where network.solve's k is:
     porosity, _ = region_porosity(pk, inset_window(region, ax, pk.grain_diameter) or region, ax)
     us = [f"{u:g}" for u in velocities]
     out = {}
@@ -417,7 +423,7 @@ def _pressure_along(args, x, r, source, tess, graph, paths):
     d, lo, hi = 2.0 * r.mean(), x.min(axis=0), x.max(axis=0)
     m = np.minimum(1.5 * d, 0.2 * (hi - lo))
     m["xyz".index(args.axis)] = 4.0 * d
-    res = solve_network(Packing(x, r, source), axis=args.axis, tessellation=tess,
+    res = solve_network(_packing(args, x, r, source), axis=args.axis, tessellation=tess,
                         sample=SampleOptions(region=Region(lo + m, hi - m), porosity_points=0),
                         conductance=ConductanceOptions(policy=args.policy),
                         flow=FlowOptions(velocity_m_s=args.velocity[0], depth_m=args.depth,
