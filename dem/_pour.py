@@ -37,7 +37,8 @@ grain's measured loose-fill porosity). A grain hitting the bed loses more than a
 contact takes, so in that time it has come to rest before the next layer covers it.
 
 **Rest.** When all grains are in, the bed settles until the mean unbalanced-force ratio is
-below ``tol`` (``converged``) or ``max_steps`` pass.
+below ``tol`` (``converged``) or ``max_steps`` pass (default :func:`rest_steps`: 0.5 s of
+simulated time, at least 60 000 steps, so real masses get the time that mass scale 100 gets).
 
 **Measured.** The long-axis orientation order :math:`S = \langle \tfrac32\cos^2\theta -
 \tfrac12\rangle` (θ between a kernel's long axis and the vertical; 0 random, -1/2 all lying
@@ -61,7 +62,7 @@ from .clumps import ClumpSimulation
 
 __all__ = ["FILL_METHODS", "FillOptions", "AIR_DENSITY_KG_M3", "DRAG_COEFFICIENT", "MAX_DROP_HEIGHT_M",
            "entry_speed", "terminal_velocity", "default_rate", "batch_interval", "pour_grains",
-           "orientation_order", "porosity_by_depth", "surface_heights", "angle_of_repose",
+           "orientation_order", "porosity_by_depth", "rest_steps", "REST_TIME_S", "surface_heights", "angle_of_repose",
            "check_fill_options"]
 
 #: fills of a grain bed: 'rain' (spreader), 'spout' (centre spout), 'grow' (grown in place)
@@ -74,6 +75,8 @@ DRAG_COEFFICIENT = 0.44
 MAX_DROP_HEIGHT_M = 10.0
 #: gravity, m/s²
 G = 9.81
+#: simulated time a poured bed gets to come to rest after its last grain, s (the default budget)
+REST_TIME_S = 0.5
 
 
 @dataclass(frozen=True, kw_only=True)
@@ -253,8 +256,19 @@ def _grown(sim, template, x_new, v_new, q_new):
     return new
 
 
+def rest_steps(dt_s, *, rest_time_s=None, min_steps=60_000):
+    """Default step budget of a poured bed's rest: :data:`REST_TIME_S` of simulated time at the
+    step ``dt_s`` (s), at least ``min_steps``; real masses take 10 times the steps of mass scale 100.
+
+    >>> rest_steps(1e-6), rest_steps(1e-4)
+    (500000, 60000)
+    """
+    t = REST_TIME_S if rest_time_s is None else rest_time_s
+    return max(int(min_steps), int(math.ceil(t / dt_s - 1e-9)))
+
+
 def pour_grains(container, template, *, material, fill=FillOptions(), n_grains, rng=None, tol=2e-3,
-                max_steps=60_000, check_every=200, progress=None, restitution=None, porosity=0.4):
+                max_steps=None, check_every=200, progress=None, restitution=None, porosity=0.4):
     r"""Pour ``n_grains`` grains of ``template`` into ``container`` (module notes) and settle.
 
     Parameters
@@ -269,8 +283,8 @@ def pour_grains(container, template, *, material, fill=FillOptions(), n_grains, 
     rng : numpy.random.Generator | int | None
     tol : float
         Mean unbalanced-force ratio of the rest (after the last grain is in).
-    max_steps : int
-        Step budget of the rest.
+    max_steps : int | None
+        Step budget of the rest (None: :func:`rest_steps`, 0.5 s of simulated time).
     restitution : float | None
         Grain-grain restitution e of the default rate (None: from ``material.damping_ratio``).
     porosity : float
@@ -345,6 +359,8 @@ def pour_grains(container, template, *, material, fill=FillOptions(), n_grains, 
             batches += 1
         psteps += sim.run(max_steps=steps_per_batch, check_every=check_every, callback=progress)["steps"] * sim.n
     fill_time, fill_steps = sim.time_s, sim.steps
+    if max_steps is None:
+        max_steps = rest_steps(sim.dt)
     rest = sim.run(max_steps=max_steps, tol=tol, check_every=check_every, callback=progress)
     psteps += rest["steps"] * sim.n
     record = {"method": fill.method, "drop_height_m": fill.drop_height_m, "entry_speed_m_s": v0,

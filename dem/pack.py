@@ -44,7 +44,7 @@ from ._io import summary_path, write_packing
 from ._clump_pack import grains_path, pack_grains, pack_grains_to_porosity, write_grain_packing
 from ._contacts import damping_ratio_for_restitution
 from ._load import janssen_stress, load_bed
-from ._pour import FILL_METHODS, FillOptions, check_fill_options, poured_bed_summary, pour_grains
+from ._pour import FILL_METHODS, FillOptions, check_fill_options, poured_bed_summary, pour_grains, rest_steps
 from ._procedures import PROCEDURES, PackOptions, RunOptions, pack_bed
 from .grains import grain
 from .templates import resolve_template
@@ -101,7 +101,8 @@ def _parser():
     p.add_argument("--keep-lid", action="store_true", help="do not remove the lid before the last settling")
     p.add_argument("--tol", type=float, default=2e-3, help="mean unbalanced-force ratio at equilibrium")
     p.add_argument("--max-steps", type=int, default=None, help="step limit of each stage (default 200000 for spheres, "
-                   f"{GRAIN_MAX_STEPS} for --grain beds); a bed not at equilibrium by then is written with "
+                   f"{GRAIN_MAX_STEPS} for grown grain beds, 0.5 s of simulated time and at least {GRAIN_MAX_STEPS} "
+                   "for a poured bed's rest and its load); a bed not at equilibrium by then is written with "
                    "\"converged\": false and exit 1")
     p.add_argument("--dt-safety", type=float, default=0.25, help="time step as this fraction of sqrt(mass_scale m_min / "
                    "max(k_n, k_s)), the critical step of the lightest sphere (default 0.25)")
@@ -408,7 +409,7 @@ def _pour(args, fill, template, container) -> int:
     if n < 1:
         raise ValueError(f"no grain of {template.volume_m3:.3g} m^3 fits the container")
     pr = progress_printer(quiet=args.quiet)
-    max_steps = GRAIN_MAX_STEPS if args.max_steps is None else args.max_steps
+    max_steps = args.max_steps                       # None: the pour's own rest budget (0.5 s)
     cb = lambda sim, f: pr(fill.method, _Progress(sim), None)
     sim, record = pour_grains(container, template, material=material, fill=fill, n_grains=n, rng=args.seed,
                               tol=args.tol, max_steps=max_steps, progress=cb, restitution=e_pp, porosity=phi_count)
@@ -427,7 +428,8 @@ def _pour(args, fill, template, container) -> int:
             load.update(depth_m=args.depth, bin_diameter_m=args.bin_diameter, bin_height_m=args.bin_height,
                         bulk_density_kg_m3=rho_b, janssen=load_src)
         if stress > 0:
-            load.update(load_bed(sim, container, stress, tol=args.tol, max_steps=max_steps,
+            load.update(load_bed(sim, container, stress, tol=args.tol,
+                                 max_steps=rest_steps(sim.dt) if max_steps is None else max_steps,
                                  callback=lambda sim, f: pr("load", _Progress(sim), None)))
             converged = converged and load["converged"]
         else:
