@@ -210,8 +210,9 @@ def curve(mask_npz, *, backend="numba", reynolds=(0.1, 5, 10, 20), u_max=0.02, t
 
 
 def network_rows(ref, policy="table-only", beds=None):
-    """The network's Stokes k (whole sample, as ``network.solve`` reports it in a sample this
-    narrow) and k_app/k at the Reynolds numbers each LBM run obtained, per bed of ``ref``
+    """The network's Stokes k (``permeability_m2``, as ``network.solve`` reports it: the whole
+    sample in the grain beds' narrow samples, the inset window in wider ones; the whole sample's
+    beside it) and k_app/k at the Reynolds numbers each LBM run obtained, per bed of ``ref``
     (``beds``: bed name -> file, for beds not bundled)."""
     from network.flow import ConductanceOptions, FlowOptions, SampleOptions, solve_network
     from network.packing import read_container, read_packing
@@ -233,9 +234,9 @@ def network_rows(ref, policy="table-only", beds=None):
                            density_kg_m3=rho)
         inert = solve_network(pk, axis="z", sample=sample, conductance=cond, flow=flow)
         pts = inert.curve_points()
-        k = res.permeability_whole_m2
-        out[bed] = {"k_m2": res.permeability_m2,
-                    "qstar_stats": res.qstar_stats.get("qstar_stats", res.qstar_stats), "k_whole_m2": k, "d32_m": d32,
+        k = res.permeability_m2        # the gradients' own base (whole or inset sample)
+        out[bed] = {"k_m2": res.permeability_m2, "sample_estimator": res.sample_estimator,
+                    "qstar_stats": res.qstar_stats.get("qstar_stats", res.qstar_stats), "k_whole_m2": res.permeability_whole_m2, "d32_m": d32,
                     "rows": [{"re": p["reynolds_particle"],
                               "k_ratio": k / p["apparent_permeability_m2"]} for p in pts]}
     return out
