@@ -107,6 +107,9 @@ def _check(args):
         check_output(args.export, "--export", inputs=csv_in + [("--db", args.db)])
     elif args.orbits:
         raise ValueError("--orbits needs --export")
+    if args.orbits and getattr(GRIDS[args.grid], "kind", None) == "pair":
+        raise ValueError(f"--orbits: grid {args.grid} (deep pairs) has no vertex-permutation "
+                         "orbits; export it without --orbits")
     if not args.csv:
         return None, None
     errors = {}

@@ -111,3 +111,13 @@ def test_bundled_grain_beds_windows_all_from_tables():
         st = res.qstar_stats["qstar_stats"]
         assert st["n_shape_factor"] == 0 and st["n_shape_factor_deep"] == 0
         assert st["n_interp"] + st["n_closed"] == st["n"]
+
+
+def test_pair_grid_export_refuses_orbits_before_any_work(tmp_path, capsys):
+    from cache import precompute
+
+    db = tmp_path / "p.sqlite"
+    code = precompute.main(["--db", str(db), "--grid", "p1", "--export", str(tmp_path / "p.npz"),
+                            "--orbits"])
+    assert code == 2 and not db.exists()
+    assert "no vertex-permutation orbits" in capsys.readouterr().err
