@@ -26,7 +26,7 @@ from dataclasses import dataclass
 from pathlib import Path
 
 __all__ = ["D272Constants", "D272", "GRAIN_ALIASES", "HUKILL_IVES_RANGE_M_S", "d272_constants",
-           "d272_velocity_range", "grain_key", "packing_grain", "template_grain",
+           "d272_line", "d272_velocity_range", "grain_key", "packing_grain", "template_grain",
            "grains_with_d272",
            "BedProperties", "BED"]
 
@@ -177,6 +177,26 @@ def d272_constants(name: str) -> tuple[float, float]:
         raise ValueError(f"no sourced ASABE D272 constants for {key} (docs/grain-library.md); "
                          f"grains with constants: {', '.join(grains_with_d272())}")
     return float(c.a_pa_s2_m3), float(c.b_s_m)
+
+
+def d272_line(grain: str | None) -> tuple[tuple[float, float] | None, str]:
+    """The ASABE D272 line a bed of ``grain`` is compared with, as every command prints it:
+    ((a Pa s²/m³, b s/m), its label) or, for a grain that is unknown (None) or has no sourced
+    constants, (None, the sentence saying why there is no line).
+
+    >>> d272_line("soybean")
+    ((10200.0, 16.0), 'ASABE D272 (soybeans)')
+    >>> d272_line(None)
+    (None, "no ASABE D272 line: the bed's grain is unknown (give --grain)")
+    """
+    if grain is None:
+        return None, "no ASABE D272 line: the bed's grain is unknown (give --grain)"
+    key = grain_key(grain)
+    c = D272[key]
+    if c.a_pa_s2_m3 is None:
+        return None, f"no ASABE D272 line: no sourced constants for {key}"
+    name = "soybeans" if key == "soybean" else key.replace("_", " ")
+    return (float(c.a_pa_s2_m3), float(c.b_s_m)), f"ASABE D272 ({name})"
 
 
 @dataclass(frozen=True)

@@ -27,7 +27,7 @@ from ._cli import (CliError, CliParser, add_air, add_packing, add_sample, add_ta
                    available_cores, bad_input, check_common, check_output_list, computing,
                    finish, load_packing, packing_inputs, progress_log, run,
                    sample_box_m, warn_validity)
-from ._grains import D272, grain_key, packing_grain
+from ._grains import D272, d272_line, grain_key, packing_grain
 from .conductance import MODELS, POLICIES, throat_qstar
 from .flow import (DEFAULT_DEPTH_M, DEFAULT_VELOCITY_M_S, ConductanceOptions, FlowOptions,
                    combined_summary, solve_axes, write_network_vtu)
@@ -110,12 +110,10 @@ def _empirical_line(s: dict, grain) -> str:
     c = s["comparisons"]
     text = (f"    Ergun {c['ergun']['pressure_drop_pa']:.4g} Pa, Kozeny-Carman "
             f"{c['kozeny_carman']['pressure_drop_pa']:.4g} Pa, ")
+    _, label = d272_line(grain)
     if c.get("asabe_d272") is not None:
-        name = "soybeans" if grain == "soybean" else grain.replace("_", " ")
-        return text + f"ASABE D272 ({name}) {c['asabe_d272']['pressure_drop_pa']:.4g} Pa"
-    if grain is None:
-        return text + "no ASABE D272 line: the bed's grain is unknown (give --grain)"
-    return text + f"no ASABE D272 line: no sourced constants for {grain}"
+        return text + f"{label} {c['asabe_d272']['pressure_drop_pa']:.4g} Pa"
+    return text + label
 
 
 def _print_result(res, out):

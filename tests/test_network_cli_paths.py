@@ -9,6 +9,7 @@ import numpy as np
 import pytest
 
 from network import random_packing
+from network._grains import d272_constants
 from network.flow import asabe_d272_gradient
 from network.paths.__main__ import main
 from network.solve import main as solve_main
@@ -57,7 +58,8 @@ def test_duplicate_paths_are_listed_but_counted_once(bed, tmp_path, capsys):
 
 
 def test_comparison_depth_is_stated_and_the_thesis_only_at_its_depth(bed, tmp_path, capsys):
-    out = _run([str(bed), "--entries", "2", "--kind", "narrowest"], tmp_path)
+    out = _run([str(bed), "--entries", "2", "--kind", "narrowest", "--grain", "soybean"],
+               tmp_path)
     t45 = out["table_4_5_pa"]
     assert out["comparison_depth_m"] == 0.25
     assert t45["ASABE D272"]["0.013"] == pytest.approx(asabe_d272_gradient(0.013) * 0.25)
@@ -76,10 +78,41 @@ def test_comparison_depth_is_stated_and_the_thesis_only_at_its_depth(bed, tmp_pa
     assert ergun == [f"Ergun (porosity {solved['porosity']:.3f})"]
     assert t45[ergun[0]]["0.013"] == pytest.approx(
         solved["comparisons"]["ergun"]["pressure_drop_pa"], rel=1e-9)
-    out = _run([str(bed), "--entries", "2", "--kind", "narrowest", "--depth", "0.5"], tmp_path)
+    out = _run([str(bed), "--entries", "2", "--kind", "narrowest", "--depth", "0.5",
+                "--grain", "soybean"], tmp_path)
     assert "measured (thesis)" not in out["table_4_5_pa"]
     text = capsys.readouterr().out
     assert "2.44" not in text and "Pa over 0.5 m" in text
+
+
+def test_the_comparisons_are_of_the_beds_own_grain(bed, tmp_path, capsys):
+    """A wheat bed (its companion JSON's template) is set beside wheat's D272 line, with none of
+    the thesis's soybean values; a bed of unknown grain gets no D272 row; a --grain that
+    contradicts the JSON exits 2."""
+    wheat = tmp_path / "wheat_bed.csv"
+    wheat.write_text(bed.read_text())
+    wheat.with_suffix(".json").write_text(json.dumps({"template": "wheat"}))
+    argv = ["--entries", "2", "--kind", "narrowest"]
+    out = _run([str(wheat), *argv], tmp_path)
+    a, b = d272_constants("wheat")
+    assert out["grain"] == "wheat" and out["thesis"] is None
+    t45 = out["table_4_5_pa"]
+    for u in (0.013, 0.027):
+        assert t45["ASABE D272"][f"{u:g}"] == pytest.approx(
+            a * u**2 / np.log1p(b * u) * 0.25, rel=1e-12)
+    assert t45["ASABE D272"]["0.013"] != pytest.approx(asabe_d272_gradient(0.013) * 0.25)
+    assert "measured (thesis)" not in t45
+    text = capsys.readouterr().out
+    assert "ASABE D272 (wheat)" in text and "soybean" not in text
+    assert "(thesis 1.40)" not in text and "measured 2.44" not in text
+
+    out = _run([str(bed), *argv], tmp_path)
+    assert out["grain"] is None and "ASABE D272" not in out["table_4_5_pa"]
+    assert "no ASABE D272 line: the bed's grain is unknown (give --grain)" in (
+        capsys.readouterr().out)
+
+    assert main([str(wheat), *argv, "--grain", "soybean"]) == 2
+    assert "is a bed of wheat" in capsys.readouterr().err.strip().splitlines()[-1]
 
 
 def test_units_mm_gives_the_same_paths(bed, tmp_path, capsys):
@@ -104,6 +137,10 @@ def test_units_mm_gives_the_same_paths(bed, tmp_path, capsys):
     ([SCENE, "--plot", "no/dir/p.png"], "--plot no/dir/p.png: folder no/dir does not exist"),
     ([SCENE, "--json", "no/dir/p.json"], "folder no/dir does not exist"),
     ([SCENE, "--axis", "q"], "invalid choice: 'q'"),
+    ([SCENE, "--grain", "wheat"], "--grain wheat: network/data/soybean_default.csv is a bed of "
+                                  "soybean"),
+    (["--standin", "0.05", "0.05", "0.05", "--grain", "wheat"],
+     "--grain wheat: the stand-in (--standin) has soybean's diameters"),
 ])
 def test_bad_options_exit_2(argv, words, capsys):
     assert main(argv) == 2

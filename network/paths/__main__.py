@@ -5,7 +5,7 @@ Usage::
     python -m network.paths PACKING [--entry X Y | --entries N] [--kind widest|narrowest|
         maximin|shortest|all] [--axis z] [--method build|delaunay] [--seed S]
         [--velocity U ...] [--depth D] [--branches path|all] [--pressure [--policy P]]
-        [--units m|cm|mm] [--json OUT.json] [--plot OUT.png] [--standin LX LY LZ]
+        [--grain G] [--units m|cm|mm] [--json OUT.json] [--plot OUT.png] [--standin LX LY LZ]
 
 ``widest``/``narrowest`` are the thesis's step-increment paths (``--method build``: tetrahedra
 built sphere by sphere as in Appendices D-E; ``--method delaunay``: the same rule walked on the
@@ -13,15 +13,18 @@ Delaunay tessellation); ``maximin`` is the optimal widest (maximin-bottleneck) p
 ``shortest`` the shortest path on the tessellation. Entry points are (X, Y) in metres in the
 plane normal to ``--axis`` (the other two axes in x, y, z order); ``--entries N`` draws N at
 random (``--seed``) away from the walls. The branched-path model (Table 4.4 layout, then the
-Table 4.5 comparison with ASABE D272 and Ergun) is evaluated on every widest/narrowest path at
-each ``--velocity``; ``--pressure`` solves the network model (``network.flow.solve_network``)
-and prints the pressure drop along every path that lies on the tessellation (thesis 4.2.3).
-Conventions (:data:`CONVENTIONS`): T is Eq. 3.27's smoothed length over L0, the bed depth for
-built paths and the path's own axial span for paths on the tessellation (they start and end
-inside the bed); pressure drops beside ASABE D272 and Ergun are over ``--depth`` (0.25 m, as
-``network.solve``), the thesis's 2.44 Pa only beside them at 0.25 m; a path traced twice
-counts once. Timings, load average and platform go into the JSON. ``--standin LX LY LZ``
-replaces PACKING by a stand-in from ``network.packing.random_packing`` at porosity 0.408.
+Table 4.5 comparison with the bed's grain's ASABE D272 line and Ergun) is evaluated on every
+widest/narrowest path at each ``--velocity``; ``--pressure`` solves the network model
+(``network.flow.solve_network``) and prints the pressure drop along every path that lies on the
+tessellation (thesis 4.2.3). Conventions (:data:`CONVENTIONS`): T is Eq. 3.27's smoothed length
+over L0, the bed depth for built paths and the path's own axial span for paths on the
+tessellation (they start and end inside the bed); pressure drops beside ASABE D272 and Ergun
+are over ``--depth`` (0.25 m, as ``network.solve``); a path traced twice counts once. The grain
+is the bed's, as in ``network.solve`` (its companion JSON, else ``--grain``; the stand-in's is
+soybean): no D272 row where it is unknown, and the thesis's soybean values (tortuosity, widths,
+2.44 Pa at 0.25 m) only beside a soybean bed. Timings, load average and platform go into the
+JSON. ``--standin LX LY LZ`` replaces PACKING by a stand-in from
+``network.packing.random_packing`` at porosity 0.408.
 Exit 0 done, 1 failed, 2 bad input (an entry outside the bed, ``--entries 0``, ...): one
 ``error:`` line on stderr (docs/cli.md).
 """
@@ -39,6 +42,7 @@ import numpy as np
 
 from .._cli import (CliParser, add_air, add_packing, bad_input, check_common, check_outputs,
                     check_plot, computing, finish, load_packing, packing_inputs, run)
+from .._grains import D272, d272_line, grain_key, packing_grain
 from . import (bed_depth, branched_table, face_graph, plot_paths, pore_pressure_array,
                pressure_along_path, random_entry_points, trace_paths)
 from ..conductance import POLICIES
@@ -49,7 +53,7 @@ from ..pores import (NoInteriorError, Region, axis_index, default_region, region
                      tessellate)
 
 _ALL = ("widest", "narrowest", "maximin", "shortest")
-#: Thesis values (Tables 4.1-4.5) printed beside ours (pressures: over 0.25 m of soybeans).
+#: Thesis values (Tables 4.1-4.5) printed beside ours on a soybean bed (pressures: over 0.25 m).
 THESIS = {
     "tortuosity": {"widest": 1.39, "narrowest": 1.40},
     "mean_width_mm": {"widest": (2.73, 2.91), "narrowest": (1.85, 2.00)},
@@ -112,6 +116,12 @@ def _parser():
     p.add_argument("--policy", default="shape-factor",
                    choices=POLICIES,
                    help="Q* source of the network model for --pressure")
+    p.add_argument("--grain", default=None,
+                   help="the crop the bed is of, for the ASABE D272 row and the thesis's soybean "
+                        f"values (any case, spaces or underscores: {', '.join(D272)}); default: "
+                        "the grain template its companion JSON names (the bundled scene and "
+                        "the stand-in: soybean); a bed of unknown grain gets no D272 row. A "
+                        "--grain that contradicts the JSON is refused")
     p.add_argument("--json", metavar="OUT.json", help="write every number here (default: not "
                                                       "written)")
     p.add_argument("--plot", metavar="OUT.png",
@@ -188,6 +198,8 @@ def _check_options(args) -> None:
             raise ValueError(f"--standin {' '.join(f'{v:g}' for v in args.standin)}: every side "
                              f"must be >= {STANDIN_MIN_SIDE_M:g} m (6 mean diameters: the "
                              "interior sample keeps 1.5 from each face)")
+    if args.grain is not None:
+        grain_key(args.grain)
     check_common(args)
     check_outputs(json=args.json, plot=args.plot, inputs=packing_inputs(args))
     if args.plot:
@@ -209,6 +221,19 @@ def _read(args):
 def _packing(args, x, r, source: str = "") -> Packing:
     """The bed as a Packing again, with the grain ids :func:`_read` found (None: spheres)."""
     return Packing(x, r, source, grain_id=getattr(args, "grain_id", None))
+
+
+def _grain(args):
+    """The bed's grain (a key of ``network._grains.D272``) or None: the stand-in's is soybean
+    (its diameters); a packing's comes from its companion JSON or ``--grain``
+    (``network._grains.packing_grain``); ValueError when ``--grain`` contradicts either."""
+    if not args.standin:
+        return packing_grain(args.packing, args.grain) if args.packing else None
+    if args.grain is not None and grain_key(args.grain) != "soybean":
+        raise ValueError(f"--grain {args.grain}: the stand-in (--standin) has soybean's "
+                         "diameters; give --grain soybean, or a packing of "
+                         f"{grain_key(args.grain)}")
+    return "soybean"
 
 
 def _entries(args, x, r):
@@ -253,6 +278,7 @@ def _main(args) -> int:
     t0 = time.perf_counter()
     with bad_input():
         _check_options(args)
+        grain = _grain(args)
         x, r, source = _read(args)
         t_read = time.perf_counter() - t0
         xy = _entries(args, x, r)
@@ -290,12 +316,13 @@ def _main(args) -> int:
               f"{p.tortuosity:6.3f} {p.tortuosity_span:6.3f} "
               f"{p.mean_width_m * 1e3:7.2f} {s['turning_below_30deg']:7.2f}"
               + (f"  same as path {dup[i]}" if dup[i] >= 0 else ""))
+    thesis = THESIS if grain == "soybean" else {"tortuosity": {}, "mean_width_mm": {}}
     for kind in kinds:
         ok = [p for p in distinct if p.kind == kind and p.status == "ok"]
         if not ok:
             continue
-        ref = THESIS["tortuosity"].get(kind)
-        refw = THESIS["mean_width_mm"].get(kind)
+        ref = thesis["tortuosity"].get(kind)
+        refw = thesis["mean_width_mm"].get(kind)
         print(f"mean {kind} ({len(ok)} distinct paths): tetrahedra "
               f"{np.mean([p.n_tetrahedra for p in ok]):.0f}, "
               f"tortuosity {np.mean([p.tortuosity for p in ok]):.3f}"
@@ -309,7 +336,7 @@ def _main(args) -> int:
     branched, table45 = [], {}
     if not args.no_branched:
         with computing():
-            branched, table45 = _branched(args, x, r, paths, dup, region)
+            branched, table45 = _branched(args, x, r, paths, dup, region, grain)
 
     along = []
     if args.pressure:
@@ -319,7 +346,7 @@ def _main(args) -> int:
     with computing():
         if args.json:
             out = {
-                "source": source, "units": args.units, "n_spheres": int(len(r)),
+                "source": source, "units": args.units, "n_spheres": int(len(r)), "grain": grain,
                 "axis": args.axis, "depth_m": depth, "comparison_depth_m": args.depth,
                 "conventions": CONVENTIONS, "method": args.method, "entries_xy_m": xy.tolist(),
                 "seconds": {"read": t_read, "tessellation": t_graph, **t_kind},
@@ -328,7 +355,8 @@ def _main(args) -> int:
                            "turning_angles_deg": p.turning_angles_deg.tolist()}
                           for p, d in zip(paths, dup)],
                 "branched": branched, "table_4_5_pa": table45,
-                "pressure_along_paths": along, "thesis": THESIS,
+                "pressure_along_paths": along,
+                "thesis": THESIS if grain == "soybean" else None,
                 "platform": platform.platform(), "cpu_count": os.cpu_count(),
                 "loadavg": os.getloadavg(), "timestamp": time.strftime("%Y-%m-%dT%H:%M:%SZ",
                                                                        time.gmtime()),
@@ -340,9 +368,11 @@ def _main(args) -> int:
     return 0
 
 
-def _thesis_point(args, u: str) -> bool:
-    """Whether the thesis's 0.25 m pressures apply at velocity ``u`` and --depth."""
-    return np.isclose(args.depth, THESIS_DEPTH_M) and u in THESIS["measured_pa"]
+def _thesis_point(args, u: str, grain) -> bool:
+    """Whether the thesis's 0.25 m soybean pressures apply to a bed of ``grain`` at velocity
+    ``u`` and --depth."""
+    return (grain == "soybean" and np.isclose(args.depth, THESIS_DEPTH_M)
+            and u in THESIS["measured_pa"])
 
 
 def _interior(args, x, r, source):
@@ -355,9 +385,9 @@ def _interior(args, x, r, source):
                          "the Ergun porosity of its Table 4.5 (--no-branched skips it)") from exc
 
 
-def _branched(args, x, r, paths, dup, region):
+def _branched(args, x, r, paths, dup, region, grain):
     """The branched model on every distinct ok widest/narrowest path: Table 4.4 (Pa along the
-    path) and the Table 4.5 layout (Pa over --depth)."""
+    path) and the Table 4.5 layout (Pa over --depth, D272 of ``grain``)."""
     t2 = time.perf_counter()
     branched = []
     for i, p in enumerate(paths):
@@ -378,22 +408,26 @@ def _branched(args, x, r, paths, dup, region):
             print(f"{b['kind']:10s} {w:8s} "
                   + " ".join(f"{b[w]['MFx3'][u]:12.3g}" for u in us) + " "
                   + " ".join(f"{b[w]['MFx2'][u]:12.3g}" for u in us))
-    table45 = _table_4_5(args, x, r, branched, region)
+    table45 = _table_4_5(args, x, r, branched, region, grain)
     for u in us:
         along = np.mean([b["average"]["MFx3"][u] for b in branched])
         print(f"mean MFx3 average-width at {u} m/s: {along:.3g} Pa along the paths, "
               f"{table45['branched model'][u]:.3g} Pa over {args.depth:g} m"
               + (f" (thesis {THESIS['branched_mfx3_average_pa'][u]} Pa, measured "
-                 f"{THESIS['measured_pa'][u]} Pa)" if _thesis_point(args, u) else ""))
+                 f"{THESIS['measured_pa'][u]} Pa)" if _thesis_point(args, u, grain) else ""))
+    ab, label = d272_line(grain)
     print(f"Table 4.5 layout (Pa over {args.depth:g} m): "
-          + "; ".join(f"{k} " + " ".join(f"{v:.3g}" for v in vals.values())
-                      for k, vals in table45.items()))
+          + "; ".join(f"{label if k == 'ASABE D272' else k} "
+                      + " ".join(f"{v:.3g}" for v in vals.values())
+                      for k, vals in table45.items())
+          + ("" if ab else f"; {label}"))
     return branched, table45
 
 
-def _table_4_5(args, x, r, branched, region):
-    """Pressure drops over --depth (Pa): measured (thesis, only at its 0.25 m), branched model
-    (ours, mean of the MFx3 average-width paths, each drop / its L0 x depth), ASABE D272 and
+def _table_4_5(args, x, r, branched, region, grain):
+    """Pressure drops over --depth (Pa): measured (thesis, only for soybean at its 0.25 m),
+    branched model (ours, mean of the MFx3 average-width paths, each drop / its L0 x depth),
+    ASABE D272 with ``grain``'s constants (no row where it has none: ``d272_line``) and
     Ergun (thesis 4.2.2) with the porosity and Sauter diameter that ``network.solve`` uses (the
     exact porosity of the sample's inset window where its k is measured), so both commands
     print one Ergun value for one bed."""
@@ -402,11 +436,14 @@ def _table_4_5(args, x, r, branched, region):
     porosity, _ = region_porosity(pk, inset_window(region, ax, pk.grain_diameter) or region, ax)
     us = [f"{u:g}" for u in velocities]
     out = {}
-    if any(_thesis_point(args, u) for u in us):
+    if any(_thesis_point(args, u, grain) for u in us):
         out["measured (thesis)"] = {u: THESIS["measured_pa"].get(u, float("nan")) for u in us}
     out["branched model"] = {u: float(np.mean([b["average"]["MFx3"][u] / b["path_depth_m"]
                                                for b in branched]) * depth) for u in us}
-    out["ASABE D272"] = {f"{u:g}": float(asabe_d272_gradient(u) * depth) for u in velocities}
+    ab, _ = d272_line(grain)
+    if ab is not None:
+        out["ASABE D272"] = {f"{u:g}": float(asabe_d272_gradient(u, a=ab[0], b=ab[1]) * depth)
+                             for u in velocities}
     out[f"Ergun (porosity {porosity:.3f})"] = {
         f"{u:g}": float(ergun_gradient(u, porosity=porosity, diameter_m=pk.sauter_diameter,
                                        viscosity_pa_s=args.viscosity) * depth)
