@@ -25,6 +25,8 @@ whose logarithm is the axis. The table holds FE's Q* over the shape factor's geo
 from __future__ import annotations
 
 import numpy as np
+from throats import validate_throats
+from throats._area import open_area_perimeter
 
 from ._cells import cell_all
 from ._interp import GRIDS, GridTable
@@ -184,9 +186,6 @@ def geometric_factor(radii, sides):
     :math:`A^*` and no-slip perimeter :math:`P^*` in mean radii, ``docs/throats-shape-factor.md``)
     of throats (N, 3) in any order and length unit; 0 where the disks cover the triangle, NaN
     for a row that is not a triangle."""
-    from throats import validate_throats
-    from throats._area import open_area_perimeter
-
     r = np.asarray(radii, dtype=float)
     s = np.asarray(sides, dtype=float)
     out = np.full(len(r), np.nan)
