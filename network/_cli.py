@@ -188,14 +188,15 @@ def check_common(args) -> None:
         check_count(f"--{name}", getattr(args, name, None), MAX_WORKERS)
 
 
-def load_packing(args):
+def load_packing(args, *, tables: bool = True):
     """(path, packing in metres) of ``args.packing`` (bundled scene if None) in ``args.units``;
     the scale warning, if any, as one stderr line, and first a ``note:`` progress line when
-    the Q* tables are used for the first time on this machine (:func:`first_run_note`). A
+    the Q* tables are used for the first time on this machine (:func:`first_run_note`; not
+    for a command that uses no table, ``tables=False``). A
     ``--depth`` thinner than the largest sphere of a packing at a grain's scale is refused
     (ValueError). A companion JSON whose container is of an unknown kind or malformed is
     refused here, before any work (:func:`read_container`)."""
-    note = first_run_note(getattr(args, "policy", None))
+    note = first_run_note(getattr(args, "policy", None)) if tables else None
     if note:
         log.info("note: %s", note)
     path = Path(args.packing) if args.packing else default_packing_path()

@@ -66,7 +66,7 @@ def _main(args) -> int:
     with bad_input():
         check_common(args)
         check_outputs(out=args.out, inputs=packing_inputs(args))
-        path, packing = load_packing(args)
+        path, packing = load_packing(args, tables=False)   # geometry only: no Q* table
         box, margin = sample_box_m(args)
         region = None if args.everything else sample_region(
             packing, box=box, margin=margin, container=None if box else read_container(path))
