@@ -20,7 +20,7 @@ from .._cli import (CliError, CliParser, add_air, add_sample, bad_input, check_c
 from .._grains import BED, D272, grains_with_d272, packing_grain
 from ..curve import DEFAULT_VELOCITIES, parse_velocities
 from ..flow import DEFAULT_DEPTH_M
-from ..packing import UNITS
+from ..packing import UNITS, read_container
 from .band import BAND_OFFSETS
 from .bed import add_bed_options, bed_json, plan_bed, prepare_bed
 from .build import build_report
@@ -102,6 +102,9 @@ def build_parser() -> CliParser:
 def _check(args) -> dict:
     """Every option checked before any solve; returns the parsed pieces."""
     check_common(args)
+    if args.packing is not None and args.sample is None \
+            and packing_meta(args.packing).get("container") is not None:
+        read_container(args.packing)        # its container bounds the sample: checked first
     if args.packing is not None:
         key = packing_grain(args.packing, args.grain, default="soybean")
     else:
