@@ -109,9 +109,27 @@ def _check_files(args, out, amps) -> None:
     check_output_list([("--out", out / n) for n in names], inputs, make_folders=True)
 
 
+def _check_run_options(args) -> None:
+    """The run's numbers, each named by its option (ValueError), before any work."""
+    for name, value in (("--duration", args.duration), ("--record-every", args.record_every)):
+        if value is not None and not (np.isfinite(value) and value > 0):
+            raise ValueError(f"{name} must be finite and > 0, got {value}")
+    if args.steady_window is not None and not (np.isfinite(args.steady_window)
+                                               and args.steady_window >= 0):
+        raise ValueError(f"--steady-window must be finite and >= 0 (0: off), got {args.steady_window}")
+    if not (np.isfinite(args.mass_scale) and args.mass_scale >= 1):
+        raise ValueError(f"--mass-scale must be >= 1 (1: physical masses), got {args.mass_scale}")
+    if args.settle_steps < 1:
+        raise ValueError(f"--settle-steps must be >= 1, got {args.settle_steps}")
+    bad = [t for t in args.snapshots if not (np.isfinite(t) and t >= 0)]
+    if bad:
+        raise ValueError(f"--snapshots must be times >= 0 s, got {bad[0]}")
+
+
 def _vibrate(args) -> int:
     check_seed(args.seed)
     check_counts(args)
+    _check_run_options(args)
     amps = _amplitudes(args)
     if args.study:
         if args.packing:

@@ -28,7 +28,7 @@ from .._cli import (CliError, CliParser, add_air, bad_input, check_common, check
 from .._grains import BED, D272, grain_key
 from ..report.system import AIRFLOW_UNITS, M3_MIN_M3_PER_CFM_BU, airflow_unit, read_fan
 from ._geometry import BinGeometry, Duct, default_size, duct_size, mesh_bin
-from ._material import (ANGLE_OF_REPOSE, d272_material, network_material, read_profile)
+from ._material import ANGLE_OF_REPOSE, JANSSEN, d272_material, network_material, read_profile
 from ._outputs import aeration, write_figure, write_vtk
 from ._solve import BinProblem
 from ._system import fan_operating_point, pressure_for_airflow, solve_checked, system_curve
@@ -80,11 +80,14 @@ def build_parser() -> CliParser:
                     help="CSV depth_m,porosity: porosity against depth below the grain surface")
     ap.add_argument("--compaction", default=None, metavar="FILE",
                     help="CSV stress_pa,porosity: porosity against vertical stress, applied to "
-                         "Janssen's stress (needs --wall-friction and --lateral-ratio)")
+                         "Janssen's stress (wall friction and K from the grain library or the "
+                         "two options below)")
     ap.add_argument("--wall-friction", type=float, default=None,
-                    help="grain-wall friction coefficient for Janssen, > 0")
+                    help="grain-wall friction coefficient for Janssen, > 0 (default: the grain "
+                         "library's on a smooth steel wall)")
     ap.add_argument("--lateral-ratio", type=float, default=None,
-                    help="Janssen's lateral-to-vertical stress ratio K, in (0, 1]")
+                    help="Janssen's lateral-to-vertical stress ratio K, in (0, 1] (default: the "
+                         "grain library's)")
     ap.add_argument("--particle-density", type=float, default=None,
                     help="kernel density, kg/m^3 (default: the grain library's)")
     add_air(ap)
@@ -142,11 +145,17 @@ def _check(args) -> dict:
         raise ValueError(f"--porosity must be in (0, 1), got {args.porosity!r}")
     if sum(x is not None for x in (args.porosity, args.porosity_profile, args.compaction)) > 1:
         raise ValueError("give one of --porosity, --porosity-profile, --compaction")
-    if (args.compaction is None) != (args.wall_friction is None and args.lateral_ratio is None) \
-            and args.compaction is None:
+    if args.compaction is None and (args.wall_friction is not None
+                                    or args.lateral_ratio is not None):
         raise ValueError("--wall-friction and --lateral-ratio go with --compaction")
-    if args.compaction is not None and (args.wall_friction is None or args.lateral_ratio is None):
-        raise ValueError("--compaction needs --wall-friction and --lateral-ratio (Janssen)")
+    if args.compaction is not None:
+        k_lat, mu_w = JANSSEN.get(key, (None, None))
+        args.lateral_ratio = args.lateral_ratio if args.lateral_ratio is not None else k_lat
+        args.wall_friction = args.wall_friction if args.wall_friction is not None else mu_w
+        if args.wall_friction is None or args.lateral_ratio is None:
+            raise ValueError(f"--compaction: the grain library has no Janssen "
+                             f"{'K' if args.lateral_ratio is None else 'wall friction'} for "
+                             f"{key}: give --lateral-ratio and --wall-friction")
     if not 8 <= args.curve_points <= 12:
         raise ValueError(f"--curve-points must be 8-12, got {args.curve_points}")
     if args.elements is not None and args.mesh_size is not None:
@@ -207,8 +216,10 @@ def _check(args) -> dict:
         kw["report"] = args.report
     make = network_material if args.law == "network" else d272_material
     material = make(key, **kw)
+    angle_source = (None if args.top == "flat" else "--peak-angle" if args.peak_angle is not None
+                    else ANGLE_OF_REPOSE[key][1])
     return {"grain": key, "geom": geom, "material": material, "airflow": airflow, "fan": fan,
-            "figure": figure}
+            "figure": figure, "angle_source": angle_source}
 
 
 def _mesh_size(args, geom):
@@ -271,7 +282,8 @@ def build(args, opts) -> dict:
                  "tolerance": REFINEMENT_TOL, "within_tolerance": bool(rel <= REFINEMENT_TOL)}
         log.info("refinement check: %d elements, airflow differs by %.3g %%",
                  coarse.n_elements, 100 * rel)
-    out = {"grain": opts["grain"], "law": material.law, "geometry": geom.as_json(),
+    out = {"grain": opts["grain"], "law": material.law,
+           "geometry": {**geom.as_json(), "peak_angle_source": opts["angle_source"]},
            "material": material.as_json(), "grain_mass_t": mass_t,
            "system_curve": [_row(s, mass_t) for s in curve],
            "mesh": {"elements": mesh.n_elements, "nodes": int(mesh.points.shape[1]),

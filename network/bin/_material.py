@@ -41,23 +41,34 @@ from ..core import read_table
 from ..report.porosity import requested_porosity
 from ._law import ForchheimerLaw, SheddLaw
 
-__all__ = ["ANGLE_OF_REPOSE", "Material", "network_material", "d272_material",
+__all__ = ["ANGLE_OF_REPOSE", "JANSSEN", "Material", "network_material", "d272_material",
            "read_profile", "janssen_stress", "PorosityProfile", "G_M_S2"]
 
 DATA = Path(__file__).resolve().parent.parent / "data"
 G_M_S2 = 9.80665
 
-_MWPS = ("secondary: a table of filling angles of repose by crop quoted in a farm forum thread "
-         "(https://community.agriculture.com/t5/Crops/Angle-of-repose/td-p/18193: barley 28, "
-         "shelled corn 23, oats 28, soybeans 25, sunflowers 27, wheat 25 degrees; 'the figures "
-         "given were for standard moisture'); the primary table was not seen")
-#: filling angle of repose, degrees, and its source (the peaked top's default cone)
+_EN = ("EN 1991-4:2006 Annex E Table E.1, angle of repose phi_r, as the grain library records it "
+       "(dem.grains, the note of internal_friction_deg, with the table's transcription as source)")
+_FARM = ("a US farm table of filling angles quoted in a forum thread gives lower values (wheat 25, "
+         "soybeans 25, shelled corn 23, barley 28 degrees: "
+         "https://community.agriculture.com/t5/Crops/Angle-of-repose/td-p/18193)")
+#: angle of repose, degrees, and its source (the peaked top's default cone); copies of the grain
+#: library's values (network does not import dem; tests/test_network_bin.py checks them)
 ANGLE_OF_REPOSE = {
-    "wheat": (25.0, _MWPS + "; a fan-sizing program's table (network._grains, search-index id "
-              "70324629401) gives 30 for wheat"),
-    "soybean": (25.0, _MWPS),
-    "shelled_corn": (23.0, _MWPS),
-    "barley": (28.0, _MWPS),
+    "soybean": (29.0, f"{_EN}: 'Soya beans' row; {_FARM}"),
+    "wheat": (34.0, f"{_EN}: wheat row; {_FARM}"),
+    "shelled_corn": (35.0, f"{_EN}: 'Maize' row; {_FARM}"),
+    "barley": (31.0, f"{_EN}: 'Barley' row; {_FARM}"),
+}
+#: Janssen's inputs (lateral pressure ratio K, bulk-on-smooth-steel wall friction mu_w): copies of
+#: dem.grains' lateral_pressure_ratio and wall_friction_steel (EN 1991-4:2006 Annex E Table E.1;
+#: canola: Jaky's K from its angle of internal friction), checked against it by the tests
+JANSSEN = {
+    "soybean": (0.63, 0.38),
+    "wheat": (0.54, 0.38),
+    "shelled_corn": (0.53, 0.36),
+    "barley": (0.59, 0.33),
+    "canola": (1.0 - math.sin(math.radians(23.91)), 0.301),
 }
 
 

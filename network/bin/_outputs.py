@@ -6,7 +6,8 @@ superficial velocity |u| has the specific airflow s = |u|/ρ_b; the bin's mass-w
 s̄ = ∫|u| dV / M (M the grain mass). The local airflow per tonne is the bin's airflow per
 tonne q_t = 60 Q/(M/1000) m³/(min t) times s/s̄, so its mass-weighted mean is q_t and a flat
 bed on a full floor has q_t everywhere. The under-aerated fraction is the grain volume where
-s < s̄/2. Cooling estimate at the least aerated element (the smallest s): the time for one
+s < s̄/2 (elements with every node on the plenum or on the surface, whose gradient the mesh
+cannot resolve, left out of it and of the least aerated point). Cooling estimate at the least aerated element (the smallest s): the time for one
 grain volume of air to pass it, t = 1/q_v with q_v = (q_t,local/60)(ρ_b/1000) m³ of air per s
 per m³ of grain (a flat bed: q_v = U/H, the whole bed's air exchange);
 a temperature front moves slower by ρ_b c_g/(ρ_a c_a), the grain's and the air's volumetric
@@ -33,8 +34,13 @@ def aeration(problem, sol, *, grain_heat_capacity=None) -> dict:
     s_mean = float(np.sum(u * vol)) / mass
     q_t = 60.0 * sol.inflow_m3_s / (mass / 1000.0)
     local = q_t * s / s_mean
-    under = s < 0.5 * s_mean
-    i = int(np.argmin(s))
+    # an element whose nodes all lie on one Dirichlet boundary (a sliver at the apex or at a
+    # corner) has a zero gradient whatever the flow: left out of the fraction and the minimum
+    free = np.zeros(problem.skmesh.p.shape[1], dtype=bool)
+    free[problem.free] = True
+    inner = free[problem.mesh.cells].any(axis=0)
+    under = (s < 0.5 * s_mean) & inner
+    i = int(np.flatnonzero(inner)[np.argmin(s[inner])])
     c = problem.centroids[:, i]
     where = ({"r_m": float(c[0]), "z_m": float(c[1])} if problem.axisymmetric else
              {"x_m": float(c[0]), "y_m": float(c[1]), "z_m": float(c[2]),
@@ -43,7 +49,7 @@ def aeration(problem, sol, *, grain_heat_capacity=None) -> dict:
     q_v = local[i] / 60.0 * rho_b[i] / 1000.0           # 1/s
     t_air = float(1.0 / q_v) if q_v > 0 else float("inf")
     out = {"grain_mass_t": mass / 1000.0, "airflow_m3_per_min_t": q_t,
-           "underaerated_fraction": float(np.sum(vol[under]) / np.sum(vol)),
+           "underaerated_fraction": float(np.sum(vol[under]) / np.sum(vol[inner])),
            "least_aerated": {**where, "airflow_m3_per_min_t": float(local[i]),
                              "ratio_to_mean": float(s[i] / s_mean)},
            "local_airflow_m3_per_min_t": local, "underaerated_mask": under,
