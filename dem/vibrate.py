@@ -119,8 +119,6 @@ def _check_run_options(args) -> None:
         raise ValueError(f"--steady-window must be finite and >= 0 (0: off), got {args.steady_window}")
     if not (np.isfinite(args.mass_scale) and args.mass_scale >= 1):
         raise ValueError(f"--mass-scale must be >= 1 (1: physical masses), got {args.mass_scale}")
-    if args.settle_steps < 1:
-        raise ValueError(f"--settle-steps must be >= 1, got {args.settle_steps}")
     bad = [t for t in args.snapshots if not (np.isfinite(t) and t >= 0)]
     if bad:
         raise ValueError(f"--snapshots must be times >= 0 s, got {bad[0]}")

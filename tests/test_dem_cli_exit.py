@@ -3,7 +3,9 @@
 
 import json
 
-from dem import pack
+import pytest
+
+from dem import pack, vibrate
 
 
 def test_unconverged_packing_is_written_marked_and_exits_1(tmp_path, capsys):
@@ -58,3 +60,20 @@ def test_grain_beds_take_the_users_step_limit(tmp_path, monkeypatch, capsys):
     assert pack.main([*base, "--max-steps", "0"]) == 2
     assert "--max-steps must be >= 1" in capsys.readouterr().err
     assert not (tmp_path / "g.csv").exists()
+
+
+@pytest.mark.parametrize("argv, words", [
+    (["--settle-steps", "0"], "--settle-steps must be 1 to"),
+    (["--mass-scale", "0.5"], "--mass-scale must be >= 1"),
+    (["--steady-window", "-1"], "--steady-window must be finite and >= 0"),
+    (["--record-every", "0"], "--record-every must be finite and > 0"),
+    (["--duration", "nan"], "--duration must be finite and > 0"),
+    (["--snapshots", "0.1", "-2"], "--snapshots must be times >= 0 s"),
+])
+def test_vibrate_names_the_bad_run_option_before_any_work(argv, words, tmp_path, capsys):
+    out = tmp_path / "vib"
+    assert vibrate.main(["no_such_bed.csv", "--amplitude", "0.001", "--out", str(out)] + argv) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and words in err
+    assert not out.exists()
+

@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import dataclasses
 import json
+import re
 
 import numpy as np
 import pytest
@@ -194,8 +195,8 @@ def test_the_command_reports_pressure_uniformity_and_the_check(tmp_path, capsys)
     assert r["airflow_m3_per_min_t"] == pytest.approx(0.1, rel=1e-8)
     # the numbers README.md quotes for this command
     assert (round(r["static_pressure_pa"], 1), round(r["airflow_m3_s"], 3),
-            round(r["grain_mass_t"], 1)) == (51.0, 0.349, 209.5)
-    assert round(100 * r["underaerated_fraction"], 1) == 0.7
+            round(r["grain_mass_t"], 1)) == (54.7, 0.366, 219.8)
+    assert round(100 * r["underaerated_fraction"], 1) == 2.7
     assert 8 <= len(r["system_curve"]) <= 12
     ps = [s["static_pressure_pa"] for s in r["system_curve"]]
     qs = [s["airflow_m3_s"] for s in r["system_curve"]]
@@ -203,6 +204,8 @@ def test_the_command_reports_pressure_uniformity_and_the_check(tmp_path, capsys)
     assert r["mass_balance"]["relative_difference"] < 1e-8
     assert r["mesh"]["refinement_check"]["relative_difference"] < 0.005
     assert 0 < r["underaerated_fraction"] < 0.05
+    assert r["geometry"]["peak_angle_deg"] == 34.0 and "EN 1991-4" in r["geometry"][
+        "peak_angle_source"]
     assert r["converged"] is True and r["law"] == "network"
     assert (tmp_path / "b.png").stat().st_size > 10_000
     assert "uniformity" in capsys.readouterr().out
@@ -343,3 +346,38 @@ def test_a_newton_failure_is_exit_1_naming_the_pressure(monkeypatch, capsys):
     err = capsys.readouterr().err.strip().splitlines()
     assert code == 1
     assert len(err) == 1 and "did not converge at a static pressure of 250 Pa" in err[0]
+
+
+def test_the_grain_library_copies_agree_with_dem_grains():
+    """network may not import dem: the angle of repose (EN 1991-4 phi_r, in dem.grains' notes)
+    and Janssen's K and wall friction copied into network.bin are dem.grains' values."""
+    from dem.grains import grain
+    from network.bin._material import ANGLE_OF_REPOSE, JANSSEN
+
+    for name, (k_lat, mu_w) in JANSSEN.items():
+        g = grain(name)
+        assert k_lat == pytest.approx(g.lateral_pressure_ratio.value, rel=1e-12)
+        assert mu_w == g.wall_friction_steel.value
+    for name, (angle, _) in ANGLE_OF_REPOSE.items():
+        assert re.search(rf"phi_r {angle:g}\b", grain(name).internal_friction_deg.note)
+
+
+def test_the_vtk_file_holds_the_mesh_and_its_fields(tmp_path):
+    """--vtk: a legacy unstructured grid whose counts match the JSON's mesh, with the nodal
+    pressure (the plenum's value at its nodes) and the four cell fields."""
+    vtk, js = tmp_path / "b.vtk", tmp_path / "b.json"
+    code = main(["--diameter", "6", "--depth", "3", "--pressure", "100", "--elements", "400",
+                 "--no-figure", "--no-refinement-check", "-q", "--vtk", str(vtk),
+                 "--json", str(js)])
+    assert code == 0
+    lines = vtk.read_text().splitlines()
+    mesh = json.loads(js.read_text())["mesh"]
+    head = {ln.split()[0]: ln.split() for ln in lines if ln[:1].isalpha()}
+    assert head["POINTS"][1] == str(mesh["nodes"]) and head["CELLS"][1] == str(mesh["elements"])
+    assert head["CELL_DATA"][1] == str(mesh["elements"])
+    names = [ln.split()[1] for ln in lines if ln.startswith(("SCALARS", "VECTORS"))]
+    assert names == ["pressure_pa", "velocity_m_s", "porosity", "airflow_m3_per_min_t",
+                     "underaerated"]
+    i = lines.index("SCALARS pressure_pa double 1") + 2
+    p = np.array(lines[i:i + mesh["nodes"]], dtype=float)
+    assert p.max() == 100.0 and p.min() == 0.0
