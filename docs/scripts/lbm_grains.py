@@ -214,8 +214,10 @@ def network_rows(ref, policy="table-only", beds=None):
     sample in the grain beds' narrow samples, the inset window in wider ones; the whole sample's
     beside it) and k_app/k at the Reynolds numbers each LBM run obtained, per bed of ``ref``
     (``beds``: bed name -> file, for beds not bundled)."""
+    from network import tessellate
     from network.flow import ConductanceOptions, FlowOptions, SampleOptions, solve_network
     from network.packing import read_container, read_packing
+    from throats import deep_overlap
 
     out = {}
     for run in ref["runs"]:
@@ -225,17 +227,28 @@ def network_rows(ref, policy="table-only", beds=None):
         path = (beds or {}).get(bed, run["bed"])
         pk, box = read_packing(path), read_container(path)
         sample, cond = SampleOptions(container=box), ConductanceOptions(policy=policy)
-        res = solve_network(pk, axis="z", sample=sample, conductance=cond)
+        tess = tessellate(pk)
+        res = solve_network(pk, axis="z", sample=sample, conductance=cond, tessellation=tess)
+        # each conduit's share of the dissipated power, q^2/g (Stokes), by window class: a
+        # window with a deep pair (two spheres of one grain) or not; d ln k / d ln g_t = share_t
+        ids = np.asarray(res.throat_ids)
+        q, g = np.asarray(res.throat_flow_m3_s), np.asarray(res.throat_conductance)
+        ok = np.isfinite(q) & np.isfinite(g) & (g > 0)
+        power = np.where(ok, q**2 / np.where(ok, g, 1.0), 0.0)
+        deep = deep_overlap(tess.throat_radii[ids], tess.throat_sides[ids])
         d32, mu, rho = res.sauter_diameter_m, res.viscosity_pa_s, 1.2
         re = sorted({round(r["re"], 3) for rr in ref["runs"] if rr["bed_name"] == bed
                      for r in rr["rows"] if r["re"] > 1})
         vel = [x * mu / (rho * d32) for x in re]
         flow = FlowOptions(inertia=True, velocity_m_s=vel[0], curve_velocities_m_s=vel[1:],
                            density_kg_m3=rho)
-        inert = solve_network(pk, axis="z", sample=sample, conductance=cond, flow=flow)
+        inert = solve_network(pk, axis="z", sample=sample, conductance=cond, flow=flow,
+                              tessellation=tess)
         pts = inert.curve_points()
         k = res.permeability_m2        # the gradients' own base (whole or inset sample)
         out[bed] = {"k_m2": res.permeability_m2, "sample_estimator": res.sample_estimator,
+                    "n_conduits": int(len(ids)), "n_deep_pair_conduits": int(deep.sum()),
+                    "deep_pair_dissipation_share": float(power[deep].sum() / power.sum()),
                     "qstar_stats": res.qstar_stats.get("qstar_stats", res.qstar_stats), "k_whole_m2": res.permeability_whole_m2, "d32_m": d32,
                     "rows": [{"re": p["reynolds_particle"],
                               "k_ratio": k / p["apparent_permeability_m2"]} for p in pts]}
