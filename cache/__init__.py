@@ -33,7 +33,8 @@ Command lines: ``python -m cache.precompute``, ``python -m cache.lookup``, ``pyt
 
 The shipped table ``cache/data/grid_g1.npz`` (Q* at the 390 625 nodes of grid ``g1``, solved
 by ``throats.solve_fem`` at rtol 1e-3) and, for rows it cannot serve, ``EXTENSION_GRIDS``
-(radius deviations to ±0.5, gaps -2.2 to 4.6 r̄) are served only while ``throats.SOLVER_VERSION``
+(radius deviations to ±0.5, gaps -2.2 to 4.6 r̄; the deep pairs of grain beds, :mod:`cache._pair`)
+are served only while ``throats.SOLVER_VERSION``
 equals the version they were built with; how to rebuild them: ``docs/cache-table.md``.  Accuracy and speed: ``python -m cache.bench``.  ``cache`` never
 imports ``network`` (data flows network → cache through arrays and CSV files) and never
 meshes or solves itself: it calls ``throats``.

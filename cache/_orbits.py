@@ -10,7 +10,8 @@ sixth of the nodes), :func:`expand` rebuilds the whole grid from them, bit for b
 
 The extension grids serve, in turn, rows the shipped g1 does not: ``x1`` (g1's nodes, radius
 deviations to ±0.375, gaps to 4.6), then ``d1`` (gaps from -2.2, the deep overlaps of two
-spheres of one grain, deviations to ±0.5, step 0.2); every grid reads a throat with its vertex of
+spheres of one grain, deviations to ±0.5, step 0.2), then ``p1`` (the deep pairs that d1's
+cells cannot hold, in coordinates of their own: :mod:`cache._pair`; no orbits); every grid reads a throat with its vertex of
 largest |ρ| third, where a box reaches twice as far (:mod:`cache._order`, ``docs/cache-table.md``).
 """
 
