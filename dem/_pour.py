@@ -234,14 +234,14 @@ def _place_stream(n, kind, size, z_lo, thickness, rb, old_x, rng, drop_height_m)
             t = min(2 * t, 8 * thickness, drop_height_m)
 
 
-def _grown(sim, template, x_new, v_new, q_new):
+def _grown(sim, template, x_new, v_new, q_new, threads=None):
     """A ClumpSimulation holding ``sim``'s grains (state, contact springs, time) plus new ones."""
     g_old, n_old = sim.n_grains, sim.n
     x = np.vstack([sim.X, x_new])
     q = np.vstack([sim.q, q_new])
     new = ClumpSimulation([template], np.zeros(len(x), int), x, q, np.ones(len(x)), sim.walls, sim.material,
                           mass_scale=sim.mass_scale, dt_safety=sim.dt_safety, skin_m=sim.verlet.skin,
-                          gravity_m_s2=sim.gravity_m_s2)
+                          gravity_m_s2=sim.gravity_m_s2, threads=threads)
     new.V[:g_old], new.V[g_old:] = sim.V, v_new
     new.L[:g_old] = sim.L
     new.time_s, new.steps = sim.time_s, sim.steps
@@ -268,7 +268,7 @@ def rest_steps(dt_s, *, rest_time_s=None, min_steps=60_000):
 
 
 def pour_grains(container, template, *, material, fill=FillOptions(), n_grains, rng=None, tol=2e-3,
-                max_steps=None, check_every=200, progress=None, restitution=None, porosity=0.4):
+                max_steps=None, check_every=200, progress=None, restitution=None, porosity=0.4, threads=1):
     r"""Pour ``n_grains`` grains of ``template`` into ``container`` (module notes) and settle.
 
     Parameters
@@ -289,6 +289,11 @@ def pour_grains(container, template, *, material, fill=FillOptions(), n_grains, 
         Grain-grain restitution e of the default rate (None: from ``material.damping_ratio``).
     porosity : float
         Porosity φ of the default rate's bulk density.
+    threads : int | None
+        Threads of the step kernels (default 1; None: chosen by timing in each batch's
+        simulation). A pour makes a new simulation at every batch, and on a shared two-core
+        machine two threads stepped a settled 25 000-sphere corn bed at a tenth of one thread's
+        particle-steps per CPU-second.
 
     Returns
     -------
@@ -351,10 +356,10 @@ def pour_grains(container, template, *, material, fill=FillOptions(), n_grains, 
             q_new = random_quaternions(k, rng)
             if sim is None:
                 sim = ClumpSimulation([template], np.zeros(k, int), x_new, q_new, np.ones(k), walls, material,
-                                      mass_scale=fill.mass_scale)
+                                      mass_scale=fill.mass_scale, threads=threads)
                 sim.V[:] = v_new
             else:
-                sim = _grown(sim, template, x_new, v_new, q_new)
+                sim = _grown(sim, template, x_new, v_new, q_new, threads=threads)
             inserted += k
             batches += 1
         psteps += sim.run(max_steps=steps_per_batch, check_every=check_every, callback=progress)["steps"] * sim.n
