@@ -27,7 +27,10 @@ __all__ = ["KEEP", "ROWS", "derived_path", "load_derived", "save_derived"]
 KEEP = 3
 
 #: rows of the saved arrays (one float64 .npy, memory-mapped)
-ROWS = ("values", "k0", "k1", "k2", "k3", "k4", "cell_ok", "qstar", "fe_error")
+ROWS = ("values", "k0", "k1", "k2", "k3", "k4", "cell_ok", "qstar", "fe_error", "geometric")
+#: rows a table may lack: saved as NaN and left out on reading (the node shape factor's geometric
+#: part, which only the deep-pair table uses: a whole-grid pass of exact open areas, 0.3 s on p1)
+OPTIONAL = ("geometric",)
 
 
 def derived_path(path, directory):
@@ -58,6 +61,9 @@ def load_derived(saved, shape):
         return None
     out = dict(zip(ROWS, np.asarray(a)))      # plain ndarray views: no memmap wrapping later
     out["cell_ok"] = out["cell_ok"] > 0.5
+    for k in OPTIONAL:
+        if np.isnan(out[k]).all():
+            del out[k]
     try:
         os.utime(saved)                       # its time says when it was last used (KEEP)
     except OSError:
@@ -70,8 +76,10 @@ def save_derived(saved, arrays):
     or full disk only costs the next run the 0.1 s of recomputing them."""
     tmp = saved.with_name(f"{saved.name}.{os.getpid()}.tmp")
     try:
-        if any(arrays.get(k) is None for k in ROWS):
+        if any(arrays.get(k) is None for k in ROWS if k not in OPTIONAL):
             return                           # a grid without curvature in every direction
+        size = np.size(arrays["values"])
+        arrays = {k: np.full(size, np.nan) if arrays.get(k) is None else arrays[k] for k in ROWS}
         saved.parent.mkdir(parents=True, exist_ok=True)
         with open(tmp, "wb") as f:
             np.save(f, np.stack([np.ravel(arrays[k]).astype(np.float64)

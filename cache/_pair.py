@@ -219,7 +219,10 @@ class PairTable(GridTable):
 
     def __init__(self, spec, qstar, fe_error=None, **kwargs):
         self.fe_qstar = np.asarray(qstar, dtype=float).reshape(spec.shape)
-        g = geometric_factor(*spec.node_shapes()).reshape(spec.shape)
+        saved = None if kwargs.get("derived") is None else kwargs["derived"].get("geometric")
+        g = (geometric_factor(*spec.node_shapes()) if saved is None
+             else np.asarray(saved)).reshape(spec.shape)
+        self.node_geometric = g
         with np.errstate(invalid="ignore", divide="ignore"):
             ratio = np.where((self.fe_qstar > 0) & (g > 0), self.fe_qstar / g, np.nan)
         ratio[~((ratio < RATIO_MAX) & (ratio > 1.0 / RATIO_MAX))] = np.nan
@@ -228,6 +231,11 @@ class PairTable(GridTable):
         if kwargs.get("derived") is None:
             self.cell_ok = cell_all(self.node_ok | closed)
         self._uniform = [False, False, False, True, True]
+
+    def derived(self):
+        """:meth:`cache.GridTable.derived` with the nodes' geometric part (a whole-grid pass of
+        exact open areas, kept with the other derived arrays)."""
+        return dict(super().derived(), geometric=self.node_geometric)
 
     def coarse_spec(self):
         return self.spec.coarse()
