@@ -26,7 +26,7 @@ import numpy as np
 from .._cli import (CliError, CliParser, add_air, bad_input, check_common, check_outputs,
                     check_plot, computing, finish, progress_log, run)
 from .._grains import BED, D272, grain_key
-from ..report.system import AIRFLOW_UNITS, M3_MIN_M3_PER_CFM_BU, airflow_unit, read_fan
+from ..report.system import AIRFLOW_UNITS, M3_MIN_M3_PER_CFM_BU, parse_airflow, read_fan
 from ._geometry import BinGeometry, Duct, default_size, duct_size, mesh_bin
 from ._material import ANGLE_OF_REPOSE, JANSSEN, d272_material, network_material, read_profile
 from ._outputs import aeration, write_figure, write_vtk
@@ -173,21 +173,14 @@ def _check(args) -> dict:
         angle = ANGLE_OF_REPOSE[key][0]
     ducts = tuple(Duct(d, l, o, args.duct_shape) for d, l, o in (args.duct or []))
     geom = BinGeometry(args.diameter, args.depth, args.top, angle, args.floor, ducts)
-    profile = compaction = janssen = None
+    profile = compaction = None
     if args.porosity_profile is not None:
         profile = read_profile(args.porosity_profile, "--porosity-profile")
     if args.compaction is not None:
         compaction = read_profile(args.compaction, "--compaction")
     airflow = None
     if args.airflow is not None:
-        value, unit = args.airflow
-        unit = airflow_unit(unit)
-        try:
-            airflow = (float(value), unit)
-        except ValueError:
-            raise ValueError(f"--airflow value {value!r} is not a number") from None
-        if not (np.isfinite(airflow[0]) and airflow[0] > 0):
-            raise ValueError(f"--airflow must be finite and > 0, got {value}")
+        airflow = parse_airflow(*args.airflow)
     fan = read_fan(args.fan) if args.fan is not None else None
     if fan is not None and not np.any(fan[1] > 0):
         raise ValueError(f"--fan {args.fan}: no static pressure above 0")

@@ -9,7 +9,6 @@ the figures and the HTML page. Exit 0 done, 1 a solve failed, 2 bad input.
 from __future__ import annotations
 
 import json
-import time
 from pathlib import Path
 
 import numpy as np
@@ -28,7 +27,7 @@ from .figures import FIGURES, write_figures, write_html
 from .options import ReportOptions, grain_key
 from .porosity import (bundled_grains, bundled_packing, check_reachable, packing_meta,
                        reach_record, requested_porosity)
-from .system import AIRFLOW_UNITS, airflow_unit, read_fan
+from .system import AIRFLOW_UNITS, parse_airflow, read_fan
 
 __all__ = ["build_parser", "main", "print_report", "report_options"]
 
@@ -145,14 +144,7 @@ def _check(args) -> dict:
             check_reachable(target, meta.get("porosity_network_region"), reach, key)
     airflow = None
     if args.airflow is not None:
-        value, unit = args.airflow
-        unit = airflow_unit(unit)
-        try:
-            airflow = (float(value), unit)
-        except ValueError:
-            raise ValueError(f"--airflow value {value!r} is not a number") from None
-        if not (np.isfinite(airflow[0]) and airflow[0] > 0):
-            raise ValueError(f"--airflow must be finite and > 0, got {value}")
+        airflow = parse_airflow(*args.airflow)
     fan = None
     if args.fan is not None:
         if args.diameter is None and args.floor_area is None:

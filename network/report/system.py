@@ -25,6 +25,7 @@ import numpy as np
 from ..core import read_table
 
 __all__ = ["AIRFLOW_UNITS", "FAN_COLUMNS", "M3_MIN_M3_PER_CFM_BU", "airflow_unit", "bulk_density",
+           "parse_airflow",
            "check_fan_shape", "floor_area", "velocity_from_airflow", "system_rows",
            "dense_system", "read_fan", "operating_point", "curve_range"]
 
@@ -52,6 +53,25 @@ def airflow_unit(text: str) -> str:
         raise ValueError(f"--airflow unit {text!r}: use one of {', '.join(AIRFLOW_UNITS)} "
                          "(any case)")
     return key
+
+
+def parse_airflow(value: str, unit: str) -> tuple[float, str]:
+    """``--airflow VALUE UNIT`` as (a finite airflow > 0, the unit as :func:`airflow_unit` spells
+    it); ValueError naming the option and what is wrong.
+
+    >>> parse_airflow("0.1", "M3/MIN/T")
+    (0.1, 'm3/min/t')
+    """
+    unit = airflow_unit(unit)
+    try:
+        airflow = float(value)
+    except ValueError:
+        raise ValueError(f"--airflow value {value!r} is not a number") from None
+    if not (np.isfinite(airflow) and airflow > 0):
+        raise ValueError(f"--airflow must be finite and > 0, got {value}")
+    return airflow, unit
+
+
 FAN_COLUMNS = ("airflow_m3_s", "static_pressure_pa")
 
 
