@@ -131,7 +131,7 @@ def test_outputs_may_not_overwrite_the_inputs_or_each_other(tmp_path, capsys, mo
 
 @pytest.mark.parametrize("argv, words", [
     (["--velocities", "0.01,-0.2"], "--velocities value -0.2 must be finite and > 0"),
-    (["--velocities", "0.3:0.01:0"], "--velocities needs n >= 1"),
+    (["--velocities", "0.3:0.01:0"], "--velocities '0.3:0.01:0': n must be 1 to 200 points, got 0"),
     (["--grain", "oats"], "unknown grain 'oats'; known grains: soybean, wheat"),
     (["--grain", "rapeseed"], "no sourced ASABE D272 constants for canola"),
     (["--density", "-1.2"], "--density must be finite and > 0, got -1.2"),
