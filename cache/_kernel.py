@@ -4,7 +4,7 @@ r"""One point of :class:`cache.GridTable`'s interpolation as a numba function, f
 ``GridTable.at_throats(..., errors=False)`` does for a chunk of throats (the same lookup order,
 :mod:`cache._order`, and coordinates,
 same cell, the 32 corners blended in float32 in the same order, the same curvature
-terms): the values agree bit for bit (``tests/test_cache_kernel.py``). A compiled loop
+terms): the values agree bit for bit (``tests/cache/test_cache_kernel.py``). A compiled loop
 (the network's conduit sections, :mod:`network.conductance._conduit_kernel`) calls it per
 section instead of gathering (N, 5) coordinate columns through numpy. The arrays come from
 :meth:`GridTable.kernel_arrays`; :func:`point_kernel` compiles it (numba is imported then).

@@ -16,7 +16,7 @@ its shape alone:
   of its orders does (the box bounds :math:`\rho_1, \rho_2`; :math:`\rho_3` reaches twice as far).
 
 :func:`lookup_order` is the numpy form; :func:`cache._kernel.interp_point` applies the same
-comparisons to one throat, so both read the same cell (``tests/test_cache_kernel.py``).
+comparisons to one throat, so both read the same cell (``tests/cache/test_cache_kernel.py``).
 """
 
 from __future__ import annotations

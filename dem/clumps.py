@@ -23,7 +23,7 @@ step runs three compiled passes (numba; ``docs/dem-clumps.md``, ``docs/dem-speed
 L (world frame) is conserved exactly without torque; the kinetic energy of a free asymmetric top
 to second order in Δt. Δt as the sphere engine's with the mass of the smallest sphere of any
 grain. One-sphere templates reproduce :class:`dem.Simulation` to round-off (the spin goes through
-L and the inertia instead of ω += T Δt/I; ``tests/test_dem_clumps.py``).
+L and the inertia instead of ω += T Δt/I; ``tests/dem/test_dem_clumps.py``).
 """
 
 from __future__ import annotations

@@ -90,6 +90,7 @@ def test_ctrl_c_exits_1_with_one_interrupted_line(bench, workdir, monkeypatch, c
     assert _listing(workdir) == before
 
 
+@pytest.mark.slow
 def test_cache_bench_prints_dash_and_writes_null_for_an_empty_extension_set(
         workdir, monkeypatch, capsys):
     """An extension grid that served no shape: '-' in the table, null in the JSON (it raised

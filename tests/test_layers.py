@@ -109,6 +109,7 @@ def _known_modules():
     return {m for p in PACKAGES for m, _, _ in _modules(p)}
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("package", PACKAGES)
 def test_packages_import_only_what_they_may(package):
     bad = []
@@ -129,6 +130,7 @@ def test_packages_import_only_what_they_may(package):
     assert not bad, "\n".join(bad)
 
 
+@pytest.mark.slow
 def test_the_shared_core_imports_only_itself():
     """network.core, which dem imports, imports nothing of network but itself and the deferred
     SciPy modules, so that importing it never loads the pipeline."""
@@ -146,6 +148,7 @@ print(json.dumps(sorted(m for m in sys.modules if m.split('.')[0] in
 """
 
 
+@pytest.mark.slow
 def test_the_shared_core_loads_numpy_alone():
     """``import network.core`` loads NumPy and the core, no SciPy, numba or pipeline layer;
     ``import dem`` loads no module of network beyond it."""
@@ -165,6 +168,7 @@ def test_the_shared_core_loads_numpy_alone():
     assert net == set(core), net
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("package", PACKAGES)
 def test_no_function_level_project_imports(package):
     bad = [f"{p.relative_to(ROOT)}:{line} imports {t} inside a function"
@@ -172,6 +176,7 @@ def test_no_function_level_project_imports(package):
     assert not bad, "\n".join(bad)
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("package", PACKAGES)
 def test_no_private_names_of_other_modules(package):
     known = _known_modules()
@@ -196,6 +201,7 @@ def _layer_of(package, module):
     raise AssertionError(f"{module}: not in any layer of {package} (add it to LAYERS)")
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("package", sorted(LAYERS))
 def test_layer_order(package):
     bad = []
@@ -211,6 +217,7 @@ def test_layer_order(package):
     assert not bad, "\n".join(bad)
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("package", PACKAGES)
 def test_no_import_cycles(package):
     known = _known_modules()
@@ -278,12 +285,13 @@ def _public_home(target: str):
     return None
 
 
+@pytest.mark.slow
 def test_tests_use_the_public_api():
     """A test imports from a private module only what no public package above it exports."""
     import importlib
 
     bad = []
-    for path in sorted((ROOT / "tests").glob("test_*.py")):
+    for path in sorted((ROOT / "tests").rglob("test_*.py")):
         tree = ast.parse(path.read_text(), filename=str(path))
         for node in ast.walk(tree):
             if not isinstance(node, ast.ImportFrom) or node.level or not node.module:

@@ -15,7 +15,7 @@ The numpy engine allocates (N, 3, 14, 2) temporaries and costs about 55 µs a ro
 deep-overlap sections of multi-sphere grains (a wheat bed: 0.55 M rows, 29 s of a 35 s
 network solve); this loop does the same arithmetic in scalars. numba is imported on the first
 call only (``import throats`` stays cheap; the compiled loop is cached on disk). Agreement
-with the numpy engine: ``tests/test_throats_area_kernel.py``.
+with the numpy engine: ``tests/throats/test_throats_area_kernel.py``.
 """
 
 from __future__ import annotations

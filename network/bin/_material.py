@@ -53,7 +53,7 @@ _FARM = ("a US farm table of filling angles quoted in a forum thread gives lower
          "soybeans 25, shelled corn 23, barley 28 degrees: "
          "https://community.agriculture.com/t5/Crops/Angle-of-repose/td-p/18193)")
 #: angle of repose, degrees, and its source (the peaked top's default cone); copies of the grain
-#: library's values (network does not import dem; tests/test_network_bin.py checks them)
+#: library's values (network does not import dem; tests/network/test_network_bin.py checks them)
 ANGLE_OF_REPOSE = {
     "soybean": (29.0, f"{_EN}: 'Soya beans' row; {_FARM}"),
     "wheat": (34.0, f"{_EN}: wheat row; {_FARM}"),

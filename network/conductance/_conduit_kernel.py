@@ -7,7 +7,7 @@ computes for blocks of throats with the Q* table answering the window and every 
 :math:`y = 1/Q` from the table (:func:`cache.point_kernel`), the slowly-varying-tube factor
 :math:`1 + s/(1+s)` and the trapezoid integral up to each side's height, in the same
 operations and order as the numpy code (agreement to the last bits or nearly,
-``tests/test_network_conduit_kernel.py``). No (N, m+1, 3) section arrays and no per-call
+``tests/network/test_network_conduit_kernel.py``). No (N, m+1, 3) section arrays and no per-call
 lookup bookkeeping are made: 0.2 s instead of about 1 s of one core for the 1.4e6 sections
 of the 20 000-sphere bench packing.
 
@@ -34,7 +34,7 @@ interp_point = None
 #: :func:`conduit_rows`: numba's disk cache of this module checks this file's own time stamp
 #: only, so an edit of cache/_kernel.py must change this line too, or a stale machine code
 #: keeps interpolating the previous source (a test compares the digest)
-INTERP_SOURCE_SHA256 = "13b0f24e7ee4054c"
+INTERP_SOURCE_SHA256 = "f22ee7f97ac0421b"
 _COMPILED: list = []
 # one compiler at a time: the conductance blocks' threads may ask together first
 _LOCK = threading.Lock()

@@ -42,7 +42,7 @@ __all__ = ["TEMPLATE_GRAINS", "PACK_TOL", "add_bed_options", "plan_bed", "bed_pa
            "user_bed_json"]
 
 #: grains with a multi-sphere template in ``dem.templates.TEMPLATE_GRAINS`` (a copy: network may
-#: not import dem; tests/test_report_bed.py checks that the two agree)
+#: not import dem; tests/network/test_report_bed.py checks that the two agree)
 TEMPLATE_GRAINS = ("soybean", "wheat", "shelled_corn", "barley", "canola")
 #: dem.pack --porosity's tolerance (its default --porosity-tol): a request this close to the
 #: bundled bed's own porosity is that bed
