@@ -1,0 +1,436 @@
+"""Per-window comparison of the conduit network with a resolved (lattice-Boltzmann) Stokes flow.
+
+The lattice of ``lbm_grains.py`` (D3Q19 TRT, Guo forcing, halfway bounce-back; the network's
+sample box, mirror lateral faces, box and mirror image one periodic cell along the flow, driven
+by a uniform body force) is solved for Stokes flow and its field kept: density and the three
+velocity components of every node of the box. Then for every conduit of the network's sample
+(a Delaunay face between two pore bodies):
+
+* the resolved flux through the face triangle, Q_LBM = ∫ u·n dA (trilinear interpolation of the
+  node velocities, zero in the solid, on a barycentric grid of points about dx/2 apart);
+* the resolved driving potential of each pore body, P = p - ρ g s (p = c_s² ρ, s the coordinate
+  along the flow), averaged over the fluid nodes of the body's tetrahedra;
+* the resolved conductance of the conduit, g_LBM = Q_LBM / (P_a - P_b), against the network's
+  g (both μ g in m³), and the network's conduit flow at the lattice's mean gradient against
+  Q_LBM.
+
+Conduits are grouped by their window: *deep pair* (two spheres of one grain overlapping so much
+that the tables' deep-overlap family serves the window, :func:`throats.deep_overlap`), *same
+grain* (two vertices of one grain, not deep), *ordinary* (three grains).
+
+    python docs/scripts/lbm_windows.py run network/data/wheat_grains.csv --resolution 16 --out .lbm/wheat_w16.npz
+    python docs/scripts/lbm_windows.py compare .lbm/wheat_w16.npz --json wheat_windows.json
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import sys
+from pathlib import Path
+
+import numpy as np
+
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+from lbm_grains import BoxLattice, mirrored_index, sample_box, voxelise_box  # noqa: E402
+from lbm_periodic import C  # noqa: E402
+
+CS2 = 1.0 / 3.0
+
+
+def run_field(bed, resolution, *, tau=1.5, max_steps=12000, tol=1e-5, log=print):
+    """Stokes field of the bed's sample box at ``resolution`` lattice units per d32."""
+    c, rad, lo, hi, d32, _ = sample_box(bed)
+    dx = d32 / resolution
+    solid = voxelise_box(c, rad, lo, hi, dx)               # (n_flow=z, x, y)
+    index, nf, n_nodes = mirrored_index(solid)
+    lat = BoxLattice(index, nf, n_nodes)
+    eps = 1.0 - solid.mean()
+    nu = (tau - 0.5) / 3.0
+    k_guess = resolution**2 * eps**3 / (180.0 * (1.0 - eps) ** 2)
+    gx = nu * 1e-3 / k_guess
+    log(f"# box {solid.shape} x2, {nf} fluid nodes, porosity {eps:.4f}")
+    r = lat.run(tau, gx, tol=tol, max_steps=max_steps)
+    log(f"# {r['steps']} steps, converged {r['converged']}, {r['seconds']:.0f} s, "
+        f"{r['mlups']:.1f} MLUPS")
+    # moments of the box (the first half of the doubled cell) as the kernel sees them
+    nf0 = int((~solid).sum())
+    f, idx = lat.f, lat.index
+    rho = np.zeros(nf0)
+    j = np.zeros((3, nf0))
+    for i in range(19):
+        v = f[idx[i * nf:i * nf + nf0]]
+        rho += v
+        for a in range(3):
+            if C[i][a]:
+                j[a] += C[i][a] * v
+    j[0] += 0.5 * rho * gx
+    u = j / rho
+    return {"solid": solid, "rho": rho, "u": u, "gx": gx, "tau": tau, "dx_m": dx, "lo_m": lo,
+            "hi_m": hi, "d32_m": d32, "U_lu": float(r["U"]), "steps": r["steps"],
+            "converged": r["converged"], "k_lu2": nu * float(r["U"]) / gx, "bed": str(bed),
+            "resolution": resolution}
+
+
+def _network(bed):
+    """Tessellation, the conduit network's Stokes solution in the sample box (table-only)."""
+    from network import tessellate
+    from network.flow import ConductanceOptions, SampleOptions, solve_network
+    from network.packing import read_container, read_packing
+
+    pk = read_packing(bed)
+    tess = tessellate(pk)
+    res = solve_network(pk, axis="z", sample=SampleOptions(container=read_container(bed)),
+                        conductance=ConductanceOptions(policy="table-only"), tessellation=tess)
+    return pk, tess, res
+
+
+def _voxel_tets(tess, pts):
+    """Tetrahedron of the tessellation holding each point (-1: none matched)."""
+    from scipy import spatial
+
+    c = tess.packing.centers
+    d = spatial.Delaunay(c, qhull_options="Qbb Qc Qz Q12")
+    key = {tuple(v): i for i, v in enumerate(np.sort(tess.pore_vertices, axis=1).tolist())}
+    m = np.array([key.get(tuple(v), -1) for v in np.sort(d.simplices, axis=1).tolist()])
+    s = d.find_simplex(pts)
+    return np.where(s >= 0, m[np.maximum(s, 0)], -1), float(np.mean(m >= 0))
+
+
+def window_class(tess, throats):
+    """'deep' / 'same' / 'ordinary' code (2, 1, 0) of throats' windows."""
+    from throats import deep_overlap
+
+    gid = tess.packing.grain_id[tess.throat_vertices[throats]]
+    same = (gid[:, 0] == gid[:, 1]) | (gid[:, 0] == gid[:, 2]) | (gid[:, 1] == gid[:, 2])
+    deep = deep_overlap(tess.throat_radii[throats], tess.throat_sides[throats])
+    return np.where(deep, 2, np.where(same, 1, 0))
+
+
+def window_intrusion(tess, throats, heights=None, n_points=48, seed=0):
+    """Fraction of each window's open area (the triangle minus its three vertex disks, the
+    section the conduit model and the Q* tables see) that lies inside some other sphere of
+    the packing, by Monte Carlo on ``n_points`` uniform points of the triangle (one
+    ``np.random.default_rng(seed)`` pattern for all). ``heights`` (M,): the section at that
+    height above the face, towards throat_pores[:, 0] (default the face itself). NaN where the
+    three disks leave no sampled point open."""
+    from scipy.spatial import cKDTree
+
+    pk = tess.packing
+    X = pk.centers[tess.throat_vertices[throats]]                         # (M, 3, 3)
+    r3 = pk.radii[tess.throat_vertices[throats]]
+    nrm = np.cross(X[:, 1] - X[:, 0], X[:, 2] - X[:, 0])
+    nrm /= np.linalg.norm(nrm, axis=1)[:, None]
+    if heights is not None:
+        cen = tess.pore_centroid[tess.throat_pores[throats, 0]]
+        nrm *= (np.sign(np.einsum("ij,ij->i", cen - X[:, 0], nrm)) * heights)[:, None]
+    b = np.random.default_rng(seed).random((n_points, 2))
+    flip = b.sum(axis=1) > 1
+    b[flip] = 1 - b[flip]
+    bw = np.column_stack([1 - b.sum(axis=1), b])
+    tree = cKDTree(pk.centers)
+    out = np.full(len(throats), np.nan)
+    for part in np.array_split(np.arange(len(throats)), max(1, len(throats) // 20000)):
+        pts = np.einsum("pk,mkc->mpc", bw, X[part])
+        if heights is not None:
+            pts += nrm[part][:, None, :]
+        in3 = (np.linalg.norm(pts[:, :, None, :] - X[part][:, None], axis=3)
+               < r3[part][:, None, :]).any(axis=2)
+        dd, ii = tree.query(pts.reshape(-1, 3), k=12)
+        inall = (dd < pk.radii[ii]).any(axis=1).reshape(in3.shape)
+        open3 = (~in3).sum(axis=1)
+        with np.errstate(invalid="ignore", divide="ignore"):
+            out[part] = np.where(open3 > 0, (~in3 & inall).sum(axis=1) / open3, np.nan)
+    return out
+
+
+def equivalent_disks(tess, throats, n_points=128, seed=0):
+    """Window radii (M, 3) enlarged so that the three-disk open area equals the open area left
+    by all spheres: the open points inside another sphere (Monte Carlo, ``n_points`` on the
+    triangle) are given to the vertex whose sphere surface is nearest, and that vertex's disk
+    grows (bisection on :func:`throats.open_area`, vertex by vertex) until the three-disk open
+    area has lost that much. Returns (radii, removed area fraction of the window's open area)."""
+    import throats as th_
+    from scipy.spatial import cKDTree
+
+    pk = tess.packing
+    X = pk.centers[tess.throat_vertices[throats]]
+    r3 = tess.throat_radii[throats].copy()
+    sides = tess.throat_sides[throats]
+    b = np.random.default_rng(seed).random((n_points, 2))
+    flip = b.sum(axis=1) > 1
+    b[flip] = 1 - b[flip]
+    bw = np.column_stack([1 - b.sum(axis=1), b])
+    tree = cKDTree(pk.centers)
+    a3 = th_.open_area(r3, sides)
+    a_tri = th_.triangle_area(sides)
+    dA = np.zeros((len(throats), 3))
+    for part in np.array_split(np.arange(len(throats)), max(1, len(throats) // 10000)):
+        pts = np.einsum("pk,mkc->mpc", bw, X[part])
+        d3 = np.linalg.norm(pts[:, :, None, :] - X[part][:, None], axis=3) - r3[part][:, None, :]
+        in3 = (d3 < 0).any(axis=2)
+        dd, ii = tree.query(pts.reshape(-1, 3), k=12)
+        extra = ~in3 & (dd < pk.radii[ii]).any(axis=1).reshape(in3.shape)
+        near = np.argmin(d3, axis=2)
+        for v in range(3):
+            dA[part, v] = (extra & (near == v)).sum(axis=1) / n_points * a_tri[part]
+    r_new = r3.copy()
+    target = a3.copy()
+    for v in range(3):
+        target = target - dA[:, v]
+        need = dA[:, v] > 0
+        lo, hi = np.zeros(len(throats)), np.where(need, r3[:, v], 0.0)
+        for _ in range(40):
+            mid = 0.5 * (lo + hi)
+            rr = r_new.copy()
+            rr[:, v] += mid
+            a = np.nan_to_num(th_.open_area(rr, sides))
+            over = a < target
+            hi = np.where(need & over, mid, hi)
+            lo = np.where(need & ~over, mid, lo)
+        r_new[:, v] += np.where(need, 0.5 * (lo + hi), 0.0)
+    return r_new, float(dA.sum() / np.nansum(a3))
+
+
+def intrusion_report(bed, log=print):
+    """Window intrusion of a bed's sample (per window class, power-weighted, at the face and
+    half-way to the pore centre) and the network's k with equivalent disks
+    (:func:`equivalent_disks`) at every height instead of the vertex spheres."""
+    import dataclasses
+
+    from network.flow import ConductanceOptions, SampleOptions, solve_network
+    from network.packing import read_container
+
+    pk, tess, res = _network(bed)
+    th = np.asarray(res.throat_ids)
+    cls = window_class(tess, th) if pk.grain_id is not None else np.zeros(th.size, int)
+    g = np.asarray(res.throat_conductance)
+    q = np.asarray(res.throat_flow_m3_s)
+    power = np.where(g > 0, q**2 / np.where(g > 0, g, 1.0), 0.0)
+    out = {"bed": str(bed), "k_whole_m2": res.permeability_whole_m2, "classes": {}}
+    h_half = 0.5 * np.minimum(np.asarray(_conduit_heights(tess, th))[:, 0],
+                              tess.throat_radii[th].max(axis=1))
+    for name, heights in (("face", None), ("half", h_half)):
+        f = window_intrusion(tess, th, heights)
+        ok = np.isfinite(f)
+        for code in np.unique(cls):
+            m = ok & (cls == code)
+            out["classes"].setdefault(CLASSES[code], {"n": int((cls == code).sum())})[
+                f"intrusion_{name}_power_weighted"] = float(np.sum(power[m] * f[m])
+                                                            / power[m].sum())
+        out[f"intrusion_{name}_power_weighted"] = float(np.sum(power[ok] * f[ok])
+                                                        / power[ok].sum())
+    r_new, removed = equivalent_disks(tess, th)
+    tr = tess.throat_radii.copy()
+    tr[th] = r_new
+    res2 = solve_network(pk, axis="z", sample=SampleOptions(container=read_container(bed)),
+                         conductance=ConductanceOptions(policy="table-only"),
+                         tessellation=dataclasses.replace(tess, throat_radii=tr))
+    out["window_area_removed"] = removed
+    out["k_equivalent_disks_m2"] = res2.permeability_whole_m2
+    out["k_change_equivalent_disks"] = res2.permeability_whole_m2 / res.permeability_whole_m2 - 1
+    log(json.dumps(out, indent=1))
+    return out
+
+
+def _conduit_heights(tess, throats):
+    """Conduit heights (M, 2) of the conduit model (merged pore bodies), m."""
+    from network.conductance import conduit_conductance
+
+    return conduit_conductance(tess, throats, policy="table-only", qstar_fn=lambda r, s:
+                               np.ones(len(r))).h_m
+
+
+CLASSES = ("ordinary", "same", "deep", "ordinary, neck body")
+
+
+def compare(field_npz, log=print):
+    """Per-conduit resolved flux and conductance against the network's (module docstring)."""
+    z = np.load(field_npz)
+    shape = tuple(int(v) for v in z["shape"])
+    solid = np.unpackbits(z["bits"], count=int(np.prod(shape))).reshape(shape).astype(bool)
+    dx, lo, gx, tau = float(z["dx_m"]), z["lo_m"], float(z["gx"]), float(z["tau"])
+    nu = (tau - 0.5) / 3.0
+    rho, u = z["rho"], z["u"]
+    pk, tess, res = _network(str(z["bed"]))
+    # node positions (bed coordinates) of the fluid nodes; lattice axes (z, x, y) of the bed
+    fl = np.flatnonzero(~solid.ravel())
+    i0, i1, i2 = np.unravel_index(fl, shape)
+    pts = np.column_stack([lo[0] + (i1 + 0.5) * dx, lo[1] + (i2 + 0.5) * dx,
+                           lo[2] + (i0 + 0.5) * dx])
+    tet, matched = _voxel_tets(tess, pts)
+    log(f"# {fl.size} fluid nodes, {np.mean(tet >= 0):.4f} located in a tetrahedron "
+        f"({matched:.4f} of qhull's simplices matched)")
+    # resolved flux through each sample face: midpoint rule on n^2 sub-triangles (n: sides
+    # split to <= dx/2), velocity trilinear between nodes, zero in the solid; sign: towards
+    # the tetrahedron throat_pores[:, 1]
+    from scipy import ndimage
+
+    th = np.asarray(res.throat_ids)
+    grid_u = np.zeros((3,) + shape)
+    for a_ in range(3):
+        grid_u[a_].ravel()[fl] = u[a_]
+    ub = [grid_u[1], grid_u[2], grid_u[0]]                    # bed x, y, z components
+    X = tess.packing.centers[tess.throat_vertices[th]]        # (M, 3, 3)
+    nrm = np.cross(X[:, 1] - X[:, 0], X[:, 2] - X[:, 0])
+    area = 0.5 * np.linalg.norm(nrm, axis=1)
+    nrm /= 2.0 * area[:, None]
+    cen1 = tess.pore_centroid[tess.throat_pores[th, 1]]
+    nrm *= np.sign(np.einsum("ij,ij->i", cen1 - X[:, 0], nrm))[:, None]
+    side = np.max(np.linalg.norm(X - np.roll(X, 1, axis=1), axis=2), axis=1)
+    nsub = np.maximum(np.ceil(side / (0.5 * dx)).astype(int), 1)
+    q_face = np.zeros(th.size)
+    for n in np.unique(nsub):
+        rows = np.flatnonzero(nsub == n)
+        i, j = np.meshgrid(np.arange(n), np.arange(n), indexing="ij")
+        up = (i + j) <= n - 1
+        dn = (i + j) <= n - 2
+        b1 = np.r_[(i[up] + 1 / 3) / n, (i[dn] + 2 / 3) / n]
+        b2 = np.r_[(j[up] + 1 / 3) / n, (j[dn] + 2 / 3) / n]
+        bw = np.stack([1 - b1 - b2, b1, b2])                  # (3, P)
+        for part in np.array_split(rows, max(1, rows.size * bw.shape[1] // 2_000_000)):
+            P = np.einsum("kp,mkc->mpc", bw, X[part])         # (m, P, 3)
+            # node (i0 flow, i1, i2) at lo + (i + 1/2) dx: fractional index = (x - lo)/dx - 1/2
+            fi = (P - lo) / dx - 0.5
+            coords = np.stack([fi[..., 2].ravel(), fi[..., 0].ravel(), fi[..., 1].ravel()])
+            un = np.zeros(coords.shape[1])
+            nn = np.repeat(nrm[part], bw.shape[1], axis=0)
+            for c_ in range(3):
+                un += nn[:, c_] * ndimage.map_coordinates(ub[c_], coords, order=1, mode="nearest")
+            q_face[part] = un.reshape(part.size, -1).mean(axis=1) * area[part] / dx**2
+    q_t = np.zeros(tess.n_throats)
+    q_t[th] = q_face                                          # lu^3 / step
+    # pore bodies of the sample: mean driving potential P = c_s^2 rho - rho0 g s
+    n_t = tess.n_pores
+    labels = np.asarray(res.pore_groups) if res.pore_groups is not None else np.arange(n_t)
+    body_ids = np.asarray(res.pore_ids)
+    loc = np.full(labels.max() + 2, -1, dtype=np.int64)
+    loc[body_ids] = np.arange(body_ids.size)
+    node_body = np.where(tet >= 0, loc[labels[np.maximum(tet, 0)]], -1)
+    s_lu = i0 + 0.5
+    P = CS2 * rho - rho.mean() * gx * s_lu
+    inb = node_body >= 0
+    cnt = np.bincount(node_body[inb], minlength=body_ids.size)
+    Pb = np.bincount(node_body[inb], P[inb], minlength=body_ids.size) / np.maximum(cnt, 1)
+    # the sample's conduits
+    conns = np.asarray(res.conns)
+    mu = res.viscosity_pa_s
+    g_net = np.asarray(res.throat_conductance) * mu                       # m^3
+    dP = Pb[conns[:, 0]] - Pb[conns[:, 1]]
+    good = (cnt[conns[:, 0]] > 0) & (cnt[conns[:, 1]] > 0)
+    g_lbm = np.where(good & (np.abs(dP) > 0), nu * q_t[th] / np.where(dP != 0, dP, 1), np.nan) \
+        * dx**3                                                          # mu g, m^3
+    # network flows at the lattice's mean gradient, as mu Q / G (m^4)
+    G_net = mu * res.velocity_m_s / res.permeability_whole_m2            # (p_in - p_out) / L
+    qn = np.asarray(res.throat_flow_m3_s) * mu / G_net
+    ql = q_t[th] * nu / (rho.mean() * gx) * dx**4
+    k_lbm = float(z["k_lu2"]) * dx**2
+    # conservation of the resolved face fluxes on the bodies (lateral and end bodies lose
+    # conduits cut by the sample's faces: the median is the check)
+    nb = body_ids.size
+    net_b = np.bincount(conns[:, 0], -ql, nb) + np.bincount(conns[:, 1], ql, nb)
+    tot_b = np.bincount(conns[:, 0], np.abs(ql), nb) + np.bincount(conns[:, 1], np.abs(ql), nb)
+    imbalance = float(np.median(np.abs(net_b[tot_b > 0]) / tot_b[tot_b > 0]))
+    log(f"# body flux imbalance |sum q| / sum |q|: median {imbalance:.3f}")
+    cls = window_class(tess, th)
+    # pore bodies holding a tetrahedron with two spheres of one grain (a neck inside the body)
+    gv = tess.packing.grain_id[tess.pore_vertices]
+    neck_t = np.zeros(n_t, dtype=bool)
+    for i_ in range(4):
+        for j_ in range(i_ + 1, 4):
+            neck_t |= gv[:, i_] == gv[:, j_]
+    neck_b = np.zeros(body_ids.size, dtype=bool)
+    sel = loc[labels] >= 0
+    np.logical_or.at(neck_b, loc[labels][sel], neck_t[sel])
+    cls = np.where((cls == 0) & (neck_b[conns[:, 0]] | neck_b[conns[:, 1]]), 3, cls)
+    closed = ~(g_net > 0)
+    out = {"field": str(field_npz), "bed": str(z["bed"]), "resolution": float(z["resolution"]),
+           "k_lbm_m2": k_lbm, "k_net_whole_m2": res.permeability_whole_m2,
+           "k_net_over_lbm": res.permeability_whole_m2 / k_lbm,
+           "body_imbalance_median": imbalance, "classes": {}}
+    power_net = np.where(g_net > 0, qn**2 / np.where(g_net > 0, g_net, 1), 0.0)
+    for code, name in enumerate(CLASSES):
+        m = (cls == code) & ~closed
+        r = g_net[m] / g_lbm[m]
+        fin = np.isfinite(r) & (r > 0)
+        w = np.abs(ql[m])
+        out["classes"][name] = {
+            "n": int(m.sum()), "n_closed": int(((cls == code) & closed).sum()),
+            "abs_flux_share_lbm": float(np.abs(ql[m]).sum() / np.abs(ql[~closed]).sum()),
+            "abs_flux_share_net": float(np.abs(qn[m]).sum() / np.abs(qn[~closed]).sum()),
+            "power_share_net": float(power_net[m].sum() / power_net.sum()),
+            "flux_ratio_net_over_lbm": float(np.abs(qn[m]).sum() / np.abs(ql[m]).sum()),
+            "g_ratio_median": float(np.median(r[fin])) if fin.any() else None,
+            "g_ratio_power_weighted_log_mean": float(np.exp(
+                np.sum(power_net[m][fin] * np.log(np.clip(r[fin], 0.1, 10)))
+                / power_net[m][fin].sum())) if fin.any() else None,
+            "dlnk_contribution": float(np.sum(power_net[m][fin] * np.log(np.clip(r[fin], 0.1, 10)))
+                                       / power_net.sum()) if fin.any() else None,
+            "g_ratio_flux_weighted_log_mean": float(np.exp(np.sum(w[fin] * np.log(r[fin]))
+                                                           / w[fin].sum())) if fin.any() else None,
+        }
+        # closed windows that carry resolved flux
+        mc = (cls == code) & closed
+        out["classes"][name]["closed_abs_flux_share_lbm"] = float(
+            np.abs(ql[mc]).sum() / np.abs(ql).sum())
+    # the same by the window's intrusion (open area of the three-disk section inside other
+    # spheres)
+    intr = window_intrusion(tess, th)
+    out["intrusion_bins"] = []
+    for lo_, hi_ in ((0.0, 0.02), (0.02, 0.1), (0.1, 0.25), (0.25, 1.01)):
+        m = (intr >= lo_) & (intr < hi_) & ~closed
+        r = g_net[m] / g_lbm[m]
+        fin = np.isfinite(r) & (r > 0)
+        out["intrusion_bins"].append({
+            "intrusion": [lo_, min(hi_, 1.0)], "n": int(m.sum()),
+            "n_deep": int((m & (cls == 2)).sum()),
+            "power_share_net": float(power_net[m].sum() / power_net.sum()),
+            "flux_ratio_net_over_lbm": float(np.abs(qn[m]).sum() / np.abs(ql[m]).sum()),
+            "g_ratio_median": float(np.median(r[fin])) if fin.any() else None,
+            "g_ratio_power_weighted_log_mean": float(np.exp(
+                np.sum(power_net[m][fin] * np.log(np.clip(r[fin], 0.1, 10)))
+                / power_net[m][fin].sum())) if fin.any() else None})
+    out["per_conduit"] = {"intrusion": np.nan_to_num(intr, nan=-1.0).tolist(),"throat": th.tolist(), "class": cls.tolist(), "q_lbm_m4": ql.tolist(),
+                          "q_net_m4": qn.tolist(), "mu_g_net_m3": g_net.tolist(),
+                          "mu_g_lbm_m3": np.nan_to_num(g_lbm, nan=-1.0).tolist()}
+    return out
+
+
+def main(argv=None):
+    ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+    sub = ap.add_subparsers(dest="cmd", required=True)
+    r = sub.add_parser("run", help="Stokes field of a bed's sample box")
+    r.add_argument("bed")
+    r.add_argument("--resolution", type=float, default=16.0, help="lattice units per d32")
+    r.add_argument("--max-steps", type=int, default=12000)
+    r.add_argument("--tol", type=float, default=1e-5)
+    r.add_argument("--out", required=True, help="NPZ of the field")
+    c = sub.add_parser("compare", help="per-conduit comparison with the network")
+    c.add_argument("field")
+    c.add_argument("--json", default=None)
+    i = sub.add_parser("intrusion", help="window area inside spheres off the face")
+    i.add_argument("beds", nargs="+")
+    i.add_argument("--json", default=None)
+    a = ap.parse_args(argv)
+    if a.cmd == "intrusion":
+        rows = [intrusion_report(b) for b in a.beds]
+        if a.json:
+            Path(a.json).write_text(json.dumps(rows, indent=1) + "\n")
+        return 0
+    if a.cmd == "run":
+        res = run_field(a.bed, a.resolution, max_steps=a.max_steps, tol=a.tol)
+        solid = res.pop("solid")
+        np.savez_compressed(a.out, bits=np.packbits(solid.ravel()), shape=solid.shape,
+                            **{k: np.asarray(v) for k, v in res.items()})
+        print(f"wrote {a.out}: k {res['k_lu2'] * res['dx_m']**2:.4e} m2")
+        return 0
+    res = compare(a.field)
+    print(json.dumps({k: res[k] for k in ("k_net_over_lbm", "body_imbalance_median", "classes",
+                                          "intrusion_bins")}, indent=1))
+    if a.json:
+        Path(a.json).write_text(json.dumps(res, indent=1) + "\n")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
