@@ -192,6 +192,88 @@ def equivalent_disks(tess, throats, n_points=128, seed=0):
     return r_new, float(dA.sum() / np.nansum(a3))
 
 
+def _q_section(V, disks, n=40):
+    """Flow rate per unit pressure gradient times viscosity of a section: the triangle ``V``
+    (3, 2) minus the disks ``[(centre (2,), radius), ...]``, u = 0 on the disks, no flux
+    through the triangle's edges (symmetry, as in the window problem): -lap u = 1 by finite
+    volumes on an n x n pixel grid over the triangle's bounding box (first order at the
+    boundaries; used for ratios of sections on one grid)."""
+    from scipy import sparse
+    from scipy.sparse.linalg import spsolve
+
+    lo = V.min(0); L = (V.max(0) - lo).max(); hgrid = L / n
+    xs = lo[0] + (np.arange(n) + 0.5) * hgrid; ys = lo[1] + (np.arange(n) + 0.5) * hgrid
+    Xg, Yg = np.meshgrid(xs, ys, indexing="ij")
+    P = np.stack([Xg.ravel(), Yg.ravel()], 1)
+    def inside_tri(P):
+        s = []
+        for i in range(3):
+            a, b = V[i], V[(i + 1) % 3]
+            s.append((b[0] - a[0]) * (P[:, 1] - a[1]) - (b[1] - a[1]) * (P[:, 0] - a[0]))
+        s = np.array(s)
+        return (s >= 0).all(0) | (s <= 0).all(0)
+    tri = inside_tri(P)
+    solid = np.zeros(len(P), bool)
+    for c, r in disks:
+        solid |= ((P - c) ** 2).sum(1) < r * r
+    fluid = tri & ~solid
+    nf = fluid.sum()
+    if nf == 0:
+        return 0.0
+    ids = -np.ones(len(P), int); ids[fluid] = np.arange(nf)
+    ids = ids.reshape(n, n); fl = fluid.reshape(n, n); so = (solid & tri).reshape(n, n) | (solid.reshape(n, n))
+    rows, cols, vals = [], [], []
+    diag = np.zeros(nf)
+    for dx_, dy_ in ((1, 0), (-1, 0), (0, 1), (0, -1)):
+        a = np.roll(np.roll(ids, -dx_, 0), -dy_, 1)
+        sa = np.roll(np.roll(so, -dx_, 0), -dy_, 1)
+        valid = np.ones((n, n), bool)
+        if dx_ == 1: valid[-1, :] = False
+        if dx_ == -1: valid[0, :] = False
+        if dy_ == 1: valid[:, -1] = False
+        if dy_ == -1: valid[:, 0] = False
+        m = fl & valid & (a >= 0)
+        rows.append(ids[m]); cols.append(a[m]); vals.append(-np.ones(m.sum()))
+        np.add.at(diag, ids[m], 1.0)
+        w = fl & valid & (a < 0) & sa                # wall (Dirichlet 0)
+        np.add.at(diag, ids[w], 1.0)
+    A = sparse.csr_matrix((np.concatenate(vals + [diag]), (np.concatenate(rows + [np.arange(nf)]),
+                           np.concatenate(cols + [np.arange(nf)]))), shape=(nf, nf))
+    u = spsolve(A.tocsc(), np.full(nf, hgrid * hgrid))
+    return float(u.sum() * hgrid * hgrid)
+
+
+
+def section_flow_ratio(tess, throats, intrusion, n=40):
+    """Q of each window's section with every sphere that cuts the face plane, over Q of the
+    three-disk section (:func:`_q_section`, one grid); 1 where no other sphere intrudes."""
+    from scipy.spatial import cKDTree
+
+    pk = tess.packing
+    tree = cKDTree(pk.centers)
+    rmax = pk.radii.max()
+    ratio = np.ones(len(throats))
+    for k in np.flatnonzero(np.nan_to_num(intrusion) > 0):
+        vid = tess.throat_vertices[throats[k]]
+        X, r = pk.centers[vid], pk.radii[vid]
+        e1 = (X[1] - X[0]) / np.linalg.norm(X[1] - X[0])
+        nn = np.cross(X[1] - X[0], X[2] - X[0])
+        nn /= np.linalg.norm(nn)
+        e2 = np.cross(nn, e1)
+        V = np.stack([[(x - X[0]) @ e1, (x - X[0]) @ e2] for x in X])
+        d3 = [(V[i], r[i]) for i in range(3)]
+        extra = []
+        for j in tree.query_ball_point(X.mean(0), np.linalg.norm(X - X.mean(0), axis=1).max()
+                                       + rmax):
+            d = (pk.centers[j] - X[0]) @ nn
+            if j not in vid and abs(d) < pk.radii[j]:
+                p = pk.centers[j] - X[0]
+                extra.append((np.array([p @ e1, p @ e2]), np.sqrt(pk.radii[j] ** 2 - d * d)))
+        q3 = _q_section(V, d3, n)
+        ratio[k] = _q_section(V, d3 + extra, n) / q3 if q3 > 0 else 1.0
+    return ratio
+
+
 def intrusion_report(bed, log=print):
     """Window intrusion of a bed's sample (per window class, power-weighted, at the face and
     half-way to the pore centre) and the network's k with equivalent disks
@@ -229,6 +311,32 @@ def intrusion_report(bed, log=print):
     out["window_area_removed"] = removed
     out["k_equivalent_disks_m2"] = res2.permeability_whole_m2
     out["k_change_equivalent_disks"] = res2.permeability_whole_m2 / res.permeability_whole_m2 - 1
+    # the resolved section flow with the intruding spheres, its ratio put on each conduit
+    f_face = window_intrusion(tess, th)
+    ratio = section_flow_ratio(tess, th, f_face)
+    hit = np.nan_to_num(f_face) > 0
+    out["n_windows_intruded"] = int(hit.sum())
+    out["section_ratio_median_intruded"] = float(np.median(ratio[hit])) if hit.any() else 1.0
+    out["section_ratio_power_weighted"] = float(np.sum(power * ratio) / power.sum())
+    rmap = dict(zip(th.tolist(), ratio.tolist()))
+
+    def scaled(on):
+        from network.conductance import conduit_conductance
+
+        def fn(tt, ids):
+            cr = conduit_conductance(tt, ids, policy="table-only")
+            gg = np.asarray(cr.g).copy()
+            if on:
+                rr = np.array([rmap.get(i, 1.0) for i in np.asarray(ids).tolist()])
+                keep = ~np.asarray(cr.internal)
+                gg[keep] *= rr[keep]
+            return gg
+        return fn
+
+    ks = [solve_network(pk, axis="z", sample=SampleOptions(container=read_container(bed)),
+                        conductance=ConductanceOptions(function=scaled(on)),
+                        tessellation=tess).permeability_whole_m2 for on in (False, True)]
+    out["k_change_section_ratio"] = ks[1] / ks[0] - 1
     log(json.dumps(out, indent=1))
     return out
 
