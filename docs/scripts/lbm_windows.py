@@ -20,6 +20,12 @@ grain* (two vertices of one grain, not deep), *ordinary* (three grains).
 
     python docs/scripts/lbm_windows.py run network/data/wheat_grains.csv --resolution 16 --out .lbm/wheat_w16.npz
     python docs/scripts/lbm_windows.py compare .lbm/wheat_w16.npz --json wheat_windows.json
+
+``intrusion`` needs no lattice: the share of each window's three-disk open area that lies inside
+other spheres, the Stokes flow of those sections with every sphere cutting the face plane
+against the three-disk section, and the network's k with that ratio on each conduit:
+
+    python docs/scripts/lbm_windows.py intrusion network/data/soybean_grains.csv network/data/wheat_grains.csv
 """
 
 from __future__ import annotations
