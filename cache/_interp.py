@@ -84,7 +84,20 @@ def grid_coordinates(radii, sides):
     return x
 
 
-class GridSpec:
+class RadiusLattice:
+    """The two radius-deviation axes every grid ends with: ``rho_count`` nodes spaced
+    ``rho_step`` and centred on 0; a subclass names its :attr:`axes`."""
+
+    @property
+    def rho_nodes(self):
+        return self.rho_step * (np.arange(self.rho_count) - (self.rho_count - 1) / 2)
+
+    @property
+    def shape(self):
+        return tuple(len(a) for a in self.axes)
+
+
+class GridSpec(RadiusLattice):
     """Definition of a grid: gap nodes (shared by the 3 gap axes) and the radius lattice.
 
     Parameters
@@ -112,17 +125,9 @@ class GridSpec:
         self.rho_count = int(rho_count)
 
     @property
-    def rho_nodes(self):
-        return self.rho_step * (np.arange(self.rho_count) - (self.rho_count - 1) / 2)
-
-    @property
     def axes(self):
         g, p = self.gap_nodes, self.rho_nodes
         return [g, g, g, p, p]
-
-    @property
-    def shape(self):
-        return tuple(len(a) for a in self.axes)
 
     def to_dict(self):
         return {"name": self.name, "gap_nodes": self.gap_nodes.tolist(),

@@ -29,7 +29,7 @@ from throats import validate_throats
 from throats._area import open_area_perimeter
 
 from ._cells import cell_all
-from ._interp import GRIDS, GridTable
+from ._interp import GRIDS, GridTable, RadiusLattice
 
 __all__ = ["PairSpec", "PairTable", "pair_coordinates", "geometric_factor", "DEEP_GAP"]
 
@@ -41,7 +41,7 @@ RATIO_MAX = 50.0
 DEEP_GAP = -0.2
 
 
-class PairSpec:
+class PairSpec(RadiusLattice):
     r"""A deep-pair grid: node sets of its five axes (module docstring).
 
     Parameters
@@ -77,17 +77,9 @@ class PairSpec:
         self.rho_count = int(rho_count)
 
     @property
-    def rho_nodes(self):
-        return self.rho_step * (np.arange(self.rho_count) - (self.rho_count - 1) / 2)
-
-    @property
     def axes(self):
         p = self.rho_nodes
         return [self.log_side_nodes, self.gap_nodes, self.tau_nodes, p, p]
-
-    @property
-    def shape(self):
-        return tuple(len(a) for a in self.axes)
 
     def to_dict(self):
         return {"name": self.name, "kind": self.kind,
