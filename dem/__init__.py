@@ -31,16 +31,10 @@ write_packing, read_packing
     CSV ``x,y,z,r`` (m) + JSON summary. CLIs: ``python -m dem.pack``, ``python -m dem.vibrate``
     (``--study thesis``: the thesis's vibration study, :mod:`dem.study`), ``python -m dem.bench``.
 
-Model and approximations (each measured by ``dem.bench`` or stated in the JSON summaries)
--------------------------------------------------------------------------------------------
-* PFC3D linear contact model: contact stiffness = series combination of the entities'
-  stiffnesses (two soybeans: 2.0e6 N/m normal), viscous dashpots at critical-damping ratio
-  0.1 (normal, no tension) and 0.1 (shear), Coulomb friction 0.47 / 0.3 (walls), rotations.
-* Density scaling S (default 100 for packing and vibration): masses × S at unchanged gravity,
-  i.e. all stiffnesses ÷ S; Δt grows by √S. Overlaps under load grow S-fold (still < 1 % of a
-  radius in the 0.25 m beds); its effect on porosity and coordination is measured with
-  ``python -m dem.bench --mass-scale-study``.
-* Equilibrium: mean unbalanced-force ratio below ``tol`` (default 2e-3). Speed: ``docs/dem-speed.md``.
+Model: PFC3D's linear contact (series stiffness, critical-damping ratio 0.1, Coulomb friction),
+density scaling S for grown and vibrated beds (poured beds use real masses), equilibrium by the
+mean unbalanced-force ratio below ``tol``: ``docs/dem-packing.md``, ``docs/dem-fill.md``; speed
+``docs/dem-speed.md``.
 """
 
 from ._contacts import damping_coefficient, linear_contact_forces, restitution_coefficient, series_stiffness

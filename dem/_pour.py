@@ -19,31 +19,10 @@ capped at the terminal velocity :math:`v_t` of its volume-equivalent sphere (dia
 :math:`v_t` = 11.2 m/s at Re ≈ 3000: the cap acts only for drops above 6.4 m. Kernels
 enter with a random orientation (uniform on SO(3)) and no spin.
 
-**Stream.** Grains enter in batches every :math:`\tau` (:func:`batch_interval`), each batch the
-mass :math:`\dot m \tau` of the stream, placed at random without overlap (bounding spheres)
-in the slab the stream fills in that time, :math:`h = v_0\tau` thick, starting one bounding
-radius above the surface (the highest sphere of the grains not falling at entry speed; under
-the spout, within its footprint). A grain placed at height :math:`s` above the slab's bottom
-gets the speed it has there on its fall, :math:`\sqrt{v_0^2 - 2 g s}` (so every grain reaches
-the surface at :math:`v_0`). A batch that does not fit its slab (a dense stream from a narrow
-spout) is spread over a slab up to 8 times thicker, at most the drop height (the mean rate is
-kept). Rain: the footprint is the whole cross-section; spout: a disk of the spout's diameter
-about the axis.
-
-**Rate.** The default mass flow makes the surface rise one grain diameter :math:`d_v` in the
-time of a landed grain's first rebound flight, :math:`t_f = 2 e v_0 / g` (grain-grain
-restitution e): :math:`\dot m = \rho_p (1-\varphi) A\, d_v g/(2 e v_0)` (φ the middle of the
-grain's measured loose-fill porosity). A grain hitting the bed loses more than a grain-grain
-contact takes, so in that time it has come to rest before the next layer covers it.
-
-**Rest.** When all grains are in, the bed settles until the mean unbalanced-force ratio is
-below ``tol`` (``converged``) or ``max_steps`` pass (default :func:`rest_steps`: 0.5 s of
-simulated time, at least 60 000 steps, so real masses get the time that mass scale 100 gets).
-
-**Measured.** The long-axis orientation order :math:`S = \langle \tfrac32\cos^2\theta -
-\tfrac12\rangle` (θ between a kernel's long axis and the vertical; 0 random, -1/2 all lying
-flat, 1 all upright), porosity in 10 layers from the floor to the surface, and, for a spout,
-the angle of repose of the pile's slope (:func:`angle_of_repose`).
+**Stream, rate, rest and what is measured** (batches placed in the slab the stream fills, the
+default mass flow that raises the surface one grain diameter per rebound flight, the settle to
+``tol`` within :func:`rest_steps`, the orientation order S, porosity in 10 layers and a spout's
+angle of repose): ``docs/dem-fill.md``, which derives each and gives the measured beds.
 """
 
 from __future__ import annotations
