@@ -8,6 +8,7 @@
     python -m dem.pack --scene box --grain soybean --out bed.csv     # multi-sphere grains, rain-filled
     python -m dem.pack --scene box --grain wheat --fill spout --spout-diameter 0.02 --out pile.csv
     python -m dem.pack --scene box --grain wheat --depth 3.4 --bin-diameter 6 --out deep.csv  # overburden
+    python -m dem.pack --scene box --grain wheat --stress 0 20000 40000 --out set.csv  # set_0kPa.csv ...
     python -m dem.pack --scene box --grain wheat --fill grow --porosity 0.402 --out bed.csv   # search
     python -m dem.pack --scene box --grain my_kernel.csv --template-units mm --out bed.csv
 
@@ -17,7 +18,10 @@ one row per grain; ``--scene box`` alone means 0.04 x 0.04 x 0.04 m. Grains are 
 (``--fill rain``, the default, or ``spout``; :mod:`dem._pour`) with their real masses and the
 library's friction and restitution, or grown in place (``--fill grow``, :mod:`dem._clump_pack`).
 ``--depth Z --bin-diameter D`` (or ``--stress PA``) then loads the poured bed through a lid
-servo-controlled to Janssen's vertical stress at that depth (:mod:`dem._load`).
+servo-controlled to Janssen's vertical stress at that depth (:mod:`dem._load`). Several
+``--stress`` values make a bed set: one pour, each stress loaded from a copy of the same poured
+state and written to ``<stem>_<kPa>kPa.csv`` (``set.csv`` with ``--stress 0 20000``:
+``set_0kPa.csv``, ``set_20kPa.csv``).
 
 Writes the packing CSV (``x,y,z,r``, m) and its JSON summary (same stem). Exit status 0
 on success, 2 on bad arguments (nothing written), 1 when the simulation went unstable (nothing
@@ -27,6 +31,7 @@ written) or stopped at the step limit before equilibrium (written, marked ``"con
 from __future__ import annotations
 
 import argparse
+import copy
 import math
 import sys
 import time
@@ -142,8 +147,10 @@ def _parser():
     p.add_argument("--bin-diameter", type=float, default=None, help="--depth: the bin's diameter, m")
     p.add_argument("--bin-height", type=float, default=None,
                    help="--depth: the bin's wall height, m (a deeper --depth is refused)")
-    p.add_argument("--stress", type=float, default=None,
-                   help="rain/spout: load the bed through a lid to this vertical stress, Pa (not with --depth)")
+    p.add_argument("--stress", type=float, nargs="+", default=None,
+                   help="rain/spout: load the bed through a lid to this vertical stress, Pa (not with --depth); "
+                        "several: one pour, each stress loaded from a copy of the poured state and written to "
+                        "<stem>_<kPa>kPa.csv")
     p.add_argument("--quiet", action="store_true", help="no progress lines on stderr")
     return p
 
@@ -286,18 +293,28 @@ def _procedure_options(args):
     return opts
 
 
+def _stress_outputs(args):
+    """[(stress Pa or None, packing path)]: ``--out`` itself, or with several ``--stress`` values
+    one ``<stem>_<kPa>kPa<suffix>`` per stress."""
+    if args.stress is None or len(args.stress) == 1:
+        return [(None if args.stress is None else args.stress[0], Path(args.out))]
+    out = Path(args.out)
+    return [(s, out.with_name(f"{out.stem}_{s / 1000:g}kPa{out.suffix}")) for s in args.stress]
+
+
 def _check_outputs(args):
     """ValueError naming --out when the packing, its JSON summary or (--grain) its grain table
     cannot be written or is the --grain template file, before any work."""
     inputs = [("--grain", Path(args.grain))] if args.grain is not None and Path(
         str(args.grain)).is_file() else []
-    check_output(args.out, inputs=inputs)
-    files = [summary_path(args.out)] + ([grains_path(args.out)] if args.grain is not None else [])
-    for f in files:
-        if f.resolve() == Path(args.out).resolve():
-            raise ValueError(f"--out {args.out}: the packing would overwrite its own {f.name}; "
-                             "give a .csv name")
-        check_output(f, f"--out {args.out}: companion", inputs=inputs)
+    for _, out in _stress_outputs(args):
+        check_output(out, inputs=inputs)
+        files = [summary_path(out)] + ([grains_path(out)] if args.grain is not None else [])
+        for f in files:
+            if f.resolve() == Path(out).resolve():
+                raise ValueError(f"--out {args.out}: the packing would overwrite its own {f.name}; "
+                                 "give a .csv name")
+            check_output(f, f"--out {args.out}: companion", inputs=inputs)
 
 
 _POUR_ONLY = (("--drop-height", "drop_height"), ("--rate", "rate"), ("--spout-diameter", "spout_diameter"),
@@ -333,10 +350,13 @@ def _fill_options(args):
         if v is not None and not (math.isfinite(v) and (v >= 0 if key == "depth" else v > 0)):
             raise ValueError(f"{opt} {v:g} m: must be a finite length, {'>= 0' if key == 'depth' else '> 0'}")
     if args.stress is not None:
-        if not (math.isfinite(args.stress) and args.stress >= 0):
-            raise ValueError(f"--stress {args.stress:g} Pa: must be finite and >= 0")
+        for v in args.stress:
+            if not (math.isfinite(v) and v >= 0):
+                raise ValueError(f"--stress {v:g} Pa: must be finite and >= 0")
+        if len(set(args.stress)) != len(args.stress):
+            raise ValueError(f"--stress {' '.join(f'{v:g}' for v in args.stress)}: a stress is given twice")
         if args.depth is not None:
-            raise ValueError(f"--stress {args.stress:g} together with --depth {args.depth:g}: give one")
+            raise ValueError(f"--stress {args.stress[0]:g} together with --depth {args.depth:g}: give one")
     if args.depth is not None and args.bin_diameter is None:
         raise ValueError(f"--depth {args.depth:g} needs --bin-diameter (Janssen's stress depends on it)")
     if args.depth is None and (args.bin_diameter is not None or args.bin_height is not None):
@@ -399,7 +419,8 @@ def _pour_material(args, name):
 
 
 def _pour(args, fill, template, container) -> int:
-    """--fill rain|spout, then the load of --depth or --stress."""
+    """--fill rain|spout, then the load of --depth or --stress (several stresses: each from a copy
+    of the same poured state)."""
     t0, c0 = time.perf_counter(), time.process_time()
     check_fill_options(fill, container, template)
     janssen = _janssen_inputs(template.name) if args.depth is not None else None
@@ -413,10 +434,24 @@ def _pour(args, fill, template, container) -> int:
     cb = lambda sim, f: pr(fill.method, _Progress(sim), None)
     sim, record = pour_grains(container, template, material=material, fill=fill, n_grains=n, rng=args.seed,
                               tol=args.tol, max_steps=max_steps, progress=cb, restitution=e_pp, porosity=phi_count)
+    outs = _stress_outputs(args)
+    poured = copy.deepcopy(sim) if len(outs) > 1 else None
+    rc = 0
+    for k, (stress, out) in enumerate(outs):
+        bed = sim if poured is None else (poured if k == len(outs) - 1 else copy.deepcopy(poured))
+        rc = max(rc, _load_and_write(args, out, bed, stress, janssen=janssen, fill=fill, template=template,
+                                     container=container, material=material, used=used, record=record, n=n,
+                                     max_steps=max_steps, pr=pr, t0=t0, c0=c0))
+    return rc
+
+
+def _load_and_write(args, out, sim, stress, *, janssen, fill, template, container, material, used, record, n,
+                    max_steps, pr, t0, c0) -> int:
+    """Load one poured bed to ``stress`` (or Janssen's at --depth), write it to ``out``, print its
+    lines; the exit status."""
     s = {"n_grains": n, "n_spheres": sim.n, "template": template.name, "template_source": template.source,
          "spheres_per_grain": template.n, "grain_volume_m3": template.volume_m3, "fill": record}
     converged = record["converged"]
-    stress = args.stress
     if janssen is not None or (stress is not None and stress > 0):
         before = poured_bed_summary(sim, template, container, record)
         load = {"porosity_before_load": before["porosity_network_region"]}
@@ -435,6 +470,8 @@ def _pour(args, fill, template, container) -> int:
         else:
             load.update(target_pa=0.0, converged=True)
         s["load"] = load
+    elif stress is not None:
+        s["load"] = {"target_pa": 0.0, "converged": True}
     s.update(poured_bed_summary(sim, template, container, record))
     s.update(steps=sim.steps, simulated_time_s=sim.time_s, dt_s=sim.dt, mass_scale=fill.mass_scale,
              wall_time_s=time.perf_counter() - t0, cpu_time_s=time.process_time() - c0,
@@ -443,12 +480,16 @@ def _pour(args, fill, template, container) -> int:
              engine="dem.clumps (numba: the sphere step's kernels and a rigid-body update)",
              scene=args.scene, seed=args.seed, container=container.to_dict(), material_from_library=used,
              converged=bool(converged))
+    if args.stress is not None and len(args.stress) > 1:
+        s["bed_set"] = {"stresses_pa": [float(v) for v in args.stress],
+                        "note": "one pour; each stress loaded from a copy of the same poured state; "
+                                "wall and CPU times count the pour and every load before this one"}
     s["particle_steps_per_cpu_s"] = s["particle_steps"] / max(s["cpu_time_s"], 1e-9)
-    write_grain_packing(args.out, sim.sphere_centers(), sim.radii.copy(), sim.gid.copy(),
+    write_grain_packing(out, sim.sphere_centers(), sim.radii.copy(), sim.gid.copy(),
                         {"centers": sim.X.copy(), "quaternions": sim.q.copy(), "volume_m3": sim.volume_m3.copy(),
                          "template": [template.name] * sim.n_grains}, s)
     print(f"{n} grains of {template.n} spheres ({sim.n} spheres), {fill.method} from {fill.drop_height_m:g} m at "
-          f"{record['rate_kg_s']:.3g} kg/s -> {args.out} (+ {grains_path(args.out).name}, {summary_path(args.out).name})")
+          f"{record['rate_kg_s']:.3g} kg/s -> {out} (+ {grains_path(out).name}, {summary_path(out).name})")
     print(f"porosity (union of spheres): network's sample region {s['porosity_network_region']:.4f} +- "
           f"{s['porosity_network_region_error']:.4f}; orientation order S {_num(s['orientation_order_S'], 3)}"
           + (f"; angle of repose {_num(s['angle_of_repose']['angle_deg'], 1)} deg" if "angle_of_repose" in s else "")

@@ -188,6 +188,32 @@ def test_bad_fill_and_load_input_exits_2_and_writes_nothing(tmp_path, capsys, ex
     assert len(err) == 1 and err[0].startswith("error:") and named in err[0]
 
 
+@pytest.mark.slow
+def test_a_bed_set_loads_each_stress_from_the_same_poured_state(tmp_path):
+    """--stress with several values: one pour, each stress loaded from a copy of the poured state,
+    so the set's bed at a stress is the bed a single --stress run of the same seed makes."""
+    base = ["--scene", "box", "--size", "0.025", "0.025", "--height", "0.02", "--grain", "soybean",
+            "--n-grains", "25", "--mass-scale", "100", "--quiet"]
+    assert main(base + ["--stress", "0", "4000", "--out", str(tmp_path / "set.csv")]) == 0
+    assert main(base + ["--stress", "4000", "--out", str(tmp_path / "one.csv")]) == 0
+    one = np.loadtxt(tmp_path / "one.csv", delimiter=",", skiprows=1)
+    loaded = np.loadtxt(tmp_path / "set_4kPa.csv", delimiter=",", skiprows=1)
+    poured = np.loadtxt(tmp_path / "set_0kPa.csv", delimiter=",", skiprows=1)
+    np.testing.assert_array_equal(loaded, one)
+    assert not np.array_equal(poured, loaded)
+    s0, s4 = (json.loads((tmp_path / f"set_{k}kPa.json").read_text()) for k in (0, 4))
+    assert s0["load"]["target_pa"] == 0.0 and s4["load"]["lid_stress_pa"] == pytest.approx(4000.0, rel=0.02)
+    np.testing.assert_equal(s4["load"]["porosity_before_load"], s0["porosity_network_region"])
+    assert s4["bed_set"]["stresses_pa"] == [0.0, 4000.0]
+
+
+def test_a_stress_given_twice_is_refused(tmp_path, capsys):
+    rc = main(["--scene", "box", "--grain", "wheat", "--stress", "100", "100", "--quiet",
+               "--out", str(tmp_path / "b.csv")])
+    assert rc == 2 and list(tmp_path.iterdir()) == []
+    assert "--stress 100 100: a stress is given twice" in capsys.readouterr().err
+
+
 def test_sphere_beds_refuse_fill_options(tmp_path, capsys):
     rc = main(["--scene", "box", "--size", "0.04", "0.04", "--height", "0.04", "--fill", "rain",
                "--out", str(tmp_path / "s.csv")])
