@@ -21,6 +21,7 @@ from ..packing import read_container
 from ..pores import region_porosity, sample_region
 from .band import BAND_OFFSETS, band_gradients, measured_band, pack_band, slope_at
 from .bed import user_bed_json
+from .binbeds import bin_section, bin_velocities, solve_set
 from .options import ReportOptions
 from .porosity import check_reachable, shift_factor
 from .system import (bulk_density, curve_range, dense_system, floor_area, operating_point,
@@ -57,6 +58,41 @@ def _fits(o: ReportOptions, pts, porosity, d32):
 
 def _points(res):
     return [{k: p[k] for k in KEYS} for p in res.curve_points()]
+
+
+def solve_bin_bed(o: ReportOptions, path, us) -> dict:
+    """One bed of the bin's set solved at velocities ``us`` in both directions: its porosity
+    (where k is measured, as the report's own) and gradients, Pa/m."""
+    from ..packing import read_packing
+    packing = read_packing(path)
+    container = None if o.sample_box_m else read_container(path)
+    rz = _solve(o, packing, container, "z", us)
+    rx = _solve(o, packing, container, "x", us)
+    pz, px = rz.curve_points(), rx.curve_points()
+    return {"porosity": float(rz.porosity),
+            "gradient_z_pa_per_m": [float(p["pressure_gradient_pa_per_m"]) for p in pz],
+            "gradient_x_pa_per_m": [float(p["pressure_gradient_pa_per_m"]) for p in px],
+            "converged": [bool(a["converged"] and b["converged"]) for a, b in zip(pz, px)]}
+
+
+def _bin_beds(o: ReportOptions) -> dict | None:
+    """The ``bin_beds`` entry: the set solved (or read from its cache) and integrated over the
+    bin's depth (:mod:`network.report.binbeds`); the plan's one line where it is not used."""
+    plan = o.bin_beds
+    if plan is None:
+        return None
+    if not plan["used"]:
+        return {"used": False, "why": plan["why"]}
+    us = bin_velocities(o.velocities_m_s)
+    inputs = {"velocities_m_s": us, "viscosity_pa_s": o.viscosity_pa_s,
+              "density_kg_m3": o.density_kg_m3, "sample_box_m": o.sample_box_m,
+              "margin_m": o.margin_m}
+    solved = solve_set(plan, lambda path: solve_bin_bed(o, path, us), inputs)
+    c = D272[o.grain]
+    out = bin_section(plan, solved, us, None if c.a_pa_s2_m3 is None else (c.a_pa_s2_m3, c.b_s_m))
+    if plan.get("pack"):
+        out["packed"] = plan["pack"]
+    return out
 
 
 def _porosity_plan(o: ReportOptions, e_p: float):
@@ -214,5 +250,6 @@ def build_report(packing, path, options: ReportOptions) -> dict:
             row = system_rows([op[0] / area], [op[1] / o.depth_m], depth_m=o.depth_m,
                               area_m2=area, bulk_density_kg_m3=rho_b)[0]
             out["operating_point"] = {"found": True, **row}
+    out["bin_beds"] = _bin_beds(o)
     out["seconds"] = time.perf_counter() - t0
     return out

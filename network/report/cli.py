@@ -9,6 +9,7 @@ the figures and the HTML page. Exit 0 done, 1 a solve failed, 2 bad input.
 from __future__ import annotations
 
 import json
+import sys
 from pathlib import Path
 
 import numpy as np
@@ -22,6 +23,7 @@ from ..flow import DEFAULT_DEPTH_M
 from ..packing import UNITS, read_container
 from .band import BAND_OFFSETS
 from .bed import add_bed_options, bed_json, plan_bed, prepare_bed
+from .binbeds import check_bin_depth, pack_bed_set, plan_bin_beds
 from .build import build_report
 from .figures import FIGURES, write_figures, write_html
 from .options import ReportOptions, grain_key
@@ -64,9 +66,13 @@ def build_parser() -> CliParser:
     ap.add_argument("--particle-density", type=float, default=None,
                     help="kernel (true) density, kg/m^3, for the bulk density rho_p (1 - "
                          "porosity); default: the grain library's (network/_grains.py BED)")
-    ap.add_argument("--depth", type=float, default=DEFAULT_DEPTH_M,
+    ap.add_argument("--depth", type=float, default=None,
                     help="grain the air crosses, m, > 0: the bed depth for --axis z, the bed's "
-                         "thickness across the airflow for --axis x")
+                         f"thickness across the airflow for --axis x (default {DEFAULT_DEPTH_M:g}). "
+                         "With --diameter it is the bin's grain depth: a grain with a bed set "
+                         "(rain-filled beds loaded to several stresses: bundled for soybean, "
+                         "wheat, shelled corn; packed on first use for barley, canola) is also "
+                         "reported through the whole depth, Janssen's stress at each depth")
     ap.add_argument("--axis", default="z", type=str.lower, choices=["z", "x"],
                     help="the bin's airflow for the system curve, --airflow and --fan: z vertical "
                          "(floor aeration, default) or x horizontal (cross-flow: the floor area "
@@ -100,6 +106,9 @@ def build_parser() -> CliParser:
 
 def _check(args) -> dict:
     """Every option checked before any solve; returns the parsed pieces."""
+    depth_given = args.depth is not None
+    if not depth_given:
+        args.depth = DEFAULT_DEPTH_M
     check_common(args)
     if args.packing is not None and args.sample is None \
             and packing_meta(args.packing).get("container") is not None:
@@ -130,9 +139,23 @@ def _check(args) -> dict:
                          f"one (dem.pack, minutes), or pack it with python -m dem.pack --scene "
                          f"box --grain {key} --porosity P --out bed.csv, then add --packing "
                          "bed.csv")
+    bed_dir = args.bed_dir or Path(args.plot_dir or f"report_{key}") / "beds"
     bed = plan_bed(key, porosity=args.porosity, seed=args.seed, packing=args.packing,
-                   move_along_band=args.move_along_band, bed_box=args.bed_box,
-                   bed_dir=args.bed_dir or Path(args.plot_dir or f"report_{key}") / "beds")
+                   move_along_band=args.move_along_band, bed_box=args.bed_box, bed_dir=bed_dir)
+    if bed["action"] == "bundled" and args.porosity is None and packing_meta(
+            bed["packing"]).get("fill", {}).get("method") in ("rain", "spout"):
+        target, why = None, ("the poured bed's own (a rain-filled bed makes its own porosity; "
+                             f"the bundled bed of {key} is the surface bed of its bin bed set)")
+    other = next((opt for opt, v in (("--packing", args.packing), ("--porosity", args.porosity),
+                                     ("--seed", args.seed),
+                                     ("--move-along-band", args.move_along_band or None),
+                                     ("--sample", getattr(args, "sample", None)))
+                  if v is not None), None)
+    bins = plan_bin_beds(key, depth_m=args.depth, diameter_m=args.diameter,
+                         depth_given=depth_given, particle_density=rho_p, bed_dir=bed_dir,
+                         other=other)
+    if bins is not None:
+        bins["grain"] = key
     reach = None
     if bed["action"] == "pack":
         target, why = None, "requested: " + bed["porosity_why"]  # the new bed's own
@@ -170,7 +193,7 @@ def _check(args) -> dict:
     return {"grain": key, "particle_density": rho_p, "particle_density_source": rho_src,
             "airflow": airflow, "fan": fan, "velocities": parse_velocities(args.velocities),
             "porosity": target, "porosity_source": why, "reachable": reach,
-            "plot_dir": plot_dir, "bed": bed}
+            "plot_dir": plot_dir, "bed": bed, "bin_beds": bins}
 
 
 def _g(v, fmt="10.4g"):
@@ -266,7 +289,38 @@ def print_report(r) -> None:
               f"{op['static_pressure_pa']:.4g} Pa, U {op['velocity_m_s']:.4g} m/s")
     elif op:
         print(op["message"])
+    print_bin_beds(r.get("bin_beds"))
     print(f"total {r['seconds']:.1f} s")
+
+
+def print_bin_beds(bb) -> None:
+    """The bin's beds: the stresses, porosities and the resistance through the whole depth."""
+    if bb is None:
+        return
+    if not bb["used"]:
+        print(f"bin's beds: not used: {bb['why']}")
+        return
+    j, st, e = bb["janssen"], bb["stress_pa"], bb["porosity"]
+    print(f"bin's beds ({bb['source']}, rain-filled, {len(bb['beds'])} beds at "
+          + ", ".join(f"{b['stress_pa'] / 1000:.3g}" for b in bb["beds"])
+          + f" kPa): {bb['diameter_m']:g} m bin, {bb['depth_m']:g} m deep; Janssen (K "
+          f"{j['lateral_ratio_K']:.3g}, mu_w {j['wall_friction_mu_w']:.3g}, bulk density "
+          f"{j['bulk_density_kg_m3']:.1f} kg/m^3)")
+    print("  stress surface / mid / bottom " + " / ".join(f"{st[k] / 1000:.3g}" for k in
+                                                          ("surface", "mid", "bottom"))
+          + " kPa; porosity " + " / ".join(f"{e[k]:.4f}" for k in ("surface", "mid", "bottom"))
+          + f" (depth mean {bb['porosity_depth_mean']:.4f}); interpolated in stress between "
+          "the beds")
+    print(f"{'U m/s':>8} {'dP v Pa':>10} {'D272 Pa':>10} {'/D272':>6} {'g_z s/m/b':>22} "
+          f"{'g_x mean':>9} {'h/v':>6}   (whole depth, layers in series; g in Pa/m)")
+    for p in bb["points"]:
+        g = p["vertical_gradient_pa_per_m"]
+        print(f"{p['velocity_m_s']:8.4g} {p['vertical_pressure_drop_pa']:10.4g} "
+              f"{_g(p['d272_pressure_drop_pa'])} "
+              + ("     -" if p["ratio_to_d272"] is None else f"{p['ratio_to_d272']:6.3f}")
+              + f" {g['surface']:7.4g}/{g['mid']:7.4g}/{g['bottom']:7.4g} "
+              f"{p['horizontal_mean_gradient_pa_per_m']:9.4g} {p['horizontal_to_vertical']:6.3f}"
+              + ("" if p["converged"] else "  NOT CONVERGED: not a result"))
 
 
 def main(argv=None) -> int:
@@ -292,7 +346,7 @@ def report_options(args, checked: dict, path) -> ReportOptions:
         band_seed=args.band_seed, viscosity_pa_s=args.viscosity, density_kg_m3=args.density,
         sample_box_m=None if box is None else tuple(box),
         margin_m=margin, bed_label=checked["bed"]["label"],
-        bed_record=bed_json(checked["bed"], path))
+        bed_record=bed_json(checked["bed"], path), bin_beds=checked["bin_beds"])
 
 
 def _main(args) -> int:
@@ -301,6 +355,16 @@ def _main(args) -> int:
         opts = _check(args)
     bed = opts["bed"]
     args.packing = prepare_bed(bed, quiet=args.quiet)
+    bins = opts["bin_beds"]
+    if bins is not None and bins["used"] and bins.get("beds") is None:
+        if not args.quiet:
+            print(f"packing the bin bed set of {opts['grain']} with dem.pack into "
+                  f"{bins['bed_dir']} (once; reused next time): this takes tens of minutes",
+                  file=sys.stderr, flush=True)
+        with computing():
+            bins["pack"] = pack_bed_set(bins, opts["grain"], quiet=args.quiet)
+        with bad_input():
+            check_bin_depth(bins)
     if bed["action"] == "pack":
         opts["reachable"] = reach_record(packing_meta(args.packing),
                                          Path(args.packing).with_suffix(".json"))

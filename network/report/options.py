@@ -80,6 +80,10 @@ class ReportOptions:
         Which bed, the first words of ``porosity_source`` (default ``"the user's packing"``).
     bed_record : dict or None
         The JSON's ``bed`` entry; None (default): a user's packing at the given path.
+    bin_beds : dict or None
+        The bin's beds (:func:`network.report.binbeds.plan_bin_beds`, its beds packed): the
+        report adds the resistance through the bin's whole depth (``bin_beds``); a plan with
+        ``used`` False is reported as its one line; None (default): no bin section.
     """
 
     grain: str
@@ -107,6 +111,7 @@ class ReportOptions:
     margin_m: float | None = None
     bed_label: str = "the user's packing"
     bed_record: dict | None = None
+    bin_beds: dict | None = None
 
     def __post_init__(self):
         set_ = object.__setattr__

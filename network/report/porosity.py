@@ -41,8 +41,9 @@ MAX_SHIFT = 0.02
 def bundled_packing(grain: str) -> Path | None:
     """The shipped packing of a grain, else None: ``network/data/<grain>_grains.csv`` (rigid
     multi-sphere grains made by ``dem.pack --grain``, network/data/README.md), else
-    ``<grain>_default.csv`` (spheres)."""
-    for name in (f"{grain}_grains.csv", f"{grain}_default.csv"):
+    ``<grain>_default.csv`` (spheres), else ``<grain>_rain_0kPa.csv`` (the poured surface bed of
+    the grain's bin bed set, :mod:`network.report.binbeds`)."""
+    for name in (f"{grain}_grains.csv", f"{grain}_default.csv", f"{grain}_rain_0kPa.csv"):
         p = DATA_DIR / name
         if p.is_file():
             return p
