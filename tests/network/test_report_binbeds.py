@@ -172,10 +172,8 @@ def test_template_volume_copies_agree_with_dem():
     (["--depth", "60"], "--depth 60 m"),
 ])
 def test_bad_bin_depth_exits_2(tmp_path, monkeypatch, capsys, argv, named):
-    if not bed_set_files("wheat"):
-        pytest.skip("no bundled wheat bed set")
     monkeypatch.chdir(tmp_path)
-    assert main(["--grain", "wheat", "--diameter", "8", "--no-figures", "-q"] + argv) == 2
+    assert main(["--grain", "soybean", "--diameter", "8", "--no-figures", "-q"] + argv) == 2
     err = capsys.readouterr().err.strip().splitlines()
     assert len(err) == 1 and err[0].startswith("error:") and named in err[0]
     assert list(tmp_path.iterdir()) == []
