@@ -40,7 +40,7 @@ from __future__ import annotations
 import numba
 import numpy as np
 
-__all__ = ["grain_poses", "grain_update"]
+__all__ = ["grain_poses", "grain_update", "pose_one", "update_one"]
 
 
 @numba.njit(inline="always", cache=True, error_model="numpy")
@@ -74,6 +74,23 @@ def _rotate_by(px, py, pz, w, x, y, z):
             aw * z + ax * y - ay * x + az * w)
 
 
+@numba.njit(inline="always", cache=True, error_model="numpy")
+def pose_one(g, X, V, q, L, inertia, start, body, x, v, w, arm):
+    """:func:`grain_poses` for grain ``g`` alone (the body of its loop)."""
+    m = _matrix(q[g, 0], q[g, 1], q[g, 2], q[g, 3])
+    ox, oy, oz = _omega(m, L[g, 0], L[g, 1], L[g, 2], inertia[g, 0], inertia[g, 1], inertia[g, 2])
+    for s in range(start[g], start[g + 1]):
+        dx = m[0] * body[s, 0] + m[1] * body[s, 1] + m[2] * body[s, 2]
+        dy = m[3] * body[s, 0] + m[4] * body[s, 1] + m[5] * body[s, 2]
+        dz = m[6] * body[s, 0] + m[7] * body[s, 1] + m[8] * body[s, 2]
+        arm[s, 0], arm[s, 1], arm[s, 2] = dx, dy, dz
+        x[s, 0], x[s, 1], x[s, 2] = X[g, 0] + dx, X[g, 1] + dy, X[g, 2] + dz
+        v[s, 0] = V[g, 0] + (oy * dz - oz * dy)
+        v[s, 1] = V[g, 1] + (oz * dx - ox * dz)
+        v[s, 2] = V[g, 2] + (ox * dy - oy * dx)
+        w[s, 0], w[s, 1], w[s, 2] = ox, oy, oz
+
+
 @numba.njit(parallel=True, cache=True, error_model="numpy")
 def grain_poses(X, V, q, L, inertia, start, body, x, v, w, arm):
     """Sphere state from the grain state (step 1 of the module notes); writes ``x, v, w, arm``.
@@ -83,18 +100,45 @@ def grain_poses(X, V, q, L, inertia, start, body, x, v, w, arm):
     centres (m), velocities (m/s), spins (rad/s), world offsets d_s = R b_s (m).
     """
     for g in numba.prange(X.shape[0]):
-        m = _matrix(q[g, 0], q[g, 1], q[g, 2], q[g, 3])
-        ox, oy, oz = _omega(m, L[g, 0], L[g, 1], L[g, 2], inertia[g, 0], inertia[g, 1], inertia[g, 2])
-        for s in range(start[g], start[g + 1]):
-            dx = m[0] * body[s, 0] + m[1] * body[s, 1] + m[2] * body[s, 2]
-            dy = m[3] * body[s, 0] + m[4] * body[s, 1] + m[5] * body[s, 2]
-            dz = m[6] * body[s, 0] + m[7] * body[s, 1] + m[8] * body[s, 2]
-            arm[s, 0], arm[s, 1], arm[s, 2] = dx, dy, dz
-            x[s, 0], x[s, 1], x[s, 2] = X[g, 0] + dx, X[g, 1] + dy, X[g, 2] + dz
-            v[s, 0] = V[g, 0] + (oy * dz - oz * dy)
-            v[s, 1] = V[g, 1] + (oz * dx - ox * dz)
-            v[s, 2] = V[g, 2] + (ox * dy - oy * dx)
-            w[s, 0], w[s, 1], w[s, 2] = ox, oy, oz
+        pose_one(g, X, V, q, L, inertia, start, body, x, v, w, arm)
+
+
+@numba.njit(inline="always", cache=True, error_model="numpy")
+def update_one(g, X, V, q, L, inertia, start, arm, force_s, torque_s, weight, inv_m, dt, force, torque, advance):
+    """:func:`grain_update` for grain ``g`` alone (the body of its loop)."""
+    fx = fy = fz = 0.0
+    tx = ty = tz = 0.0
+    for s in range(start[g], start[g + 1]):
+        f0, f1, f2 = force_s[s, 0], force_s[s, 1], force_s[s, 2]
+        fx += f0
+        fy += f1
+        fz += f2
+        tx += (arm[s, 1] * f2 - arm[s, 2] * f1) + torque_s[s, 0]
+        ty += (arm[s, 2] * f0 - arm[s, 0] * f2) + torque_s[s, 1]
+        tz += (arm[s, 0] * f1 - arm[s, 1] * f0) + torque_s[s, 2]
+    fz -= weight[g]
+    force[g, 0], force[g, 1], force[g, 2] = fx, fy, fz
+    torque[g, 0], torque[g, 1], torque[g, 2] = tx, ty, tz
+    if not advance:
+        return
+    V[g, 0] += fx * inv_m[g]
+    V[g, 1] += fy * inv_m[g]
+    V[g, 2] += fz * inv_m[g]
+    X[g, 0] += V[g, 0] * dt
+    X[g, 1] += V[g, 1] * dt
+    X[g, 2] += V[g, 2] * dt
+    L[g, 0] += tx * dt
+    L[g, 1] += ty * dt
+    L[g, 2] += tz * dt
+    lx, ly, lz = L[g, 0], L[g, 1], L[g, 2]
+    ix, iy, iz = inertia[g, 0], inertia[g, 1], inertia[g, 2]
+    qw, qx, qy, qz = q[g, 0], q[g, 1], q[g, 2], q[g, 3]
+    ox, oy, oz = _omega(_matrix(qw, qx, qy, qz), lx, ly, lz, ix, iy, iz)
+    hw, hx, hy, hz = _rotate_by(ox * (0.5 * dt), oy * (0.5 * dt), oz * (0.5 * dt), qw, qx, qy, qz)
+    ox, oy, oz = _omega(_matrix(hw, hx, hy, hz), lx, ly, lz, ix, iy, iz)
+    nw, nx, ny, nz = _rotate_by(ox * dt, oy * dt, oz * dt, qw, qx, qy, qz)
+    norm = np.sqrt(nw * nw + nx * nx + ny * ny + nz * nz)
+    q[g, 0], q[g, 1], q[g, 2], q[g, 3] = nw / norm, nx / norm, ny / norm, nz / norm
 
 
 @numba.njit(parallel=True, cache=True, error_model="numpy")
@@ -106,36 +150,4 @@ def grain_update(X, V, q, L, inertia, start, arm, force_s, torque_s, weight, inv
     Δt/(S m); writes ``force``, ``torque`` (G, 3); ``advance``: also update V, X, L, q.
     """
     for g in numba.prange(X.shape[0]):
-        fx = fy = fz = 0.0
-        tx = ty = tz = 0.0
-        for s in range(start[g], start[g + 1]):
-            f0, f1, f2 = force_s[s, 0], force_s[s, 1], force_s[s, 2]
-            fx += f0
-            fy += f1
-            fz += f2
-            tx += (arm[s, 1] * f2 - arm[s, 2] * f1) + torque_s[s, 0]
-            ty += (arm[s, 2] * f0 - arm[s, 0] * f2) + torque_s[s, 1]
-            tz += (arm[s, 0] * f1 - arm[s, 1] * f0) + torque_s[s, 2]
-        fz -= weight[g]
-        force[g, 0], force[g, 1], force[g, 2] = fx, fy, fz
-        torque[g, 0], torque[g, 1], torque[g, 2] = tx, ty, tz
-        if not advance:
-            continue
-        V[g, 0] += fx * inv_m[g]
-        V[g, 1] += fy * inv_m[g]
-        V[g, 2] += fz * inv_m[g]
-        X[g, 0] += V[g, 0] * dt
-        X[g, 1] += V[g, 1] * dt
-        X[g, 2] += V[g, 2] * dt
-        L[g, 0] += tx * dt
-        L[g, 1] += ty * dt
-        L[g, 2] += tz * dt
-        lx, ly, lz = L[g, 0], L[g, 1], L[g, 2]
-        ix, iy, iz = inertia[g, 0], inertia[g, 1], inertia[g, 2]
-        qw, qx, qy, qz = q[g, 0], q[g, 1], q[g, 2], q[g, 3]
-        ox, oy, oz = _omega(_matrix(qw, qx, qy, qz), lx, ly, lz, ix, iy, iz)
-        hw, hx, hy, hz = _rotate_by(ox * (0.5 * dt), oy * (0.5 * dt), oz * (0.5 * dt), qw, qx, qy, qz)
-        ox, oy, oz = _omega(_matrix(hw, hx, hy, hz), lx, ly, lz, ix, iy, iz)
-        nw, nx, ny, nz = _rotate_by(ox * dt, oy * dt, oz * dt, qw, qx, qy, qz)
-        norm = np.sqrt(nw * nw + nx * nx + ny * ny + nz * nz)
-        q[g, 0], q[g, 1], q[g, 2], q[g, 3] = nw / norm, nx / norm, ny / norm, nz / norm
+        update_one(g, X, V, q, L, inertia, start, arm, force_s, torque_s, weight, inv_m, dt, force, torque, advance)

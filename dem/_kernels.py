@@ -26,7 +26,7 @@ import numpy as np
 
 from ._contacts import contact_law
 
-__all__ = ["pair_damping", "pair_forces", "particle_update"]
+__all__ = ["pair_damping", "pair_forces", "particle_update", "wall_contacts"]
 
 
 @numba.njit(parallel=True, cache=True, error_model="numpy")
@@ -87,6 +87,64 @@ def pair_forces(x, v, w, r, pi, pj, cn, ct, shear, kn, ks, mu, dt, f_pair, t_pai
         t_pair[k, 2] = nx * fty - ny * ftx
 
 
+@numba.njit(inline="always", cache=True, error_model="numpy")
+def wall_contacts(p, x, v, w, r, ms, wall_kind, wall_normal, wall_offset, wall_cyl, wall_moves, wall_vz, wall_shear,
+                  wall_fn, wall_touch, kn_w, ks_w, beta, mu_w, dt):
+    """Wall contacts of particle ``p`` (the walls' part of :func:`particle_update`, wall by wall):
+    returns its wall force and torque (fx, fy, fz, tx, ty, tz) and the number of walls touched;
+    writes the wall springs, ``wall_fn`` and ``wall_touch`` of ``p``."""
+    rp = r[p]
+    wfx = wfy = wfz = 0.0
+    wtx = wty = wtz = 0.0
+    hits = 0
+    for m in range(wall_kind.shape[0]):
+        if wall_kind[m] == 0:
+            d = wall_offset[m]
+            if wall_normal[m, 0] != 0.0:
+                d = d + wall_normal[m, 0] * x[p, 0]
+            if wall_normal[m, 1] != 0.0:
+                d = d + wall_normal[m, 1] * x[p, 1]
+            if wall_normal[m, 2] != 0.0:
+                d = d + wall_normal[m, 2] * x[p, 2]
+            ov = rp - d
+            nx, ny, nz = -wall_normal[m, 0], -wall_normal[m, 1], -wall_normal[m, 2]
+        else:
+            ddx = x[p, 0] - wall_cyl[m, 0]
+            ddy = x[p, 1] - wall_cyl[m, 1]
+            rho = np.sqrt(ddx * ddx + ddy * ddy)
+            ov = rp - (wall_cyl[m, 2] - rho)
+            rh = max(rho, 1e-300)
+            nx, ny, nz = ddx / rh, ddy / rh, 0.0
+        if not ov > 0.0:
+            if wall_touch[m, p]:
+                wall_touch[m, p] = 0
+                wall_shear[m, p, 0] = 0.0
+                wall_shear[m, p, 1] = 0.0
+                wall_shear[m, p, 2] = 0.0
+            continue
+        hits += 1
+        wall_touch[m, p] = 1
+        ax, ay, az = w[p, 0] * rp, w[p, 1] * rp, w[p, 2] * rp
+        vwz = wall_vz if wall_moves[m] else 0.0
+        vx = v[p, 0] - 0.0 + (ay * nz - az * ny)
+        vy = v[p, 1] - 0.0 + (az * nx - ax * nz)
+        vz = v[p, 2] - vwz + (ax * ny - ay * nx)
+        cn = 2.0 * beta * np.sqrt(ms[p] * kn_w)
+        ct = 2.0 * beta * np.sqrt(ms[p] * ks_w)
+        out = contact_law(ov, nx, ny, nz, vx, vy, vz, wall_shear[m, p, 0], wall_shear[m, p, 1],
+                          wall_shear[m, p, 2], kn_w, ks_w, cn, ct, mu_w, dt)
+        wfx += out[0]
+        wfy += out[1]
+        wfz += out[2]
+        wall_fn[m, p] = out[3]
+        ftx, fty, ftz = out[4], out[5], out[6]
+        wall_shear[m, p, 0], wall_shear[m, p, 1], wall_shear[m, p, 2] = out[7], out[8], out[9]
+        wtx += (ny * ftz - nz * fty) * rp
+        wty += (nz * ftx - nx * ftz) * rp
+        wtz += (nx * fty - ny * ftx) * rp
+    return wfx, wfy, wfz, wtx, wty, wtz, hits
+
+
 @numba.njit(parallel=True, cache=True, error_model="numpy")
 def particle_update(x, v, w, r, ms, gforce, first_start, second_start, by_second, f_pair, t_pair, touch,
                     wall_kind, wall_normal, wall_offset, wall_cyl, wall_moves, wall_vz, wall_shear, wall_fn,
@@ -122,54 +180,9 @@ def particle_update(x, v, w, r, ms, gforce, first_start, second_start, by_second
                 ty += t_pair[k, 1] * rp
                 tz += t_pair[k, 2] * rp
         # walls: summed apart, wall by wall, then added (one fixed order: the same bits always)
-        wfx = wfy = wfz = 0.0
-        wtx = wty = wtz = 0.0
-        hits = 0
-        for m in range(wall_kind.shape[0]):
-            if wall_kind[m] == 0:
-                d = wall_offset[m]
-                if wall_normal[m, 0] != 0.0:
-                    d = d + wall_normal[m, 0] * x[p, 0]
-                if wall_normal[m, 1] != 0.0:
-                    d = d + wall_normal[m, 1] * x[p, 1]
-                if wall_normal[m, 2] != 0.0:
-                    d = d + wall_normal[m, 2] * x[p, 2]
-                ov = rp - d
-                nx, ny, nz = -wall_normal[m, 0], -wall_normal[m, 1], -wall_normal[m, 2]
-            else:
-                ddx = x[p, 0] - wall_cyl[m, 0]
-                ddy = x[p, 1] - wall_cyl[m, 1]
-                rho = np.sqrt(ddx * ddx + ddy * ddy)
-                ov = rp - (wall_cyl[m, 2] - rho)
-                rh = max(rho, 1e-300)
-                nx, ny, nz = ddx / rh, ddy / rh, 0.0
-            if not ov > 0.0:
-                if wall_touch[m, p]:
-                    wall_touch[m, p] = 0
-                    wall_shear[m, p, 0] = 0.0
-                    wall_shear[m, p, 1] = 0.0
-                    wall_shear[m, p, 2] = 0.0
-                continue
-            hits += 1
-            wall_touch[m, p] = 1
-            ax, ay, az = w[p, 0] * rp, w[p, 1] * rp, w[p, 2] * rp
-            vwz = wall_vz if wall_moves[m] else 0.0
-            vx = v[p, 0] - 0.0 + (ay * nz - az * ny)
-            vy = v[p, 1] - 0.0 + (az * nx - ax * nz)
-            vz = v[p, 2] - vwz + (ax * ny - ay * nx)
-            cn = 2.0 * beta * np.sqrt(ms[p] * kn_w)
-            ct = 2.0 * beta * np.sqrt(ms[p] * ks_w)
-            out = contact_law(ov, nx, ny, nz, vx, vy, vz, wall_shear[m, p, 0], wall_shear[m, p, 1],
-                              wall_shear[m, p, 2], kn_w, ks_w, cn, ct, mu_w, dt)
-            wfx += out[0]
-            wfy += out[1]
-            wfz += out[2]
-            wall_fn[m, p] = out[3]
-            ftx, fty, ftz = out[4], out[5], out[6]
-            wall_shear[m, p, 0], wall_shear[m, p, 1], wall_shear[m, p, 2] = out[7], out[8], out[9]
-            wtx += (ny * ftz - nz * fty) * rp
-            wty += (nz * ftx - nx * ftz) * rp
-            wtz += (nx * fty - ny * ftx) * rp
+        wfx, wfy, wfz, wtx, wty, wtz, hits = wall_contacts(p, x, v, w, r, ms, wall_kind, wall_normal, wall_offset,
+                                                           wall_cyl, wall_moves, wall_vz, wall_shear, wall_fn,
+                                                           wall_touch, kn_w, ks_w, beta, mu_w, dt)
         if hits:
             fx += wfx
             fy += wfy

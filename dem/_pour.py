@@ -36,6 +36,7 @@ from scipy.spatial import cKDTree
 
 from ._clump_pack import bed_porosities, union_porosity_in_box
 from ._contacts import restitution_coefficient
+from ._freeze import FREEZE_DEPTH_LENGTHS, FreezePolicy
 from ._rigid import quat_to_matrix, random_quaternions
 from .clumps import ClumpSimulation
 
@@ -75,6 +76,9 @@ class FillOptions:
         'spout': the spout's diameter, m; None: three kernel lengths.
     mass_scale : float
         Density scaling S >= 1 of the pour (default 1: real masses).
+    freeze : bool
+        Freeze the settled grains deep in the bed while the pour goes on (default True;
+        :mod:`dem._freeze`, ``docs/dem-fill.md`` section Speed); False steps every grain.
     """
 
     method: str = "rain"
@@ -82,6 +86,7 @@ class FillOptions:
     rate_kg_s: float | None = None
     spout_diameter_m: float | None = None
     mass_scale: float = 1.0
+    freeze: bool = True
 
     def __post_init__(self):
         if self.method not in FILL_METHODS:
@@ -232,6 +237,8 @@ def _grown(sim, template, x_new, v_new, q_new, threads=None):
     new._wall_touch[:, :n_old] = sim._wall_touch
     new.stats = sim.stats
     new._poses()
+    if sim.active is not None:
+        new.active = sim.active.grown(new)
     return new
 
 
@@ -244,6 +251,27 @@ def rest_steps(dt_s, *, rest_time_s=None, min_steps=60_000):
     """
     t = REST_TIME_S if rest_time_s is None else rest_time_s
     return max(int(min_steps), int(math.ceil(t / dt_s - 1e-9)))
+
+
+#: largest drift of a grain that freezes over :data:`FREEZE_WINDOW_S`, in volume-equivalent diameters d_v
+FREEZE_DRIFT_FRACTION = 0.01
+#: window over which a grain must drift less than that before it freezes, s
+FREEZE_WINDOW_S = 0.03
+#: normal force of an active neighbour, in weights of the frozen grain, that releases it
+RELEASE_PUSH_WEIGHTS = 50.0
+
+
+def freeze_policy(template, v0):
+    """The :class:`dem._freeze.FreezePolicy` of a pour (``docs/dem-fill.md`` section Speed): frozen
+    below :data:`dem._freeze.FREEZE_DEPTH_LENGTHS` kernel lengths after drifting less than
+    :data:`FREEZE_DRIFT_FRACTION` d_v in :data:`FREEZE_WINDOW_S` and moving slower than twice that
+    drift per window, released at :data:`RELEASE_PUSH_WEIGHTS` weights; ``v0`` the entry speed
+    (grains faster than v0/2 are falling)."""
+    length = float(template.extent_m[0])
+    drift = FREEZE_DRIFT_FRACTION * 2 * template.equivalent_radius_m
+    return FreezePolicy(depth_m=FREEZE_DEPTH_LENGTHS * length, drift_m=drift, window_s=FREEZE_WINDOW_S,
+                        speed_m_s=2 * drift / FREEZE_WINDOW_S, push_weights=RELEASE_PUSH_WEIGHTS, cell_m=length,
+                        length_m=length, falling_m_s=0.5 * v0)
 
 
 def pour_grains(container, template, *, material, fill=FillOptions(), n_grains, rng=None, tol=2e-3,
@@ -288,7 +316,7 @@ def pour_grains(container, template, *, material, fill=FillOptions(), n_grains, 
     if n_grains < 1:
         raise ValueError(f"no grain to pour: n_grains = {n_grains}")
     rng = np.random.default_rng(rng)
-    t0 = time.perf_counter()
+    t0, c0 = time.perf_counter(), time.process_time()
     psteps = 0
     rho = material.density_kg_m3
     d_v = 2 * template.equivalent_radius_m
@@ -337,6 +365,9 @@ def pour_grains(container, template, *, material, fill=FillOptions(), n_grains, 
                 sim = ClumpSimulation([template], np.zeros(k, int), x_new, q_new, np.ones(k), walls, material,
                                       mass_scale=fill.mass_scale, threads=threads)
                 sim.V[:] = v_new
+                lo, hi = container.bounds(rb, headroom=0.0)
+                sim.attach_active(lo_m=lo, hi_m=hi, capacity=n_grains * template.n,
+                                  policy=freeze_policy(template, v0) if fill.freeze else None)
             else:
                 sim = _grown(sim, template, x_new, v_new, q_new, threads=threads)
             inserted += k
@@ -345,8 +376,26 @@ def pour_grains(container, template, *, material, fill=FillOptions(), n_grains, 
     fill_time, fill_steps = sim.time_s, sim.steps
     if max_steps is None:
         max_steps = rest_steps(sim.dt)
-    rest = sim.run(max_steps=max_steps, tol=tol, check_every=check_every, callback=progress)
+    # the rest: the active grains first (the frozen ones are at rest), then every grain released
+    # and the whole bed judged (module notes of dem._freeze)
+    region = sim.active
+    active = {"steps": 0}
+    if fill.freeze:
+        active = sim.run(max_steps=max_steps, tol=tol, check_every=check_every, callback=progress)
+        psteps += active["steps"] * sim.n
+    freeze = {"enabled": bool(fill.freeze), "frozen_at_fill_end": region.n_frozen if fill.freeze else 0,
+              "freeze_events": region.frozen_events, "release_events": region.released_events,
+              "max_push_weights": region.max_push_weights,
+              "active_particle_steps": int(region.active_particle_steps), "relists": region.relists,
+              "relisted_spheres": region.relisted_spheres, "rest_active_steps": active["steps"]}
+    if fill.freeze:
+        freeze.update(policy={k: getattr(region.policy, k) for k in region.policy.__dataclass_fields__})
+    sim.detach_active()
+    rest = sim.run(max_steps=max(max_steps - active["steps"], check_every), tol=tol, check_every=check_every,
+                   callback=progress)
     psteps += rest["steps"] * sim.n
+    freeze["active_particle_steps"] += rest["steps"] * sim.n
+    rest = dict(rest, steps=rest["steps"] + active["steps"])
     record = {"method": fill.method, "drop_height_m": fill.drop_height_m, "entry_speed_m_s": v0,
               "terminal_velocity_m_s": terminal_velocity(d_v, rho),
               "drag_law": (f"Newton's regime, C_D = {DRAG_COEFFICIENT} for a sphere of the kernel's volume "
@@ -357,8 +406,8 @@ def pour_grains(container, template, *, material, fill=FillOptions(), n_grains, 
               "spout_diameter_m": spout_d, "entry_area_m2": area_in, "mass_scale": fill.mass_scale,
               "restitution_pp": e, "batches": batches, "batch_interval_s": tau,
               "fill_time_s": fill_time, "fill_steps": fill_steps,
-              "rest": rest, "converged": bool(rest["converged"]), "particle_steps": int(psteps),
-              "wall_time_s": time.perf_counter() - t0}
+              "rest": rest, "converged": bool(rest["converged"]), "particle_steps": int(psteps), "freeze": freeze,
+              "wall_time_s": time.perf_counter() - t0, "cpu_time_s": time.process_time() - c0}
     return sim, record
 
 

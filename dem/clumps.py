@@ -98,6 +98,7 @@ class ClumpSimulation(Simulation):
                          mass_scale=mass_scale, dt_safety=dt_safety, threads=threads,
                          skin_m=skin_m if skin_m is not None else GRAIN_SKIN_FRACTION * float(radii.max()))
         self.verlet = VerletList(self.verlet.skin, groups=self.gid)
+        self.active = None
         self._poses()
 
     # ------------------------------------------------------------------ state
@@ -179,6 +180,28 @@ class ClumpSimulation(Simulation):
         grain_update(self.X, self.V, self.q, self.L, self._inertia_s, self._start, self._arm, self._force,
                      self._torque, self._weight, self._inv_m_g, self._dt, self._force_g, self._torque_g, advance)
 
+    def attach_active(self, *, lo_m, hi_m, capacity=None, policy=None):
+        """Step the active grains only, with per-sphere neighbour rows (:class:`dem._freeze.ActiveRegion`,
+        box ``lo_m``-``hi_m`` of its cell grid, rows for ``capacity`` spheres); ``policy``
+        (:class:`dem._freeze.FreezePolicy`) freezes and releases grains at each check of :meth:`run`."""
+        from ._freeze import ActiveRegion
+        self.active = ActiveRegion(self, capacity=capacity, lo_m=lo_m, hi_m=hi_m)
+        self.active.policy = policy
+        return self.active
+
+    def detach_active(self):
+        """Release every frozen grain and step the whole bed again; the contact springs are kept
+        (the Verlet list is rebuilt at the next step from the rows' pairs)."""
+        if self.active is None:
+            return
+        keys, hist = self.active.pair_history()
+        self.active = None
+        self.verlet.keys = keys
+        self.shear = np.ascontiguousarray(hist[:, :3])
+        self._touch = hist[:, 3].astype(np.uint8)
+        self.verlet._ref = None
+        self._coef_valid = False
+
     def _grain_pass(self, advance):
         self._poses()
         self._evaluate(advance)
@@ -190,13 +213,21 @@ class ClumpSimulation(Simulation):
 
     def step(self):
         """Advance one time step (module notes); returns the net force on the grains, (G, 3)."""
+        if self.active is not None:
+            force = self.active.step()
+            self.time_s += self._dt
+            self.steps += 1
+            return force
         self._grain_pass(True)
         self.time_s += self._dt
         self.steps += 1
         return self._force_g
 
     def unbalanced_force_ratio(self, force):
-        """Mean |net force| on the grains over the mean normal contact force (0: equilibrium)."""
+        """Mean |net force| on the grains over the mean normal contact force (0: equilibrium);
+        while frozen grains are held (:meth:`attach_active`), over the active grains and their contacts."""
+        if self.active is not None:
+            return self.active.unbalanced_force_ratio()
         fn = np.concatenate([self.contact_fn, self.last_wall_fn])
         if len(fn) == 0 or fn.mean() == 0:
             return float("inf")
@@ -221,6 +252,8 @@ class ClumpSimulation(Simulation):
             if k % check_every == 0:
                 self.check_stability()
                 ratio = self.unbalanced_force_ratio(force)
+                if self.active is not None:
+                    self.active.at_check()
                 if callback is not None:
                     callback(self, force)
                 if tol is not None and ratio < tol:

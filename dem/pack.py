@@ -141,6 +141,10 @@ def _parser():
                         "rebound flight 2 e v0/g of a landed grain, so it is at rest before it is covered)")
     p.add_argument("--spout-diameter", type=float, default=None,
                    help="spout: diameter, m (default three kernel lengths)")
+    p.add_argument("--no-freeze", action="store_const", const=True, default=None,
+                   help="poured fill: step every grain to the end (default: grains settled more than three kernel "
+                        "lengths below the surface are frozen while the pour goes on, and released before the "
+                        "bed's rest is judged and before a load; docs/dem-fill.md, Speed)")
     p.add_argument("--depth", type=float, default=None,
                    help="rain/spout: load the bed to Janssen's vertical stress at this depth of a bin, m "
                         "(needs --bin-diameter)")
@@ -319,7 +323,7 @@ def _check_outputs(args):
 
 _POUR_ONLY = (("--drop-height", "drop_height"), ("--rate", "rate"), ("--spout-diameter", "spout_diameter"),
               ("--depth", "depth"), ("--bin-diameter", "bin_diameter"), ("--bin-height", "bin_height"),
-              ("--stress", "stress"))
+              ("--stress", "stress"), ("--no-freeze", "no_freeze"))
 
 
 def _fill_options(args):
@@ -366,7 +370,8 @@ def _fill_options(args):
     try:
         return FillOptions(method=method, drop_height_m=0.3 if args.drop_height is None else args.drop_height,
                            rate_kg_s=args.rate, spout_diameter_m=args.spout_diameter,
-                           mass_scale=1.0 if args.mass_scale is None else args.mass_scale)
+                           mass_scale=1.0 if args.mass_scale is None else args.mass_scale,
+                           freeze=not args.no_freeze)
     except ValueError as e:
         opt = {"drop height": "--drop-height", "rate": "--rate", "spout diameter": "--spout-diameter",
                "mass scale": "--mass-scale"}
@@ -463,9 +468,11 @@ def _load_and_write(args, out, sim, stress, *, janssen, fill, template, containe
             load.update(depth_m=args.depth, bin_diameter_m=args.bin_diameter, bin_height_m=args.bin_height,
                         bulk_density_kg_m3=rho_b, janssen=load_src)
         if stress > 0:
+            tl, cl = time.perf_counter(), time.process_time()
             load.update(load_bed(sim, container, stress, tol=args.tol,
                                  max_steps=rest_steps(sim.dt) if max_steps is None else max_steps,
                                  callback=lambda sim, f: pr("load", _Progress(sim), None)))
+            load.update(wall_time_s=time.perf_counter() - tl, cpu_time_s=time.process_time() - cl)
             converged = converged and load["converged"]
         else:
             load.update(target_pa=0.0, converged=True)
