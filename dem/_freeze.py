@@ -82,14 +82,6 @@ def _grid_insert(p, c, head, nxt, prv, cellof):
 
 
 @numba.njit(cache=True)
-def _grid_fill(ref, n, lo, cell, dims, head, nxt, prv, cellof):
-    """Insert spheres 0..n-1 at their references (finite ones) into an empty grid."""
-    for p in range(n):
-        if np.isfinite(ref[p, 0]):
-            _grid_insert(p, _cell(ref[p, 0], ref[p, 1], ref[p, 2], lo, cell, dims), head, nxt, prv, cellof)
-
-
-@numba.njit(cache=True)
 def _scan(i, xi0, xi1, xi2, ref, r, gid, skin, lo, cell, dims, head, nxt, buf):
     """Partners of sphere i at reference (xi0, xi1, xi2): spheres of other grains within
     r_i + r_j + skin of it, written to ``buf``; returns their count (-1 when ``buf`` is full)."""
@@ -405,9 +397,11 @@ class ActiveRegion:
         Spheres the rows are allocated for (grains added later up to this count need no copy).
     lo_m, hi_m : (3,) arrays
         Box of the cell grid, m (centres outside it go to its edge cells: still correct, slower).
+    width : int
+        Partners a row holds at first (a row that needs more widens every row by half).
     """
 
-    def __init__(self, sim, *, capacity=None, lo_m, hi_m, width=48):
+    def __init__(self, sim, *, capacity=None, lo_m, hi_m, width=24):
         n = sim.n
         cap_n = max(int(capacity or n), n)
         self.skin = float(sim.verlet.skin)
