@@ -73,13 +73,16 @@ def load_bed(sim, container, stress_pa, *, tol=2e-3, stress_tol=0.02, max_steps=
     The lid starts at the highest sphere top and closes on the bed; the run ends when the mean
     unbalanced-force ratio is below ``tol`` and the lid stress, averaged over the last
     ``average_steps`` steps, is within ``stress_tol`` (relative) of the target, or after
-    ``max_steps`` steps. ``sim`` keeps its lid (the last wall).
+    ``max_steps`` steps. ``sim`` keeps its lid (the last wall). Grains frozen in a pour
+    (:mod:`dem._freeze`) are released first: the lid loads the whole bed.
 
     Returns dict: ``target_pa``, ``lid_stress_pa`` (the average), ``lid_stress_rel_error``,
     ``lid_height_m``, ``steps``, ``ratio``, ``converged``.
     """
     if not (math.isfinite(stress_pa) and stress_pa > 0):
         raise ValueError(f"lid stress must be > 0, got {stress_pa!r}")
+    if getattr(sim, "active", None) is not None:   # the load acts on the whole bed: no grain stays frozen
+        sim.detach_active()
     xs = sim.sphere_centers()
     z_lid = float(np.max(xs[:, 2] + sim.radii))
     old_shear, old_touch = sim.wall_shear.copy(), sim._wall_touch.copy()

@@ -6,6 +6,7 @@
     python -m dem.bench --grains 500 2000 5000   # the grain engine (soybean templates)
     python -m dem.bench --grain-pack 5000        # + wall time of dem.pack for 5000 soybeans
     python -m dem.bench --study DIR              # the thesis vibration study (about 1 h): its row
+    python -m dem.bench --pour 3000 --pour-stress 20000   # rain-filled wheat bed, then its load
 
 Scene for the rate: N spheres of radius 3.25 mm on a simple cubic lattice 6.5 mm apart
 (overlap 1e-4 r, six contacts each, close to the 4–6 true contacts of a settled bed),
@@ -14,8 +15,13 @@ with gravity, box walls and the Verlet list, density scaling 100: the inner loop
 lattice of their length, width and thickness (overlap 1e-4 of each), the same walls, gravity and
 scaling, timed in sphere-steps/s of :class:`dem.ClumpSimulation`. ``--grain-pack G`` times
 ``python -m dem.pack --scene box --grain soybean`` for G grains in a cube (as a subprocess,
-numba compilation excluded by a warm-up run). The JSON records the load average, platform, CPU
-count and a timestamp.
+numba compilation excluded by a warm-up run). ``--pour G`` times the rain fill of G wheat kernels
+into a 0.06 x 0.06 m box (``python -m dem.pack --scene box --size 0.06 0.06 --height 0.05 --grain
+wheat --n-grains G --mass-scale 100``, plus ``--stress PA`` with ``--pour-stress``; the speed target
+of a poured bed, ``docs/dem-fill.md`` section Speed) as a subprocess after a warm-up of 20 grains,
+with the pour's and the load's CPU and wall seconds, its particle-steps (all spheres, and the
+active ones stepped) and the frozen share; ``--pour-no-freeze`` adds the same pour without
+freezing. The JSON records the load average, platform, CPU count and a timestamp.
 """
 
 from __future__ import annotations
@@ -146,6 +152,53 @@ def grain_pack_time(n_grains, *, seed=1, porosity=0.40985, out_dir=None, warm_up
             "porosity_network_region": summary.get("porosity_network_region"), "stdout": done.stdout[-2000:]}
 
 
+#: the poured benchmark bed: wheat rained into a 0.06 x 0.06 m box (0.05 m fill height), mass scale 100
+POUR_ARGS = ["--scene", "box", "--size", "0.06", "0.06", "--height", "0.05", "--grain", "wheat", "--mass-scale", "100"]
+#: targets of a 3000-kernel poured bed and of its load on two cores, s
+POUR_TARGET_S, LOAD_TARGET_S = 600.0, 300.0
+
+
+def pour_time(n_grains, *, stress_pa=None, freeze=True, seed=1, out_dir=None, warm_up=True):
+    """CPU and wall seconds of ``python -m dem.pack`` with :data:`POUR_ARGS` for ``n_grains`` wheat
+    kernels (then ``--stress stress_pa``; ``freeze`` False adds ``--no-freeze``), as a subprocess
+    after a warm-up of 20 kernels that fills numba's cache. Returns the command, the pour's and the
+    load's CPU and wall seconds (from the companion JSON), the particle-steps of every sphere and
+    of the active ones, the grains frozen at the fill's end, the porosity and the load averages."""
+    import tempfile
+    out_dir = out_dir or tempfile.mkdtemp(prefix="pour_")
+    cmd = [sys.executable, "-m", "dem.pack", *POUR_ARGS, "--n-grains", str(n_grains), "--seed", str(seed),
+           "--quiet", "--out", os.path.join(out_dir, "bed.csv")]
+    if stress_pa:
+        cmd[-3:-3] = ["--stress", f"{stress_pa:g}"]
+    if not freeze:
+        cmd[-3:-3] = ["--no-freeze"]
+    if warm_up:
+        warm = [*cmd[:cmd.index("--n-grains") + 1], "20", "--max-steps", "400", "--quiet", "--out",
+                os.path.join(out_dir, "warm.csv")]
+        subprocess.run(warm, capture_output=True)          # a warm-up not at rest exits 1: only the cache counts
+    load0, t0, c0 = os.getloadavg(), time.perf_counter(), os.times()
+    done = subprocess.run(cmd, capture_output=True, text=True)
+    wall, c1 = time.perf_counter() - t0, os.times()
+    if done.returncode not in (0, EXIT_FAILED):
+        raise RuntimeError(f"{' '.join(cmd[1:])} exited {done.returncode}: {done.stderr.strip()[-300:]}")
+    with open(os.path.join(out_dir, "bed.json")) as f:
+        s = json.load(f)
+    fill, load = s["fill"], s.get("load", {})
+    fz = fill.get("freeze", {})
+    return {"grains": n_grains, "n_spheres": s["n_spheres"], "freeze": freeze, "stress_pa": stress_pa,
+            "command": "python " + " ".join(cmd[1:]), "converged": s["converged"], "wall_s": wall,
+            "cpu_s": (c1.children_user - c0.children_user) + (c1.children_system - c0.children_system),
+            "pour_cpu_s": fill.get("cpu_time_s"), "pour_wall_s": fill.get("wall_time_s"),
+            "load_cpu_s": load.get("cpu_time_s"), "load_wall_s": load.get("wall_time_s"),
+            "steps": s["steps"], "fill_steps": fill["fill_steps"], "rest_steps": fill["rest"]["steps"],
+            "load_steps": load.get("steps"), "particle_steps": fill["particle_steps"],
+            "active_particle_steps": fz.get("active_particle_steps"), "frozen_at_fill_end": fz.get("frozen_at_fill_end"),
+            "pour_particle_steps_per_cpu_s": fill["particle_steps"] / fill["cpu_time_s"],
+            "porosity_network_region": s.get("porosity_network_region"),
+            "pour_target_s": POUR_TARGET_S, "load_target_s": LOAD_TARGET_S,
+            "loadavg_before": load0, "loadavg_after": os.getloadavg()}
+
+
 def mass_scale_study(scales=(1.0, 10.0, 100.0), *, seed=1, settle_time_s=0.3, grow_time_s=0.04):
     """Pack the same small box (0.05 x 0.02 x 0.05 m, ~200 spheres) with several density
     scalings S, with the same physical expansion and settling times (S = 1 is the reference)."""
@@ -215,6 +268,13 @@ def _parser():
                    help="instead of the sphere rates: grain-engine rates for these soybean grain counts")
     p.add_argument("--grain-pack", type=int, default=None, metavar="G",
                    help="also time python -m dem.pack --grain soybean for G grains in a cube (e.g. 5000)")
+    p.add_argument("--pour", type=int, default=None, metavar="G",
+                   help="instead of the rates: time the rain fill of G wheat kernels into a 0.06 x 0.06 m box "
+                        "(mass scale 100; the speed target of a poured bed: 3000 kernels in 10 min)")
+    p.add_argument("--pour-stress", type=float, default=None, metavar="PA",
+                   help="--pour only: then load the bed to PA through the lid (dem.pack --stress; target 5 min)")
+    p.add_argument("--pour-no-freeze", action="store_true",
+                   help="--pour only: also time the same pour with every grain stepped (dem.pack --no-freeze)")
     p.add_argument("--study", metavar="DIR", default=None,
                    help="instead of the rates: run (or resume, or reuse) the thesis vibration study on the "
                         "representative 0.10 x 0.25 m cylinder in DIR (about an hour on two cores) and print "
@@ -238,11 +298,17 @@ def _check_args(args) -> None:
     positive("--threads", [args.threads], MAX_WORKERS)
     positive("--grains", args.grains or [])
     positive("--grain-pack", [args.grain_pack])
+    positive("--pour", [args.pour])
+    if args.pour_stress is not None and not (math.isfinite(args.pour_stress) and args.pour_stress > 0):
+        raise ValueError(f"--pour-stress must be finite and > 0, got {args.pour_stress:g}")
+    if (args.pour_stress is not None or args.pour_no_freeze) and not args.pour:
+        raise ValueError(f"{'--pour-stress' if args.pour_stress is not None else '--pour-no-freeze'}: only with --pour")
     for v in args.scales or []:
         if not (math.isfinite(v) and v > 0):
             raise ValueError(f"--scales must be finite and > 0, got {v:g}")
     modes = [opt for opt, on in (("--study", args.study), ("--mass-scale-study", args.mass_scale_study),
-                                 ("--grains", args.grains), ("--grain-pack", args.grain_pack)) if on]
+                                 ("--grains", args.grains), ("--grain-pack", args.grain_pack),
+                                 ("--pour", args.pour)) if on]
     if len(modes) > 1 and set(modes) != {"--grains", "--grain-pack"}:
         raise ValueError(f"{' and '.join(modes)}: one kind of run at a time (--grains goes with "
                          "--grain-pack only)")
@@ -290,6 +356,20 @@ def _run(args) -> int:
             print(f"  not in the total: the wall time of earlier runs of amplitudes {r['wall_s']['incomplete']} "
                   f"(checkpoints without it) and {r['wall_s']['network_steps_untimed']} network steps done before",
                   flush=True)
+    elif args.pour:
+        print(f"{'grains':>7} {'spheres':>8} {'freeze':>6} {'pour CPU s':>11} {'wall s':>7} {'load CPU s':>11} "
+              f"{'wall s':>7} {'p-steps/CPU-s':>14} {'active':>7} {'porosity':>9} {'load':>5}")
+        rows = []
+        for freeze in (True, False) if args.pour_no_freeze else (True,):
+            r = pour_time(args.pour, stress_pa=args.pour_stress, freeze=freeze)
+            rows.append(r)
+            act = r["active_particle_steps"] / r["particle_steps"] if r["active_particle_steps"] else 1.0
+            print(f"{r['grains']:7d} {r['n_spheres']:8d} {'on' if freeze else 'off':>6} {r['pour_cpu_s']:11.0f} "
+                  f"{r['pour_wall_s']:7.0f} {r['load_cpu_s'] or 0:11.0f} {r['load_wall_s'] or 0:7.0f} "
+                  f"{r['pour_particle_steps_per_cpu_s']:14.3e} {act:7.2f} {r['porosity_network_region'] if r['porosity_network_region'] is not None else float('nan'):9.4f} "
+                  f"{r['loadavg_after'][0]:5.2f}", flush=True)
+        print(f"targets: pour {POUR_TARGET_S:.0f} s, load {LOAD_TARGET_S:.0f} s (3000 kernels, two cores)")
+        result["pour"] = rows
     elif args.mass_scale_study:
         result["mass_scale_study"] = mass_scale_study(tuple(args.scales or (1.0, 10.0, 100.0)))
     elif args.grains or args.grain_pack:

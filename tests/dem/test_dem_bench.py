@@ -107,3 +107,13 @@ def test_grain_pack_time_runs_dem_pack_for_the_grain_count(tmp_path):
     assert (r["grains"], r["n_spheres"]) == (6, 36) and r["steps"] >= 6000
     assert 0 < r["pack_wall_time_s"] <= r["wall_s"] and r["cpu_s"] > 0 and len(r["loadavg_before"]) == 3
     assert "--n-grains 6" in r["command"] and (tmp_path / "bed.csv").exists()
+
+
+@pytest.mark.slow
+def test_pour_time_runs_the_wheat_pour_and_its_load(tmp_path):
+    r = bench.pour_time(6, stress_pa=2000.0, out_dir=str(tmp_path), warm_up=False)
+    assert (r["grains"], r["n_spheres"], r["freeze"], r["stress_pa"]) == (6, 48, True, 2000.0)
+    assert "--n-grains 6" in r["command"] and "--stress 2000" in r["command"] and "--mass-scale 100" in r["command"]
+    assert 0 < r["pour_cpu_s"] and 0 < r["load_cpu_s"] and r["pour_cpu_s"] + r["load_cpu_s"] <= r["cpu_s"]
+    assert r["steps"] == r["fill_steps"] + r["rest_steps"] + r["load_steps"]
+    assert 0 < r["active_particle_steps"] <= r["particle_steps"]

@@ -171,3 +171,15 @@ def test_pour_records_its_freezing(tmp_path):
     assert rc in (0, 1)
     f = s["fill"]["freeze"]
     assert f["enabled"] is False and f["freeze_events"] == 0 and f["relists"] > 0
+
+
+def test_the_lid_loads_a_bed_with_no_grain_frozen():
+    from dem import load_bed
+    sim, box, lo, hi = _bed()
+    reg = sim.attach_active(lo_m=lo, hi_m=hi)
+    reg.set_frozen(sim.X[:, 2] < np.median(sim.X[:, 2]))
+    X0 = sim.X.copy()
+    load_bed(sim, box, 2000.0, max_steps=400)
+    assert sim.active is None
+    low = X0[:, 2] < np.median(X0[:, 2])
+    assert np.all(np.any(sim.X[low] != X0[low], axis=1))     # the lower half moves under the lid too
