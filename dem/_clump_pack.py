@@ -8,14 +8,14 @@ bounding spheres fill 20 % of that box: elongated grains' bounding spheres are 5
 volume), each with a random orientation (uniform on SO(3)); the whole templates grow to scale 1
 and settle with the grain-grain friction ``deposition_friction`` (walls frictionless; 0, the
 default, gives the densest bed, friction while the grains grow and fall loosens it: the
-procedure's porosity lever, :func:`pack_grains_to_porosity`), then the material's friction is
+procedure's porosity lever, :func:`dem._grain_search.pack_grains_to_porosity`), then the material's friction is
 restored, the lid removed and the bed settled to ``tol`` (or ``max_steps``).
 
 Porosity: the union of all spheres by QMC (:func:`union_porosity_in_box`), with its standard
 error, in two boxes: ``porosity_interior_union`` keeps one grain length from the walls and the
 surface; ``porosity_network_region`` is the box ``network`` samples by default (the spheres'
 bounding box shrunk by 1.5 volume-equivalent grain diameters on every side,
-``network.pores.default_region``), the one :func:`pack_grains_to_porosity` aims at.
+``network.pores.default_region``), the one :func:`dem._grain_search.pack_grains_to_porosity` aims at.
 
 Output: :func:`write_grain_packing` writes ``x,y,z,r,grain_id`` (one row per sphere, what
 ``network`` reads), ``<stem>.grains.csv`` (one row per grain: id, centre, quaternion w,x,y,z,
@@ -27,7 +27,6 @@ from __future__ import annotations
 import json
 import os
 import time
-from concurrent.futures import ProcessPoolExecutor
 from dataclasses import replace
 from pathlib import Path
 
@@ -41,16 +40,14 @@ from ._material import SOYBEAN
 from ._rigid import random_quaternions
 from .clumps import ClumpSimulation
 
-__all__ = ["pack_grains", "pack_grains_to_porosity", "procedure_lever", "write_grain_packing",
+__all__ = ["pack_grains", "grain_number", "procedure_lever", "write_grain_packing",
            "union_porosity_in_box", "network_region", "DEPOSITION_FRICTION_RANGE"]
 
-#: deposition friction searched by :func:`pack_grains_to_porosity`: frictionless (densest) to 1.0
+#: deposition friction searched by :func:`dem._grain_search.pack_grains_to_porosity`: frictionless (densest) to 1.0
 DEPOSITION_FRICTION_RANGE = (0.0, 1.0)
 
-#: porosities the grain count N = (1-φ)V/V_g of a porosity search is taken from: a target
-#: outside is counted at the nearest end (0.2 overfills the bin: the closed-box end blows up;
-#: 0.9 leaves a bed too thin for network's region), its reachable range measured and refused
-COUNT_POROSITY_RANGE = (0.35, 0.5)
+#: :func:`pack_grains`'s default step limit of the settle stage
+PACK_MAX_STEPS = 40000
 
 #: grain sizes: the coefficient of variation is below this; normal deviates cut at SIZE_CUT sigma
 SIZE_CV_MAX = 0.3
@@ -128,9 +125,16 @@ def bed_porosities(xs, r, template, container, grain_volume_m3):
             "network_region_m": [net_lo.tolist(), net_hi.tolist()], "bed_top_m": float(np.max(xs[:, 2] + r))}
 
 
+def grain_number(container, template, porosity, size_cv=0.0):
+    r"""Grains of ``template`` that fill ``container`` to ``porosity``:
+    :math:`N = \lfloor (1-φ) V / (V_t \overline{f^3}) \rfloor`, :math:`\overline{f^3}` the mean
+    cube of the size factors (``size_cv``: :func:`pack_grains`)."""
+    return int((1 - porosity) * container.volume_m3 / (template.volume_m3 * _mean_cube(size_cv)))
+
+
 def pack_grains(container, template, *, material=SOYBEAN, porosity=0.408, n_grains=None, rng=None,
                 initial_multiplier=None, deposition_friction=0.0, size_cv=0.0, mass_scale=100.0,
-                lid_headroom=0.3, grow_steps=3000, sediment_steps=3000, tol=2e-3, max_steps=40000,
+                lid_headroom=0.3, grow_steps=3000, sediment_steps=3000, tol=2e-3, max_steps=PACK_MAX_STEPS,
                 check_every=200, progress=None):
     r"""Settled packing of grains of one template in ``container`` (procedure: module notes).
 
@@ -150,7 +154,7 @@ def pack_grains(container, template, *, material=SOYBEAN, porosity=0.408, n_grai
     rng = np.random.default_rng(rng)
     f3 = _mean_cube(size_cv)
     v_mean = template.volume_m3 * f3
-    n = int((1 - porosity) * container.volume_m3 / v_mean) if n_grains is None else int(n_grains)
+    n = grain_number(container, template, porosity, size_cv) if n_grains is None else int(n_grains)
     if n < 1:
         raise ValueError(f"no grain of {v_mean:.3g} m^3 fits the container")
     check_sphere_count(n * template.n, f"spheres ({n:,} grains of {template.n})")
@@ -214,104 +218,6 @@ def procedure_lever(lam, *, headroom=0.3, friction_max=DEPOSITION_FRICTION_RANGE
     if lam < 0:
         return round(headroom * (1 + lam), 12), 0.0
     return headroom, round(lam * friction_max, 12)
-
-
-def pack_grains_to_porosity(container, template, *, porosity, porosity_tol=0.005, max_packings=6,
-                            on_packing=None, workers=1, **kwargs):
-    r"""A packing whose porosity in network's region (``porosity_network_region``) is within
-    ``porosity_tol`` of ``porosity``, reached by the packing procedure's lever λ (:func:`procedure_lever`).
-
-    The two ends λ = -1 and +1 are packed first (same seed, same grain count
-    :math:`N = \lfloor(1-φ)V/V_g\rfloor` from the requested φ, clipped to
-    :data:`COUNT_POROSITY_RANGE`): they bound the porosities this procedure reaches. A request
-    more than ``porosity_tol`` outside them is a ValueError naming the reachable range (also
-    when an end leaves network's region empty: a bed too thin). Inside, regula falsi on φ(λ)
-    (monotone up to the packing noise) packs until
-    a bed lands within ``porosity_tol`` or ``max_packings`` beds are spent (then RuntimeError with the
-    closest). ``on_packing(dict)`` is called after each packing with its λ, headroom, friction,
-    porosity and wall time. ``workers=2`` packs the two ends in two processes (the same beds:
-    a packing depends on its seed only; no progress callback there). Returns what
-    :func:`pack_grains` returns; the summary gains ``porosity_search``: target, tol, ``reachable`` (the range of all beds made: φ(λ) need not
-    be monotone, wheat's is not), ``ends``, every (λ, φ) tried.
-    """
-    if not (np.isfinite(porosity) and 0 < porosity < 1):
-        raise ValueError(f"porosity must be in (0, 1), got {porosity!r}")
-    tol = porosity_tol
-    if not (np.isfinite(tol) and tol > 0):
-        raise ValueError(f"porosity tolerance must be > 0, got {tol!r}")
-    if int(max_packings) < 2:
-        raise ValueError(f"the search packs its two ends at least: max packings >= 2, got {max_packings!r}")
-    tried, best = [], None
-    count_phi = float(np.clip(porosity, *COUNT_POROSITY_RANGE))   # sets N only
-
-    def pack(lam, out=None):
-        head, mu = procedure_lever(lam)
-        if out is None:
-            out = pack_grains(container, template, porosity=count_phi, deposition_friction=mu,
-                              lid_headroom=head, **kwargs)
-        e = out[4]["porosity_network_region"]
-        tried.append({"lever": float(lam), "lid_headroom": head, "deposition_friction": mu,
-                      "porosity": e, "porosity_error": out[4]["porosity_network_region_error"],
-                      "wall_time_s": out[4]["wall_time_s"]})
-        if on_packing is not None:
-            on_packing(tried[-1])
-        out[4]["procedure_lever"] = float(lam)
-        return out, e
-
-    if workers > 1:
-        with ProcessPoolExecutor(2) as ex:
-            kw = {**kwargs, "progress": None}
-            jobs = [ex.submit(pack_grains, container, template, porosity=count_phi,
-                              deposition_friction=procedure_lever(lam)[1],
-                              lid_headroom=procedure_lever(lam)[0], **kw) for lam in (-1.0, 1.0)]
-            (lo, e_lo), (hi, e_hi) = pack(-1.0, jobs[0].result()), pack(1.0, jobs[1].result())
-    else:
-        (lo, e_lo), (hi, e_hi) = pack(-1.0), pack(1.0)
-    if not (np.isfinite(e_lo) and np.isfinite(e_hi)):
-        raise ValueError(f"network's sample region (1.5 grain diameters inside the bed on every "
-                         f"side) is empty in the {template.name} beds this container holds "
-                         f"(porosity {e_lo:.4f} at lever -1, {e_hi:.4f} at +1): give a larger "
-                         "container or more grains")
-    reach = (min(e_lo, e_hi), max(e_lo, e_hi))
-    if not (reach[0] - tol <= porosity <= reach[1] + tol):
-        raise ValueError(f"porosity {porosity:g} is outside what this procedure reaches for "
-                         f"{template.name} in this container: {reach[0]:.4f}-{reach[1]:.4f} "
-                         "(lever -1: closed-box growth, +1: deposition friction 1; network's "
-                         "sample region)")
-    a, b = (-1.0, e_lo), (1.0, e_hi)
-    def rank(o):  # a bed at equilibrium within tol first, then the closest
-        s = o[4]
-        settled = s.get("stages", {}).get("settle", {}).get("converged", True)
-        miss = abs(s["porosity_network_region"] - porosity)
-        return (miss > tol or not settled, miss)
-
-    best = min((lo, hi), key=rank)
-    while rank(best)[0] and len(tried) < max_packings:
-        if b[1] == a[1]:
-            break
-        lam = a[0] + (porosity - a[1]) * (b[0] - a[0]) / (b[1] - a[1])
-        w = 0.05 * abs(b[0] - a[0])
-        lam = float(np.clip(lam, min(a[0], b[0]) + w, max(a[0], b[0]) - w))
-        if any(abs(lam - t["lever"]) < 1e-9 for t in tried):  # the same bed again: step aside
-            lam = float(lam + (0.5 * w if a[0] > lam else -0.5 * w))
-        out, e = pack(lam)
-        best = min((best, out), key=rank)
-        if (e - porosity) * (a[1] - porosity) > 0:
-            a = (lam, e)
-        else:
-            b = (lam, e)
-    made = [t["porosity"] for t in tried]  # phi(lambda) need not be monotone: all beds made
-    best[4]["porosity_search"] = {
-        "target": float(porosity), "tol": float(tol), "reachable": [min(made), max(made)],
-        "ends": list(reach), "tried": tried,
-        "lever": "lambda in [-1, 0]: lid headroom 0.3 (1 + lambda), frictionless growth; "
-                 "[0, 1]: deposition friction lambda (porosity in network's sample region)"}
-    got = best[4]["porosity_network_region"]
-    if abs(got - porosity) > tol:
-        steps = [(round(t["lever"], 3), round(t["porosity"], 4)) for t in tried]
-        raise RuntimeError(f"no packing within {tol:g} of porosity {porosity:g} after "
-                           f"{len(tried)} packings (closest {got:.4f}; lever, porosity: {steps})")
-    return best
 
 
 def write_grain_packing(path, centers, radii, grain_id, grains, summary=None):

@@ -16,7 +16,7 @@ With ``--grain`` (a library name or a template CSV x,y,z,r) the grains are rigid
 clumps (:mod:`dem.clumps`): the CSV gains ``grain_id`` and a second file ``<stem>.grains.csv`` has
 one row per grain; ``--scene box`` alone means 0.04 x 0.04 x 0.04 m. Grains are poured
 (``--fill rain``, the default, or ``spout``; :mod:`dem._pour`) with their real masses and the
-library's friction and restitution, or grown in place (``--fill grow``, :mod:`dem._clump_pack`).
+library's friction and restitution, or grown in place (``--fill grow``, :mod:`dem._clump_pack`; ``--porosity``: :mod:`dem._grain_search`).
 ``--depth Z --bin-diameter D`` (or ``--stress PA``) then loads the poured bed through a lid
 servo-controlled to Janssen's vertical stress at that depth (:mod:`dem._load`). Several
 ``--stress`` values make a bed set: one pour, each stress loaded from a copy of the same poured
@@ -39,16 +39,18 @@ from dataclasses import replace
 from pathlib import Path
 
 import numpy as np
-from network.core import check_physical_porosity, reach_text, recorded_reach
+from network.core import check_physical_porosity, recorded_reach
 
 from ._cli import (EXIT_FAILED, check_counts, check_output, check_seed, progress_printer, resolve_container,
                    run_main)
 from ._container import SCENE_DEFAULTS, SCENES, default_measure_spheres
 from ._material import Material
 from ._io import summary_path, write_packing
-from ._clump_pack import grains_path, pack_grains, pack_grains_to_porosity, write_grain_packing
+from ._clump_pack import grains_path, pack_grains, write_grain_packing
+from ._grain_search import grain_count, pack_grains_to_porosity
 from ._contacts import damping_ratio_for_restitution
 from ._load import janssen_stress, load_bed
+from ._reach import count_porosity
 from ._pour import FILL_METHODS, FillOptions, check_fill_options, poured_bed_summary, pour_grains, rest_steps
 from ._procedures import PROCEDURES, PackOptions, RunOptions, pack_bed
 from .grains import grain
@@ -70,14 +72,17 @@ def _parser():
     p.add_argument("--porosity", type=float, default=None,
                    help="target porosity (spheres: default 0.408, Table 3.1). With --grain: reached within "
                         "--porosity-tol in network's sample region by searching the procedure's lever "
-                        "(closed-box growth .. deposition friction, 3-6 packings), or exit 2 with the "
-                        "reachable range; without it one packing at --deposition-friction, grain count "
-                        "from the grain's measured loose-fill porosity")
+                        "(closed-box growth .. deposition friction) with the grain's own count (from its "
+                        "measured loose-fill porosity), or exit 2 with the reachable range: the beds at "
+                        "levers -1, 0, +1, packed once per grain, container and seed and kept in "
+                        "$GRAINFLOW_REACH_CACHE or ~/.cache/grainflow/reach (the bundled boxes': recorded); "
+                        "without it one packing at --deposition-friction")
     p.add_argument("--porosity-tol", type=float, default=0.005, help="--grain --porosity: tolerance (default 0.005)")
     p.add_argument("--max-packings", type=int, default=6,
-                   help="--grain --porosity: packings the search may spend, the two ends included (default 6)")
+                   help="--grain --porosity: packings the search may spend inside the reachable range, the "
+                        "range's own beds not counted (default 6)")
     p.add_argument("--workers", type=int, default=1, choices=[1, 2],
-                   help="--grain --porosity: processes for the search's two end packings (default 1)")
+                   help="--grain --porosity: processes for the range's packings (default 1)")
     p.add_argument("--size-cv", type=float, default=None,
                    help="--grain: size spread, the coefficient of variation of the kernels' axes (grains scaled "
                         "by 1 + cv z, z normal cut at 2.5; default: the library's axes_sd_mm / axes_mm when "
@@ -192,16 +197,15 @@ def _pack_grains(args, fill) -> int:
               tol=args.tol, max_steps=GRAIN_MAX_STEPS if args.max_steps is None else args.max_steps,
               progress=lambda sim, f: pr("grains", _Progress(sim), None))
     if args.porosity is not None and args.deposition_friction is None:
-        rec = recorded_reach(template.name, container.to_dict())
-        if rec is not None and not (rec["range"][0] - rec["tol"] <= args.porosity
-                                    <= rec["range"][1] + rec["tol"]):
-            raise ValueError(f"--porosity {args.porosity:g} is outside what dem.pack reaches for "
-                             f"{template.name} in this container: {reach_text(rec)}")
+        n, _, _ = grain_count(container, template, size_cv=size_cv, n_grains=args.n_grains)
+        rec = recorded_reach(template.name, container.to_dict(), args.seed)
+        if rec is not None and (rec["n_grains"] != n or not rec["beds"]):
+            rec = None                     # the record's beds have another grain count
         try:
             xs, r, gid, grains, s = pack_grains_to_porosity(container, template, porosity=args.porosity,
                                                             porosity_tol=args.porosity_tol,
                                                             on_packing=_packing_line, workers=args.workers,
-                                                            max_packings=args.max_packings,
+                                                            max_packings=args.max_packings, reach=rec,
                                                             **kw)
         except RuntimeError as e:
             print(f"error: {e}", file=sys.stderr)
@@ -222,7 +226,7 @@ def _pack_grains(args, fill) -> int:
           f"{s['steps']} steps, wall {s['wall_time_s']:.1f} s")
     if "porosity_search" in s:
         ps = s["porosity_search"]
-        print(f"porosity search: reachable {ps['reachable'][0]:.4f}-{ps['reachable'][1]:.4f}; tried "
+        print(f"porosity search: reachable {ps['reachable_text']}; tried "
               + ", ".join(f"lever {t['lever']:+.3f} -> {t['porosity']:.4f}" for t in ps["tried"]))
     if not s["converged"]:
         print(f"error: not at equilibrium: the grains' settle stage stopped at the step limit (unbalanced force "
@@ -233,8 +237,13 @@ def _pack_grains(args, fill) -> int:
 
 
 def _packing_line(t):
-    """One stderr line per packing of a porosity search."""
-    print(f"[search] lever {t['lever']:+.3f} (lid headroom {t['lid_headroom']:.3f}, deposition friction "
+    """One stderr line per bed of a porosity search: the range's (packed now or read from the
+    cache) and the search's own."""
+    if t.get("cached"):
+        print(f"[range] lever {t['lever']:+.3f}: porosity {t['porosity']:.4f} (cached)", file=sys.stderr,
+              flush=True)
+        return
+    print(f"[{t.get('stage', 'search')}] lever {t['lever']:+.3f} (lid headroom {t['lid_headroom']:.3f}, deposition friction "
           f"{t['deposition_friction']:.3f}): porosity {t['porosity']:.4f} +- {t['porosity_error']:.4f}, "
           f"{t['wall_time_s']:.0f} s", file=sys.stderr, flush=True)
 
@@ -256,14 +265,8 @@ def _size_cv(args, name):
 
 def _grain_porosity(args, name):
     """The porosity that sets the grain count of one packing: --porosity, else the middle of the
-    grain's measured loose-fill range, else 0.408 (thesis Table 3.1)."""
-    if args.porosity is not None:
-        return args.porosity
-    try:
-        rng = grain(name).bulk_porosity.value
-    except ValueError:
-        rng = None
-    return 0.408 if rng is None else 0.5 * (rng[0] + rng[1])
+    grain's measured loose-fill range, else 0.408 (thesis Table 3.1): dem._reach.count_porosity."""
+    return args.porosity if args.porosity is not None else count_porosity(name)[0]
 
 
 class _Progress:

@@ -14,5 +14,7 @@ def _private_throat_table(tmp_path_factory):
     """
     mp = pytest.MonkeyPatch()
     mp.setenv("GRAINFLOW_CACHE_DB", str(tmp_path_factory.mktemp("cache") / "throats.sqlite"))
+    # nor the user's reachable porosity ranges of the grown fill (~/.cache/grainflow/reach)
+    mp.setenv("GRAINFLOW_REACH_CACHE", str(tmp_path_factory.mktemp("reach")))
     yield
     mp.undo()

@@ -25,15 +25,15 @@ from ._packing import (MIN_SPHERES, PLAUSIBLE_DIAMETER_M, DegeneratePackingError
                        check_grains, check_three_dimensional, grain_volumes, scale_warning,
                        validate_spheres)
 from ._reach import (KEPLER_POROSITY, LOOSEST_POROSITY, check_physical_porosity, recorded_reach,
-                     reach_text)
+                     reach_refusal, reach_text)
 
 __all__ = ["EXIT_BAD_INPUT", "EXIT_FAILED", "EXIT_OK", "FORMATS", "KEPLER_POROSITY",
            "LOOSEST_POROSITY", "MIN_SPHERES", "PLAUSIBLE_DIAMETER_M", "UNITS", "CliError",
            "CliParser", "DegeneratePackingError", "Packing", "bad_input", "check_grains",
            "check_output_list", "check_outputs", "check_physical_porosity",
            "check_three_dimensional", "check_writable_folder", "computing",
-           "default_packing_path", "finish", "grain_volumes", "progress_log", "reach_text",
-           "read_container", "read_packing", "read_summary", "recorded_reach", "run", "same_file",
+           "default_packing_path", "finish", "grain_volumes", "progress_log", "reach_refusal",
+           "reach_text", "read_container", "read_packing", "read_summary", "recorded_reach", "run", "same_file",
            "scale_warning", "summary_path", "validate_spheres", "warn", "write_packing_csv",
            "write_summary", "read_text", "read_table", "split_fields", "delimiter_of",
            "check_count", "MAX_WORKERS", "MAX_SPHERES", "MAX_REPEATS", "AXES", "Region",

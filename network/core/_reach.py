@@ -16,7 +16,7 @@ import math
 from pathlib import Path
 
 __all__ = ["KEPLER_POROSITY", "LOOSEST_POROSITY", "check_physical_porosity", "recorded_reach",
-           "reach_text"]
+           "reach_text", "reach_refusal"]
 
 #: densest packing of equal spheres (face-centred cubic), 1 - pi / sqrt(18)
 KEPLER_POROSITY = 1.0 - math.pi / math.sqrt(18.0)
@@ -72,7 +72,8 @@ def recorded_reach(grain: str, container: dict | None = None, seed=None) -> dict
     ``Container.to_dict()``; None: any) with ``seed`` (None: any), or None.
 
     Returns a dict: ``range`` (low, high porosity of the beds the search made), ``tol`` (its
-    tolerance), ``container``, ``seed`` and ``source`` (the file that records it).
+    tolerance), ``container``, ``seed``, ``source`` (the file that records it), ``beds`` (the
+    search's beds: lever, porosity, ...) and ``n_grains`` (their grain count).
 
     >>> r = recorded_reach("soybean"); [round(v, 4) for v in r["range"]], r["tol"]
     ([0.349, 0.4114], 0.005)
@@ -90,24 +91,44 @@ def recorded_reach(grain: str, container: dict | None = None, seed=None) -> dict
             continue
         if seed is not None and meta.get("seed") != seed:
             continue
+        beds = [{"converged": True, **b} for b in search.get("range_beds", search.get("tried", []))]
         return {"range": (min(lo, hi), max(lo, hi)), "tol": float(search.get("tol", 0.0)),
                 "container": meta.get("container"), "seed": meta.get("seed"),
-                "source": f"network/data/{path.name}"}
+                "source": f"network/data/{path.name}", "beds": beds,
+                "n_grains": meta.get("n_grains")}
     return None
 
 
 def reach_text(record: dict) -> str:
-    """The range as every command quotes it: ``0.3490-0.4114 (...)``.
+    """The range as every command quotes it: ``0.3490-0.4114 (...)``, naming the container, the
+    seed, how the beds were made (``how``, where given) and the file that keeps them.
 
     >>> reach_text(recorded_reach("soybean"))  # doctest: +ELLIPSIS
     '0.3490-0.4114 (the beds dem.pack --porosity made in the 0.05 x 0.05 x 0.05 m box, seed 1, ...'
     """
     lo, hi = record["range"]
     c = record.get("container") or {}
-    box = ""
-    if c.get("kind") == "box" and c.get("size_m") is not None:
-        box = " in the " + " x ".join(f"{v:g}" for v in [*c["size_m"], c["fill_height_m"]]) \
-            + " m box"
+    where = ""
+    try:
+        if c.get("kind") == "box":
+            where = " in the " + " x ".join(f"{v:g}" for v in [*c["size_m"], c["fill_height_m"]]) \
+                + " m box"
+        elif c.get("kind") == "cylinder":
+            where = (f" in the {_list(c['size_m'])[0]:g} m wide, {c['fill_height_m']:g} m high "
+                     "cylinder")
+    except (KeyError, TypeError, ValueError):
+        where = ""
     seed = "" if record.get("seed") is None else f", seed {record['seed']}"
-    return (f"{lo:.4f}-{hi:.4f} (the beds dem.pack --porosity made{box}{seed}, "
+    how = f", {record['how']}" if record.get("how") else ""
+    return (f"{lo:.4f}-{hi:.4f} (the beds dem.pack --porosity made{where}{seed}{how}, "
             f"{record['source']}; a request within its {record['tol']:g} tolerance is taken)")
+
+
+def reach_refusal(porosity: float, grain: str, record: dict, what: str = "--porosity") -> str:
+    """The one message of a porosity outside ``record``'s range (widened by its tolerance).
+
+    >>> reach_refusal(0.45, "soybean", recorded_reach("soybean"))  # doctest: +ELLIPSIS
+    '--porosity 0.45 is outside what dem.pack reaches for soybean in this container: 0.3490-...'
+    """
+    return (f"{what} {porosity:g} is outside what dem.pack reaches for {grain} in this container: "
+            f"{reach_text(record)}")

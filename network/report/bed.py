@@ -11,8 +11,9 @@ The bed is chosen before anything is written (:func:`plan_bed`), in this order:
    in the bundled bed's box (``--bed-box`` otherwise), at P = ``--porosity`` or the grain's
    measured loose-fill porosity; the report is then for the new bed's own porosity
    (dem.pack reaches P within 0.005 in network's sample region, or refuses, exit 2, naming
-   the range it reaches); a P outside the range recorded for the grain in that box
-   (:func:`network.core.recorded_reach`) is refused at once, nothing packed;
+   the range it reaches: measured once per grain, box and seed, then kept); a P outside the
+   range recorded for the grain in that box and seed (:func:`network.core.recorded_reach`) is
+   refused at once, nothing packed;
 4. else the bundled bed (the default run: seconds).
 
 dem.pack runs as a subprocess (network does not import dem; the CSV and its companion JSON are
@@ -34,7 +35,7 @@ from pathlib import Path
 
 from .._cli import EXIT_BAD_INPUT, EXIT_FAILED, CliError, computing
 from .._grains import BED
-from ..core import reach_text, recorded_reach
+from ..core import reach_refusal, recorded_reach
 from .porosity import bundled_packing, packing_meta
 
 __all__ = ["TEMPLATE_GRAINS", "PACK_TOL", "add_bed_options", "plan_bed", "bed_paths", "find_bed",
@@ -149,11 +150,11 @@ def plan_bed(grain: str, *, porosity, seed, packing, move_along_band: bool, bed_
     box = tuple(float(v) for v in box)
     if not all(v > 0 and v < 10 for v in box):
         raise ValueError(f"--bed-box must be three lengths in (0, 10) m, got {list(box)}")
-    rec = recorded_reach(grain, {"kind": "box", "size_m": list(box[:2]), "fill_height_m": box[2]})
+    rec = recorded_reach(grain, {"kind": "box", "size_m": list(box[:2]), "fill_height_m": box[2]},
+                         int(seed))
     if rec is not None and not rec["range"][0] - rec["tol"] <= porosity <= rec["range"][1] \
             + rec["tol"]:
-        raise ValueError(f"--porosity {porosity:g} is outside the range a packing of {grain} "
-                         f"reaches in this box: {reach_text(rec)}; no bed packed")
+        raise ValueError(f"{reach_refusal(porosity, grain, rec)}; no bed packed")
     d = Path(bed_dir)
     for p in [d, *d.parents]:
         if p.exists():

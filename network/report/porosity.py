@@ -88,8 +88,9 @@ def requested_porosity(grain: str, porosity: float | None) -> tuple[float | None
 
 def reach_record(meta: dict, source) -> dict | None:
     """The range a packing of the grain reaches, from its companion JSON (``porosity_search`` of
-    ``dem.pack --porosity``: the porosities of the beds its search made, and its tolerance), as
-    :func:`network.core.recorded_reach` gives it; None without that record.
+    ``dem.pack --porosity``: the range it searched in, where it is kept, and its tolerance), as
+    :func:`network.core.recorded_reach` gives it, quoted as dem.pack quoted it; None without
+    that record.
 
     >>> r = reach_record({"porosity_search": {"reachable": [0.35, 0.41], "tol": 0.005}}, "b.json")
     >>> r["range"], r["tol"]
@@ -108,7 +109,8 @@ def reach_record(meta: dict, source) -> dict | None:
     if src.resolve().parent == DATA_DIR:        # a bundled bed: named as every command names it
         src = Path("network/data") / src.name
     return {"range": (lo, hi), "tol": tol, "container": meta.get("container"),
-            "seed": meta.get("seed"), "source": str(src)}
+            "seed": meta.get("seed"), "how": s.get("reachable_how"),
+            "source": str(s.get("reachable_source") or src)}
 
 
 class UnreachablePorosity(ValueError):

@@ -10,7 +10,8 @@ import pytest
 
 import dem._clump_pack as cp
 from dem import Container
-from dem._clump_pack import network_region, pack_grains_to_porosity, procedure_lever
+from dem._clump_pack import network_region, procedure_lever
+from dem._grain_search import grain_count, pack_grains_to_porosity
 from dem.templates import sphere_template
 
 
@@ -50,6 +51,7 @@ def _fake(law, calls):
 
 
 def test_search_reaches_the_target_within_tol(monkeypatch):
+    """The range's three beds (levers -1, 0, +1) first, then the search inside them."""
     calls = []
     monkeypatch.setattr(cp, "pack_grains", _fake(lambda lam: 0.38 + 0.02 * (lam + 1) ** 1.5, calls))
     box = Container("box", (0.01, 0.01), 0.01)
@@ -57,32 +59,68 @@ def test_search_reaches_the_target_within_tol(monkeypatch):
     s = out[4]["porosity_search"]
     assert abs(out[4]["porosity_network_region"] - 0.405) <= 0.002
     assert s["reachable"] == pytest.approx([0.38, 0.38 + 0.02 * 2**1.5])
-    assert calls[:2] == [-1.0, 1.0] and len(calls) <= 6
-    assert [t["lever"] for t in s["tried"]] == pytest.approx(calls, abs=1e-9)
+    assert calls[:3] == [-1.0, 0.0, 1.0] and len(calls) <= 3 + 6
+    assert [b["lever"] for b in s["range_beds"]] == [-1.0, 0.0, 1.0]
+    assert [t["lever"] for t in s["tried"]] == pytest.approx(calls[3:], abs=1e-9)
+
+
+def test_a_range_bed_within_the_tolerance_is_the_answer(monkeypatch):
+    """0.401 +- 0.002 and the range's bed at lever 0 has 0.400: that bed, no packing more."""
+    calls = []
+    monkeypatch.setattr(cp, "pack_grains", _fake(lambda lam: 0.38 + 0.02 * (lam + 1), calls))
+    box = Container("box", (0.01, 0.01), 0.01)
+    out = pack_grains_to_porosity(box, sphere_template(0.001), porosity=0.401, porosity_tol=0.002)
+    assert calls == [-1.0, 0.0, 1.0] and out[4]["procedure_lever"] == 0.0
+    assert out[4]["porosity_network_region"] == pytest.approx(0.40)
 
 
 def test_search_outside_the_reachable_range_names_it(monkeypatch):
     monkeypatch.setattr(cp, "pack_grains", _fake(lambda lam: 0.40 + 0.01 * lam, []))
     box = Container("box", (0.01, 0.01), 0.01)
-    with pytest.raises(ValueError, match=r"outside what this procedure reaches .*0\.3900-0\.4100"):
+    with pytest.raises(ValueError, match=r"porosity 0.43 is outside what dem.pack reaches for "
+                                         r"sphere in this container: 0\.3900-0\.4100 \(the beds "
+                                         r"dem.pack --porosity made in the 0.01 x 0.01 x 0.01 m box"):
         pack_grains_to_porosity(box, sphere_template(0.001), porosity=0.43)
 
 
 def test_search_gives_up_after_max_packings(monkeypatch):
     """A porosity that jumps across the target (packing noise) is not found: RuntimeError with
-    the closest bed, never a bed outside the tolerance."""
-    monkeypatch.setattr(cp, "pack_grains", _fake(lambda lam: 0.39 if lam < 0.3 else 0.42, []))
+    the closest bed, never a bed outside the tolerance; the range's beds are not counted."""
+    calls = []
+    monkeypatch.setattr(cp, "pack_grains", _fake(lambda lam: 0.39 if lam < 0.3 else 0.42, calls))
     box = Container("box", (0.01, 0.01), 0.01)
-    with pytest.raises(RuntimeError, match="no packing within 0.005 of porosity 0.405 after 6"):
+    with pytest.raises(RuntimeError, match="no packing at equilibrium within 0.005 of porosity "
+                                           "0.405 after 6 packings"):
         pack_grains_to_porosity(box, sphere_template(0.001), porosity=0.405)
+    assert len(calls) == 3 + 6
+
+
+def test_steep_lever_is_searched_to_the_target(monkeypatch):
+    """Soybean in the 0.04 m box (253 grains, seed 1), its beds' porosity against the lever as
+    packed on one x86-64 host: steep between deposition friction 0.15 and 0.22 (0.3918 ->
+    0.4104), not monotone (0.4201 at 0.39, 0.4169 at 1). Plain regula falsi from the two ends
+    missed 0.40 after 6 packings; from the range's three beds, by regula falsi with bisection
+    after two beds on one side, every target in the range lands within 0.005 within the default
+    6 packings (the range's not counted)."""
+    pts = [(-1, 0.3616), (-0.087, 0.3799), (0, 0.3727), (0.152, 0.3918), (0.221, 0.4104),
+           (0.39, 0.4201), (1, 0.4169)]
+    calls = []
+    monkeypatch.setattr(cp, "pack_grains", _fake(lambda lam: float(np.interp(lam, *zip(*pts))),
+                                                 calls))
+    box = Container("box", (0.01, 0.01), 0.01)
+    for target in np.arange(0.357, 0.4219, 0.0025):   # the range 0.3616-0.4169 +- 0.005
+        calls.clear()
+        out = pack_grains_to_porosity(box, sphere_template(0.001), porosity=float(target))
+        assert abs(out[4]["porosity_network_region"] - target) <= 0.005
+        assert len(calls) - 3 <= 6, (target, calls)
 
 
 def test_bad_requests():
     box = Container("box", (0.01, 0.01), 0.01)
     with pytest.raises(ValueError, match="porosity must be in"):
         pack_grains_to_porosity(box, sphere_template(0.001), porosity=1.2)
-    with pytest.raises(ValueError, match="max packings >= 2"):
-        pack_grains_to_porosity(box, sphere_template(0.001), porosity=0.4, max_packings=1)
+    with pytest.raises(ValueError, match="max packings >= 1"):
+        pack_grains_to_porosity(box, sphere_template(0.001), porosity=0.4, max_packings=0)
     with pytest.raises(ValueError, match="deposition friction"):
         cp.pack_grains(box, sphere_template(0.001), deposition_friction=-0.1)
 
@@ -105,61 +143,122 @@ def test_grain_bed_not_at_equilibrium_exits_1(tmp_path, capsys):
 
 
 def test_search_passes_over_a_bed_not_at_equilibrium(monkeypatch):
-    """A bed within the tolerance whose settle stage did not converge is not the answer while
-    packings remain: the search steps aside (the same lever would give the same bed) to one at
-    equilibrium."""
+    """A bed within the tolerance whose settle stage did not converge (here the range's bed at
+    lever 0, 0.400 for 0.401 +- 0.002) is not the answer: the search packs others (the same
+    lever would give the same bed) until one at equilibrium lands (0.2: 0.404, 0.05: 0.401)."""
     calls = []
     law = _fake(lambda lam: 0.38 + 0.02 * (lam + 1), calls)
 
     def pack(*a, **kw):
         out = law(*a, **kw)
-        out[4]["stages"] = {"settle": {"converged": abs(calls[-1] - 0.05) > 1e-6}}
+        out[4]["stages"] = {"settle": {"converged": abs(calls[-1]) > 1e-6}}
         return out
     monkeypatch.setattr(cp, "pack_grains", pack)
     box = Container("box", (0.01, 0.01), 0.01)
     out = pack_grains_to_porosity(box, sphere_template(0.001), porosity=0.401, porosity_tol=0.002)
-    assert len(calls) == 4 and out[4]["stages"]["settle"]["converged"]
+    assert calls == pytest.approx([-1.0, 0.0, 1.0, 0.2, 0.05])
+    assert out[4]["stages"]["settle"]["converged"] and out[4]["procedure_lever"] == 0.05
     assert abs(out[4]["porosity_network_region"] - 0.401) <= 0.002
 
 
-@pytest.mark.parametrize("target, count_phi", [(0.2, 0.35), (0.9, 0.5), (0.42, 0.42)])
-def test_far_targets_count_grains_within_range_and_name_reach(monkeypatch, target, count_phi):
-    """A target far outside what grains reach does not set the grain count: 0.2 would overfill
-    the bin (N = 0.8 V/V_g: the closed-box end blows up) and 0.9 would leave a bed too thin for
-    network's region. N comes from the target clipped to COUNT_POROSITY_RANGE; the ends are
-    packed and the reachable range named (ValueError: exit 2). On a real soybean bed
-    (0.08 x 0.08 x 0.05 m box) 0.2 ends with the reachable range 0.3211-0.4000."""
-    seen = []
-    law = _fake(lambda lam: 0.40 + 0.01 * lam, [])
+def test_grain_count_and_range_do_not_depend_on_the_request(monkeypatch, tmp_path):
+    """The grain count is the grain's (soybean: from its loose-fill middle 0.40985), whatever the
+    request: 0.30, 0.405 and 0.55 pack the same range beds, and the range is quoted the same.
+    With an integer seed the beds are packed once and read from the cache after (no packing)."""
+    monkeypatch.setenv("GRAINFLOW_REACH_CACHE", str(tmp_path))
+    calls, counts = [], []
+    law = _fake(lambda lam: 0.38 + 0.02 * (lam + 1), calls)
 
-    def pack(container, template, *, porosity, **kw):
-        seen.append(porosity)
+    def pack(container, template, *, n_grains, porosity, **kw):
+        counts.append((n_grains, porosity))
         return law(container, template, porosity=porosity, **kw)
     monkeypatch.setattr(cp, "pack_grains", pack)
-    assert cp.COUNT_POROSITY_RANGE == (0.35, 0.5)
-    box = Container("box", (0.01, 0.01), 0.01)
-    with pytest.raises(ValueError, match=r"outside what this procedure reaches .*0\.3900-0\.4100"):
-        pack_grains_to_porosity(box, sphere_template(0.001), porosity=target)
-    assert seen == [count_phi, count_phi]
+    from dem.templates import resolve_template
+    box, soy = Container("box", (0.04, 0.04), 0.04), resolve_template("soybean")
+    n = int((1 - 0.40985) * 0.04**3 / soy.volume_m3)
+    assert grain_count(box, soy)[:2] == (n, 0.40985)
+    quoted = []
+    for target in (0.30, 0.405, 0.55):
+        try:
+            out = pack_grains_to_porosity(box, soy, porosity=target, rng=1)
+            quoted.append(out[4]["porosity_search"]["reachable_text"])
+        except ValueError as e:
+            quoted.append(str(e).split("in this container: ")[1])
+    assert len(set(quoted)) == 1 and quoted[0].startswith("0.3800-0.4200 (the beds dem.pack "
+                                                          "--porosity made in the 0.04 x 0.04 x "
+                                                          f"0.04 m box, seed 1, {n} grains at "
+                                                          f"levers -1, 0, +1, {tmp_path}")
+    assert calls[:3] == [-1.0, 0.0, 1.0] and -1.0 not in calls[3:] and 1.0 not in calls[3:]
+    assert set(counts) == {(n, 0.40985)}
+    assert len(list(tmp_path.glob("soybean-*.json"))) == 1
+    calls.clear()                               # no seed: nothing cached, the range packed again
+    with pytest.raises(ValueError, match="0.3800-0.4200"):
+        pack_grains_to_porosity(box, soy, porosity=0.55)
+    assert calls == [-1.0, 0.0, 1.0]
 
 
 def test_an_empty_network_region_is_named_not_nan(monkeypatch):
     monkeypatch.setattr(cp, "pack_grains", _fake(lambda lam: float("nan"), []))
     box = Container("box", (0.01, 0.01), 0.01)
     with pytest.raises(ValueError, match=r"network's sample region .* is empty .*porosity nan "
-                                         r"at lever -1, nan at \+1\): give a larger container"):
+                                         r"at lever -1, nan at lever 0, nan at lever \+1\): give "
+                                         r"a larger container"):
         pack_grains_to_porosity(box, sphere_template(0.001), porosity=0.9)
 
 
 def test_pack_cli_unreachable_porosity_exits_2(tmp_path, monkeypatch, capsys):
-    """dem.pack --grain --porosity 0.45 beyond what the search's ends reach in a container
+    """dem.pack --grain --porosity 0.45 beyond what the range's beds reach in a container
     without a recorded range: exit 2 with the reachable range, nothing written."""
+    monkeypatch.setenv("GRAINFLOW_REACH_CACHE", str(tmp_path / "reach"))
     monkeypatch.setattr(cp, "pack_grains", _fake(lambda lam: 0.32 + 0.04 * (lam + 1), []))
     from dem.pack import main
     out = tmp_path / "g.csv"
     assert main(["--scene", "box", "--size", "0.08", "0.08", "--height", "0.05", "--grain",
                  "soybean", "--porosity", "0.45", "--out", str(out), "--quiet"]) == 2
-    err = [ln for ln in capsys.readouterr().err.splitlines() if not ln.startswith("[search]")]
-    assert len(err) == 1 and err[0].startswith("error: porosity 0.45 is outside"), err
+    err = [ln for ln in capsys.readouterr().err.splitlines() if not ln.startswith("[range]")]
+    assert len(err) == 1 and err[0].startswith("error: porosity 0.45 is outside what dem.pack "
+                                               "reaches for soybean in this container: "), err
     assert "0.3200-0.4000" in err[0]
-    assert not list(tmp_path.iterdir())
+    assert [p.name for p in tmp_path.iterdir()] == ["reach"]
+
+
+@pytest.mark.slow
+def test_one_range_per_grain_container_and_seed(tmp_path, monkeypatch, capsys):
+    """Real beds: soybean in a 0.04 m box, seed 1 (253 grains, a bed in seconds). --porosity
+    0.45 packs the range's three beds and exits 2 quoting it (0.3616-0.4169 on one x86-64
+    host); 0.44 exits 2 with the same words from the cache, nothing packed; 0.40 packs inside
+    the range only (no range bed again) and its JSON quotes the same range."""
+    import json
+    import re
+    from dem.pack import main
+    monkeypatch.setenv("GRAINFLOW_REACH_CACHE", str(tmp_path / "reach"))
+    real, levers = cp.pack_grains, []
+
+    def counted(*a, deposition_friction, lid_headroom, **kw):
+        levers.append(deposition_friction if deposition_friction > 0 else lid_headroom / 0.3 - 1)
+        return real(*a, deposition_friction=deposition_friction, lid_headroom=lid_headroom, **kw)
+    monkeypatch.setattr(cp, "pack_grains", counted)
+    box = ["--scene", "box", "--size", "0.04", "0.04", "--height", "0.04", "--grain", "soybean",
+           "--quiet"]
+    quoted = []
+    for p in ("0.45", "0.44"):
+        assert main(box + ["--porosity", p, "--out", str(tmp_path / "b.csv")]) == 2
+        err = [ln for ln in capsys.readouterr().err.splitlines() if not ln.startswith("[")]
+        assert len(err) == 1 and err[0].startswith(f"error: porosity {p} is outside what dem.pack "
+                                                   "reaches for soybean in this container: "), err
+        quoted.append(err[0].split("in this container: ")[1])
+        assert levers == ([-1.0, 0.0, 1.0] if p == "0.45" else []), levers
+        levers.clear()
+    assert quoted[0] == quoted[1]
+    lo, hi = map(float, re.match(r"(\d\.\d{4})-(\d\.\d{4}) \(the beds dem.pack --porosity made in "
+                                 r"the 0.04 x 0.04 x 0.04 m box, seed 1, 253 grains at levers "
+                                 r"-1, 0, \+1, ", quoted[0]).groups())
+    assert 0.34 < lo < 0.38 and 0.40 < hi < 0.44 and hi + 0.005 < 0.44
+    assert not (tmp_path / "b.csv").exists()
+    assert main(box + ["--porosity", "0.40", "--out", str(tmp_path / "b.csv")]) == 0
+    s = json.loads((tmp_path / "b.json").read_text())
+    ps = s["porosity_search"]
+    assert ps["reachable"] == [lo, hi] or ps["reachable"] == pytest.approx([lo, hi], abs=5e-5)
+    assert ps["reachable_text"] == quoted[0] and s["n_grains"] == ps["n_grains"] == 253
+    assert abs(s["porosity_network_region"] - 0.40) <= 0.005 and s["converged"]
+    assert [t["lever"] for t in ps["tried"]] == pytest.approx(levers) and len(levers) <= 6

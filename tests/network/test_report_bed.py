@@ -43,9 +43,10 @@ def test_pack_command_lets_slow_grains_settle(tmp_path):
 
 @pytest.mark.slow
 def test_packs_a_new_bed_then_reuses_it(tmp_path, monkeypatch):
-    """--porosity 0.40 --seed 1: dem.pack packs the bed (reached within 0.005 of 0.40: 0.3969
-    on one x86-64 host, 0.4020 on an AMD EPYC host; the DEM's host-compiled steps differ in
-    last bits and a packing is chaotic), the report is for that bed's own porosity; the same
+    """--porosity 0.40 --seed 1: dem.pack packs the bed (soybean's own count, 253 grains;
+    reached within 0.005 of 0.40: 0.3961 at the fifth bed of the search on one x86-64 host, the
+    DEM's host-compiled steps differ in last bits and a packing is chaotic), the report is for
+    that bed's own porosity; the same
     command again reuses the bed (no packing: the CSV untouched, the numbers the same)."""
     monkeypatch.chdir(tmp_path)
     beds, out = tmp_path / "beds", tmp_path / "r.json"
@@ -67,7 +68,7 @@ def test_packs_a_new_bed_then_reuses_it(tmp_path, monkeypatch):
     assert abs(meta["porosity_network_region"] - 0.40) <= PACK_TOL
     assert meta["porosity_network_region"] == pytest.approx(float(reached.group(1)), abs=1e-4)
     assert r["n_grains"] == meta["n_grains"] and r["n_spheres"] == 6 * r["n_grains"]
-    assert 240 <= r["n_grains"] <= 280                   # 258 on one x86-64 host
+    assert r["n_grains"] == 253                          # soybean's own count: (1 - 0.40985) V / V_g
     # the report's porosity is the new bed's own (network's Monte Carlo), not moved
     assert r["porosity"] == r["porosity_packing"]
     assert abs(r["porosity"] - 0.40) <= PACK_TOL + 3 * r["porosity_packing_std"]
@@ -84,16 +85,18 @@ def test_packs_a_new_bed_then_reuses_it(tmp_path, monkeypatch):
     assert csv.stat().st_mtime_ns == stamp
     assert [p["pressure_gradient_pa_per_m"] for p in again["points"]] == pytest.approx(
         [p["pressure_gradient_pa_per_m"] for p in r["points"]], rel=1e-9)
-    # soybean at porosity 0.40: 4.30 and 57.45 Pa/m on one x86-64 host's bed
+    # soybean near porosity 0.40 in this 3-grain-wide sample: 5.49 and 81.8 Pa/m on one x86-64
+    # host's bed (0.3965; D272 6.87 and 107, Ergun 4.22 and 70.1); beds of other hosts differ
     g = [p["pressure_gradient_pa_per_m"] for p in r["points"]]
-    assert 3.0 < g[0] < 6.0 and 40.0 < g[1] < 80.0 and g[1] / g[0] > 10.0
+    assert 3.0 < g[0] < 8.0 and 40.0 < g[1] < 110.0 and g[1] / g[0] > 10.0
 
 
 @pytest.mark.slow
 def test_a_porosity_dem_pack_cannot_reach_exits_2(tmp_path, monkeypatch, capsys):
-    """dem.pack's own refusal (exit 2, the range its two end packings reach: 0.3753-0.4074 for
-    the grain count of 0.45 on one x86-64 host, 0.3880-0.4029 on an AMD EPYC host: chaotic
-    packings of host-compiled steps) is the report's one error line; nothing written."""
+    """dem.pack's own refusal (exit 2, the one range of soybean in this box with seed 1, its
+    beds at levers -1, 0, +1: 0.3616-0.4169 for its 253 grains on one x86-64 host; chaotic
+    packings of host-compiled steps differ by host) is the report's one error line; nothing
+    written."""
     monkeypatch.chdir(tmp_path)
     beds, out = tmp_path / "a" / "beds", tmp_path / "r.json"
     assert main(SMALL + ["--porosity", "0.45", "--bed-dir", str(beds), "--json", str(out)]) == 2
@@ -101,7 +104,8 @@ def test_a_porosity_dem_pack_cannot_reach_exits_2(tmp_path, monkeypatch, capsys)
     assert len(err) == 1 and err[0].startswith("error: dem.pack"), err
     lo, hi = map(float, re.search(r"reaches for soybean in this container: "
                                   r"(\d\.\d{4})-(\d\.\d{4})", err[0]).groups())
-    assert 0.36 < lo < hi < 0.42 and hi + PACK_TOL < 0.45
+    assert 0.34 < lo < hi < 0.43 and hi + PACK_TOL < 0.45
+    assert "seed 1, 253 grains at levers -1, 0, +1, " in err[0]
     assert not out.exists() and not (tmp_path / "a").exists()
 
 
