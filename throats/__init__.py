@@ -19,6 +19,10 @@ shape_factor_qstar, deep_overlap
     Fast Q* estimate c_t A² G (Patzek & Silin 2001) fitted per contact type, over 1e6
     throats/s; median error about 20 % against FE (``docs/throats-shape-factor.md``); the rows
     with a deep overlap (two spheres of one grain) that take their own constants.
+section_ratio, section_fem, section_area_perimeter
+    Sections with more disks than the three vertex disks (other spheres of the vertices'
+    grains cutting the plane): the flow rate relative to the three-disk section by the
+    distance-squared estimate, Q by finite elements, exact open area and wetted perimeter.
 solve_fem, ThroatSolution, SOLVER_VERSION
     Q* by finite elements (gmsh + scikit-fem), batch, ``rtol``-driven, with an error estimate;
     the version string is bumped whenever results could change.
@@ -29,16 +33,17 @@ Command line: ``python -m throats.solve`` (one throat as JSON, or a CSV of throa
 Method (closing rule for passages narrower than 0.01 r̄, curved quadratic gmsh triangles,
 Lagrange P3/P4, the error estimate, and what each costs) in
 ``docs/throats-method.md``; modules, lowest first: ``_geometry``, ``_boundary``, ``_area``,
-``_shape_factor``, ``_mesh``, ``_trimesh``, ``_solve``.
+``_shape_factor``, ``_mesh``, ``_trimesh``, ``_solve``, ``_multidisk``.
 """
 
 from ._area import open_area
 from ._geometry import (as_throats, canonical_form, contact_type, triangle_area, triangle_vertices,
                         validate_throats)
+from ._multidisk import section_area_perimeter, section_fem, section_ratio
 from ._shape_factor import deep_overlap, shape_factor_qstar
 from ._solve import SOLVER_VERSION, ThroatSolution, solve_fem
 
 __all__ = ["SOLVER_VERSION", "as_throats", "ThroatSolution", "canonical_form", "contact_type",
-           "deep_overlap", "open_area",
+           "deep_overlap", "open_area", "section_area_perimeter", "section_fem", "section_ratio",
            "shape_factor_qstar", "solve_fem", "triangle_area", "triangle_vertices",
            "validate_throats"]

@@ -4,9 +4,10 @@ The open region of a throat (lengths in units of r̄) is
 
 .. math:: \Omega = T \cap \bigcap_i \overline{D_i}^c \cap \bigcap_m R_m^c,
 
-the triangle T minus the three disks D_i (and, for the mesher, minus the rectangles R_m of
-its closing rules).  Its boundary is assembled from primitive curves: the triangle edges, the
-three circles and optional extra segments.  Each primitive is split at its intersections with
+the triangle T minus the disks D_i (the three vertex disks; more where other spheres cut the
+section's plane) and, for the mesher, minus the rectangles R_m of its closing rules.  Its
+boundary is assembled from primitive curves: the triangle edges, the circles and optional
+extra segments.  Each primitive is split at its intersections with
 all the others; a sub-piece belongs to the boundary when its midpoint lies in the closure of
 every other set that makes up the region.  The area follows from Green's theorem,
 :math:`A = \tfrac12 \oint_{\partial\Omega} (x\,dy - y\,dx)`, in closed form over segments
@@ -40,15 +41,17 @@ def region_boundary(verts, centers, radii, lines_a=None, lines_b=None, lines_own
     r"""Boundary of :math:`\Omega = T \cap \bigcap_i \overline{D_i}^c \cap \bigcap_m R_m^c`.
 
     Vectorised over N throats (lengths in units of r̄).  Primitive curves: the 3 triangle
-    edges (counter-clockwise, owner set 0), the 3 circles (clockwise so that the fluid is on
-    the left, owner sets 1..3) and optional extra segments (owner set 4 + m, oriented with the
-    fluid on the left) that bound removed rectangles ``rects`` (closing rules of the mesher).
+    edges (counter-clockwise, owner set 0), the K circles (clockwise so that the fluid is on
+    the left, owner sets 1..K) and optional extra segments (owner set 4 + m, oriented with the
+    fluid on the left) that bound removed rectangles ``rects`` (closing rules of the mesher;
+    with the three vertex disks only, K = 3).
 
     Parameters
     ----------
     verts : (N, 3, 2) triangle vertices, counter-clockwise
-    centers : (N, 3, 2) disk centres (the vertices)
-    radii : (N, 3)
+    centers : (N, K, 2) disk centres (the throat's K = 3 vertex disks, or more disks: a section
+        that other spheres cut too)
+    radii : (N, K)
     lines_a, lines_b : (N, K, 2) extra segments (start, end)
     lines_owner : (K,) int, set index 4 + m of the rectangle each segment bounds
     lines_present : (N, K) bool
@@ -56,14 +59,14 @@ def region_boundary(verts, centers, radii, lines_a=None, lines_b=None, lines_own
         ``s1``, ``present``: removed open set {x0 < x < x1, s < s1} in the frame.
     extra_lt : (N, L', E), optional
         Extra split parameters on the first L' segments (mesh feature points).
-    extra_cu : (N, 3, E), optional
+    extra_cu : (N, K, E), optional
         Extra split parameters (clockwise, in [0, 1)) on the circles.
 
     Returns
     -------
     dict with, for the L = 3 + K segments: ``la, lb`` (N, L, 2), ``lt`` (N, L, Kb) sorted
     breakpoints, ``lon`` (N, L, Kb-1) piece-on-boundary mask, ``lowner`` (L,); for the 3
-    circles: ``cu`` (N, 3, Kc) sorted clockwise parameters, ``con`` (N, 3, Kc-1); and
+    circles: ``cu`` (N, K, Kc) sorted clockwise parameters, ``con`` (N, K, Kc-1); and
     ``area`` (N,) from Green's theorem.
     """
     N = verts.shape[0]
@@ -84,6 +87,7 @@ def region_boundary(verts, centers, radii, lines_a=None, lines_b=None, lines_own
     L = la.shape[1]
     C = centers
     R = radii
+    K = C.shape[1]
     d = lb - la                                                   # (N, L, 2)
 
     # --- breakpoints on segments -----------------------------------------------------
@@ -125,7 +129,7 @@ def region_boundary(verts, centers, radii, lines_a=None, lines_b=None, lines_own
     pts = la[:, :, None, None, :] + t_cl[..., None] * d[:, :, None, None, :]  # (N,L,3,2,2)
     u_cl = _angle_param(pts, C[:, None, :, None, :])                         # (N,L,3,2)
     u_cl = np.where(np.isfinite(t_cl), u_cl, np.nan)
-    u_cl = np.moveaxis(u_cl, 2, 1).reshape(N, 3, -1)                          # (N,3,2L)
+    u_cl = np.moveaxis(u_cl, 2, 1).reshape(N, K, -1)                          # (N,3,2L)
     # circle c vs circle k
     dv = C[:, None, :, :] - C[:, :, None, :]                                  # (N,3,3,2)
     dist = np.linalg.norm(dv, axis=-1)
@@ -140,10 +144,10 @@ def region_boundary(verts, centers, radii, lines_a=None, lines_b=None, lines_own
     base = C[:, :, None, :] + aq[..., None] * ev
     pcc = np.stack([base + hq[..., None] * perp, base - hq[..., None] * perp], axis=3)
     u_cc = _angle_param(pcc, C[:, :, None, None, :])                          # (N,3,3,2)
-    u_cc = np.where(meet[..., None], u_cc, np.nan).reshape(N, 3, -1)
+    u_cc = np.where(meet[..., None], u_cc, np.nan).reshape(N, K, -1)
     cu = np.concatenate([u_cl, u_cc] + ([] if extra_cu is None else [extra_cu]), axis=2)
     cu = np.where((cu > 1e-13) & (cu < 1 - 1e-13), cu, np.nan)
-    cu = np.concatenate([np.zeros((N, 3, 1)), np.ones((N, 3, 1)), cu], axis=2)
+    cu = np.concatenate([np.zeros((N, K, 1)), np.ones((N, K, 1)), cu], axis=2)
     cu = np.sort(cu, axis=2)
 
     # --- midpoint membership ---------------------------------------------------------
@@ -157,7 +161,7 @@ def region_boundary(verts, centers, radii, lines_a=None, lines_b=None, lines_own
         e = vb - va
         sd = _cross(e, p[..., None, :] - va) / np.linalg.norm(e, axis=-1)
         res &= (sd >= -tol).all(axis=-1) | (skip == 0)
-        for i in range(3):
+        for i in range(K):
             dd = np.linalg.norm(p - C[:, None, None, i], axis=-1)
             res &= (dd >= R[:, None, None, i] - tol) | (skip == 1 + i)
         if rects is not None:
@@ -183,7 +187,7 @@ def region_boundary(verts, centers, radii, lines_a=None, lines_b=None, lines_own
     um = 0.5 * (cu[..., 1:] + cu[..., :-1])
     thm = -2 * np.pi * np.nan_to_num(um)
     pc = C[:, :, None, :] + R[:, :, None, None] * np.stack([np.cos(thm), np.sin(thm)], -1)
-    con = cvalid & inside_all(pc, np.array([1, 2, 3]))
+    con = cvalid & inside_all(pc, np.arange(1, K + 1))
 
     # --- Green's theorem -----------------------------------------------------------------
     t0 = np.nan_to_num(lt[..., :-1])

@@ -139,9 +139,12 @@ def mesh_geometry(geom, h, *, lfs_factor=1.0, h_min=1e-4, curv_angle=0.6, grade=
         ctag.append(sub)
         (noslip if bc == NOSLIP else sym).extend(sub)
     surfs = []
-    for loop in geom.loops:
-        cl = g.addCurveLoop([t for c in loop for t in ctag[c]])
-        surfs.append(g.addPlaneSurface([cl]))
+    outer, holes = _loops_and_holes(geom)
+    for k, loop in enumerate(geom.loops):
+        if k in outer:
+            loops = [loop] + [geom.loops[j] for j in holes.get(k, [])]
+            cls = [g.addCurveLoop([t for c in lp for t in ctag[c]]) for lp in loops]
+            surfs.append(g.addPlaneSurface(cls))
     g.synchronize()
     gmsh.model.addPhysicalGroup(1, noslip, NOSLIP)
     if sym:
@@ -162,3 +165,44 @@ def mesh_geometry(geom, h, *, lfs_factor=1.0, h_min=1e-4, curv_angle=0.6, grade=
     noslip_el = lookup[np.concatenate(bnd).astype(np.int64)].reshape(-1, 3).T
     p = xyz.reshape(-1, 3)[:, :2].T.copy()
     return TriMesh(p, np.ascontiguousarray(t), noslip_el)
+
+
+def _loops_and_holes(geom):
+    """Which loops bound a piece of the region from outside (fluid on the left: counter-
+    clockwise, positive area) and which are holes (a disk inside the region: clockwise), and
+    the outer loop holding each hole: (set of outer loop indices, {outer: [holes]}). The
+    three-disk sections have no holes (every disk is centred on the boundary); a region whose
+    loops all run one way (a duct's wall, :func:`throats._mesh.disk_geometry`) has none."""
+    pts = geom.points
+    polys = []
+    for loop in geom.loops:
+        ring = []
+        for c in loop:
+            kind, i0, i1, cen, rad, _ = geom.curves[c]
+            ring.append(pts[i0])
+            if kind == "arc":           # the arc's midpoint (clockwise from i0 to i1)
+                a, b = pts[i0] - cen, pts[i1] - cen
+                th0 = np.arctan2(a[1], a[0])
+                span = np.mod(th0 - np.arctan2(b[1], b[0]), 2 * np.pi)
+                th = th0 - 0.5 * span
+                ring.append(cen + rad * np.array([np.cos(th), np.sin(th)]))
+        polys.append(np.array(ring))
+    signed = [0.5 * float(np.sum(p[:, 0] * np.roll(p[:, 1], -1) - np.roll(p[:, 0], -1) * p[:, 1]))
+              for p in polys]
+    outer = {k for k, a in enumerate(signed) if a > 0}
+    if not outer:                       # one orientation only (a duct's own wall): no holes
+        return set(range(len(signed))), {}
+    holes: dict = {}
+    for j, a in enumerate(signed):
+        if a > 0:
+            continue
+        x, y = polys[j][0]
+        for k in outer:                 # even-odd test of a point of the hole
+            p, q = polys[k], np.roll(polys[k], -1, axis=0)
+            cross = (p[:, 1] > y) != (q[:, 1] > y)
+            with np.errstate(divide="ignore", invalid="ignore"):
+                xc = p[:, 0] + (y - p[:, 1]) * (q[:, 0] - p[:, 0]) / (q[:, 1] - p[:, 1])
+            if np.sum(cross & (xc > x)) % 2 == 1:
+                holes.setdefault(k, []).append(j)
+                break
+    return outer, holes

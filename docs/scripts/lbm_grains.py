@@ -209,7 +209,7 @@ def curve(mask_npz, *, backend="numba", reynolds=(0.1, 5, 10, 20), u_max=0.02, t
     return res
 
 
-def network_rows(ref, policy="table-only", beds=None):
+def network_rows(ref, policy="table-only", beds=None, grain_mates="off"):
     """The network's Stokes k (``permeability_m2``, as ``network.solve`` reports it: the whole
     sample in the grain beds' narrow samples, the inset window in wider ones; the whole sample's
     beside it) and k_app/k at the Reynolds numbers each LBM run obtained, per bed of ``ref``
@@ -226,7 +226,8 @@ def network_rows(ref, policy="table-only", beds=None):
             continue
         path = (beds or {}).get(bed, run["bed"])
         pk, box = read_packing(path), read_container(path)
-        sample, cond = SampleOptions(container=box), ConductanceOptions(policy=policy)
+        sample = SampleOptions(container=box)
+        cond = ConductanceOptions(policy=policy, model_options={"grain_mates": grain_mates})
         tess = tessellate(pk)
         res = solve_network(pk, axis="z", sample=sample, conductance=cond, tessellation=tess)
         # each conduit's share of the dissipated power, q^2/g (Stokes), by window class: a
@@ -280,6 +281,9 @@ def main(argv=None):
     n.add_argument("--json", default=None)
     n.add_argument("--bed", action="append", default=[], metavar="NAME=FILE",
                    help="a bed of the reference that is not bundled (corn=shelled_corn.csv)")
+    n.add_argument("--grain-mates", choices=("off", "window", "all"), default="off",
+                   help="where the conduit model takes grain mates out of the sections "
+                        "(network.conductance.conduit_conductance's grain_mates)")
     a = ap.parse_args(argv)
     if a.cmd == "voxelise":
         c, rad, lo, hi, d32, _ = sample_box(a.bed)
@@ -317,7 +321,8 @@ def main(argv=None):
                 json.dump(out, fh, indent=1)
         return 0
     ref = json.load(open(a.ref))
-    rows = network_rows(ref, beds=dict(b.split("=", 1) for b in a.bed))
+    rows = network_rows(ref, beds=dict(b.split("=", 1) for b in a.bed),
+                        grain_mates=a.grain_mates)
     print(json.dumps(rows, indent=1, default=float))
     if a.json:
         with open(a.json, "w") as fh:

@@ -21,6 +21,13 @@ grain* (two vertices of one grain, not deep), *ordinary* (three grains).
     python docs/scripts/lbm_windows.py run network/data/wheat_grains.csv --resolution 16 --out .lbm/wheat_w16.npz
     python docs/scripts/lbm_windows.py compare .lbm/wheat_w16.npz --json wheat_windows.json
 
+``mates`` needs no lattice either: the conduits' g with the grain mates taken out of the
+windows and out of every section (``network.conductance.conduit_conductance``'s
+``grain_mates``) over their g with the mates left in, by the window's intrusion, and with a
+``compare`` JSON the resolved comparison's ratios times those:
+
+    python docs/scripts/lbm_windows.py mates network/data/wheat_grains.csv --ref docs/data/lbm_windows_wheat.json
+
 ``intrusion`` needs no lattice: the share of each window's three-disk open area that lies inside
 other spheres, the Stokes flow of those sections with every sphere cutting the face plane
 against the three-disk section, and the network's k with that ratio on each conduit:
@@ -358,6 +365,40 @@ def _conduit_heights(tess, throats):
 CLASSES = ("ordinary", "same", "deep", "ordinary, neck body")
 
 
+def mates_bins(bed, ref=None, log=print):
+    """The conduits' g with the grain mates taken out of the windows ('window') and out of
+    every section ('all') over their g with the mates left in ('off'), dissipation-weighted
+    geometric means by the window's intrusion (:func:`window_intrusion`, the bins of
+    :func:`compare`); with ``ref`` (a ``compare`` JSON of the same bed) also the resolved
+    comparison's g_net / g_LBM per bin times those ratios."""
+    from network.conductance import conduit_conductance
+
+    pk, tess, res = _network(bed)
+    th = np.asarray(res.throat_ids)
+    g = np.asarray(res.throat_conductance)
+    q = np.asarray(res.throat_flow_m3_s)
+    power = np.where(g > 0, q**2 / np.where(g > 0, g, 1.0), 0.0)
+    intr = window_intrusion(tess, th)
+    gs = {m: np.asarray(conduit_conductance(tess, th, policy="table-only", grain_mates=m).g)
+          for m in ("off", "window", "all")}
+    bins = json.loads(Path(ref).read_text())["intrusion_bins"] if ref else None
+    out = []
+    for b, (lo_, hi_) in enumerate(((0.0, 0.02), (0.02, 0.1), (0.1, 0.25), (0.25, 1.01))):
+        m = (intr >= lo_) & (intr < hi_) & (gs["off"] > 0)
+        row = {"intrusion": [lo_, min(hi_, 1.0)], "n": int(m.sum()),
+               "power_share": float(power[m].sum() / power.sum())}
+        for k in ("window", "all"):
+            r = np.clip(gs[k][m] / gs["off"][m], 1e-3, 10)
+            row[f"g_{k}_over_off"] = float(np.exp(np.sum(power[m] * np.log(r)) / power[m].sum()))
+        if bins:
+            row["g_off_over_lbm"] = bins[b]["g_ratio_power_weighted_log_mean"]
+            for k in ("window", "all"):
+                row[f"g_{k}_over_lbm"] = row[f"g_{k}_over_off"] * row["g_off_over_lbm"]
+        out.append(row)
+        log(json.dumps(row))
+    return out
+
+
 def compare(field_npz, log=print):
     """Per-conduit resolved flux and conductance against the network's (module docstring)."""
     z = np.load(field_npz)
@@ -522,10 +563,16 @@ def main(argv=None):
     c = sub.add_parser("compare", help="per-conduit comparison with the network")
     c.add_argument("field")
     c.add_argument("--json", default=None)
+    g = sub.add_parser("mates", help="the conduits' g with grain mates out, by intrusion")
+    g.add_argument("bed")
+    g.add_argument("--ref", default=None, help="a compare JSON of the same bed")
     i = sub.add_parser("intrusion", help="window area inside spheres off the face")
     i.add_argument("beds", nargs="+")
     i.add_argument("--json", default=None)
     a = ap.parse_args(argv)
+    if a.cmd == "mates":
+        mates_bins(a.bed, a.ref)
+        return 0
     if a.cmd == "intrusion":
         rows = [intrusion_report(b) for b in a.beds]
         if a.json:

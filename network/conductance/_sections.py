@@ -92,7 +92,7 @@ def colmax(a):
 
 
 def side_resistance(radii, sides, h_side, y_window, *, n_sections: int = 8,
-                    section_q=None):
+                    section_q=None, section_factor=None):
     r"""Viscosity-free resistance :math:`R_P/\mu` of N conduit halves (unit⁻³).
 
     .. math:: \frac{R_P}{\mu} = \int_0^{H_P} y\,\Bigl[1 + \frac{s}{1+s}\Bigr] dh,\quad
@@ -115,6 +115,10 @@ def side_resistance(radii, sides, h_side, y_window, *, n_sections: int = 8,
         no wall, NaN when the source cannot answer reliably: such a section is continued
         from the last answered one by :func:`section_estimate` ratios). None: the window
         value scaled by :func:`section_estimate` ratios.
+    section_factor : callable or None, keyword-only
+        ``section_factor(h (N, m+1)) -> (N, k, m+1)``: the flow rate of each side's section at
+        the nodes h, relative to the three-disk section's (sections that other spheres cut
+        too, :mod:`._mates`; 0 closes the section). None: 1.
 
     Returns
     -------
@@ -186,6 +190,28 @@ def side_resistance(radii, sides, h_side, y_window, *, n_sections: int = 8,
             with np.errstate(divide="ignore", invalid="ignore"):
                 cont = np.where(np.isinf(ce), 0.0, yb[rows, last] * ce[rows, last] / ce)
             y[bad] = np.where(mb, cont, yb)
+    if section_factor is not None:
+        with np.errstate(divide="ignore"):
+            ys = y[:, None, :] / section_factor(h)             # (N, k, m+1); 0: closed
+        R = np.empty_like(H)
+        for c in range(H.shape[1]):
+            # nodes side c integrates over: up to the first at or above its height
+            jc = np.clip((h < (H[:, c] * (1 - 1e-12))[:, None]).sum(axis=1), 1, m)
+            used = np.arange(m + 1)[None, :] <= jc[:, None]
+            yc = ys[:, c]
+            bad = used & ~np.isfinite(yc)
+            yc = np.where(np.isfinite(yc), yc, np.where(used, yc, y))
+            R[:, c] = _integrate(yc, y0, h, dhdth, th_end, H[:, c:c + 1], m)[:, 0]
+            R[:, c] = np.where(bad.any(axis=1) & (H[:, c] > 0), np.inf, R[:, c])
+        return R[:, 0] if one else R
+    R = _integrate(y, y0, h, dhdth, th_end, H, m)
+    return R[:, 0] if one else R
+
+
+def _integrate(y, y0, h, dhdth, th_end, H, m):
+    """:func:`side_resistance`'s integral of the sections' y at the nodes h (N, m+1) up to
+    each column of H (N, k)."""
+    n = y.shape[0]
     fin = np.isfinite(y)
     closed = ~np.isfinite(y0)
     for c in range(m + 1):                                      # any(~fin, axis=1), by columns
@@ -220,5 +246,4 @@ def side_resistance(radii, sides, h_side, y_window, *, n_sections: int = 8,
         w = np.clip(w, 0.0, 1.0)
         R[:, c] = C[rows, j - 1] + (Hc - h0) * (F0 + 0.5 * w * (F1 - F0))
     R = np.where(H > 0, R, 0.0)
-    R = np.where(closed[:, None], np.inf, R)
-    return R[:, 0] if one else R
+    return np.where(closed[:, None], np.inf, R)
