@@ -275,7 +275,8 @@ def freeze_policy(template, v0):
 
 
 def pour_grains(container, template, *, material, fill=FillOptions(), n_grains, rng=None, tol=2e-3,
-                max_steps=None, check_every=200, progress=None, restitution=None, porosity=0.4, threads=1):
+                max_steps=None, check_every=200, progress=None, restitution=None, porosity=0.4, threads=1,
+                policy=None):
     r"""Pour ``n_grains`` grains of ``template`` into ``container`` (module notes) and settle.
 
     Parameters
@@ -301,6 +302,8 @@ def pour_grains(container, template, *, material, fill=FillOptions(), n_grains, 
         simulation). A pour makes a new simulation at every batch, and on a shared two-core
         machine two threads stepped a settled 25 000-sphere corn bed at a tenth of one thread's
         particle-steps per CPU-second.
+    policy : FreezePolicy | None
+        With ``fill.freeze``: when grains freeze and are released (None: :func:`freeze_policy`).
 
     Returns
     -------
@@ -367,7 +370,7 @@ def pour_grains(container, template, *, material, fill=FillOptions(), n_grains, 
                 sim.V[:] = v_new
                 lo, hi = container.bounds(rb, headroom=0.0)
                 sim.attach_active(lo_m=lo, hi_m=hi, capacity=n_grains * template.n,
-                                  policy=freeze_policy(template, v0) if fill.freeze else None)
+                                  policy=(policy or freeze_policy(template, v0)) if fill.freeze else None)
             else:
                 sim = _grown(sim, template, x_new, v_new, q_new, threads=threads)
             inserted += k
