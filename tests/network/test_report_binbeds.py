@@ -213,3 +213,20 @@ def test_the_report_on_a_bin_s_bundled_beds(tmp_path, monkeypatch, capsys, grain
     r2 = json.loads((tmp_path / "r.json").read_text())
     assert all(b["cached"] for b in r2["bin_beds"]["beds"])
     assert r2["bin_beds"]["points"] == bb["points"]
+
+
+@pytest.mark.slow
+def test_a_bed_set_is_packed_on_first_use_with_a_progress_bar(tmp_path, monkeypatch, capsys):
+    """pack_bed_set runs dem.pack --stress s1 s2 s3 into the cache folder through a temporary
+    folder (a small soybean box here), draws its tqdm bar over the pour and each load on stderr
+    and leaves the complete set, which the next plan reuses."""
+    import network.report.binbeds as bb
+    monkeypatch.setattr(bb, "set_box", lambda grain: (0.025, 0.025, 0.02))
+    plan = {"bed_dir": str(tmp_path / "beds"), "beds": None}
+    rec = bb.pack_bed_set(plan, "soybean")
+    assert [s for s, _ in plan["beds"]] == pytest.approx(list(BED_SET_STRESSES_PA), rel=0.02)
+    assert "--stress 0 20000 45000" in rec["command"] and str(tmp_path / "beds") in rec["command"]
+    assert sorted(p.name for p in (tmp_path / "beds").iterdir() if p.name.startswith(".")) == []
+    err = capsys.readouterr().err
+    assert "packing the soybean bed set" in err and "3/3" in err
+    assert bb._set_in("soybean", tmp_path / "beds") == plan["beds"]      # found next time
