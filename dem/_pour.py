@@ -101,6 +101,8 @@ class FillOptions:
             raise ValueError(f"spout diameter {d:g} m: must be > 0")
         if not (math.isfinite(self.mass_scale) and self.mass_scale >= 1):
             raise ValueError(f"mass scale {self.mass_scale:g}: must be >= 1")
+        if not isinstance(self.freeze, bool):
+            raise ValueError(f"freeze must be True or False, got {self.freeze!r}")
 
 
 def terminal_velocity(diameter_m, density_kg_m3):

@@ -52,6 +52,7 @@ def test_default_rate_raises_the_surface_one_diameter_per_rebound_flight():
     (dict(rate_kg_s=-2.0), "rate -2 kg/s"),
     (dict(spout_diameter_m=-0.01), "spout diameter -0.01 m"),
     (dict(mass_scale=0.5), "mass scale 0.5"),
+    (dict(freeze="no"), "freeze must be True or False"),
 ])
 def test_fill_options_refuse_bad_values(kw, match):
     with pytest.raises(ValueError, match=match):
