@@ -5,6 +5,8 @@ the lever (a DEM packing of hundreds of grains takes minutes); the lever's physi
 measured on real packings in docs/report.md.
 """
 
+from pathlib import Path
+
 import numpy as np
 import pytest
 
@@ -262,3 +264,36 @@ def test_one_range_per_grain_container_and_seed(tmp_path, monkeypatch, capsys):
     assert ps["reachable_text"] == quoted[0] and s["n_grains"] == ps["n_grains"] == 253
     assert abs(s["porosity_network_region"] - 0.40) <= 0.005 and s["converged"]
     assert [t["lever"] for t in ps["tried"]] == pytest.approx(levers) and len(levers) <= 6
+
+
+def test_bundled_box_searches_from_its_record(tmp_path, monkeypatch, capsys):
+    """In the bundled soybean box with seed 1 the bundled JSON's record is the range (its beds:
+    lever -1 0.3490, +1 0.4114, the same 495 grains the grain's own count gives): nothing is
+    packed for the range, the search starts inside it, and the bed's JSON quotes that record."""
+    import json
+    from dem.pack import main
+    monkeypatch.setenv("GRAINFLOW_REACH_CACHE", str(tmp_path / "reach"))
+    calls, counts = [], []
+    law = _fake(lambda lam: 0.3490 + 0.0312 * (lam + 1), calls)
+
+    def pack(container, template, *, n_grains, **kw):
+        counts.append(n_grains)
+        out = law(container, template, **kw)
+        out[4].update(stages={"settle": {"converged": True, "steps": 1}}, n_grains=n_grains,
+                      n_spheres=6 * n_grains, porosity_interior_union=0.4,
+                      porosity_interior_error=0.001, deposition_friction=0.0, steps=1)
+        return out
+    monkeypatch.setattr(cp, "pack_grains", pack)
+    monkeypatch.setattr("dem.pack.write_grain_packing",
+                        lambda path, *a: Path(path).with_suffix(".json").write_text(
+                            json.dumps(a[-1], default=str)))
+    out = tmp_path / "b.csv"
+    assert main(["--scene", "box", "--size", "0.05", "0.05", "--height", "0.05", "--grain",
+                 "soybean", "--porosity", "0.40", "--out", str(out), "--quiet"]) == 0
+    ps = json.loads(out.with_suffix(".json").read_text())["porosity_search"]
+    assert calls and not {-1.0, 0.0, 1.0} & set(calls) and set(counts) == {495}
+    assert ps["reachable"] == pytest.approx([0.349029541015625, 0.411376953125])
+    assert ps["reachable_text"].startswith("0.3490-0.4114 (the beds dem.pack --porosity made in "
+                                           "the 0.05 x 0.05 x 0.05 m box, seed 1, network/data/"
+                                           "soybean_grains.json;")
+    assert not (tmp_path / "reach").exists()
