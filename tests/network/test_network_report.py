@@ -219,8 +219,11 @@ def test_done_when_wheat_from_the_bundled_bed(tmp_path, capsys, monkeypatch):
         assert [band[k] for k in ("-0.02", "-0.01", "+0.01", "+0.02")] == pytest.approx(
             [p["pressure_gradient_pa_per_m"] * np.exp(S * d) for d in (-0.02, -0.01, 0.01, 0.02)],
             rel=1e-9)
+    # the figures, and beds/ with the cached solves of wheat's bin bed set (one per bed)
     assert sorted(x.name for x in (tmp_path / "report_wheat").iterdir()) == [
-        "report_band.png", "report_curve.png", "report_system.png"]
+        "beds", "report_band.png", "report_curve.png", "report_system.png"]
+    assert len(list((tmp_path / "report_wheat" / "beds" / "bin_solves").glob("*.json"))) == len(
+        r["bin_beds"]["beds"]) == 3
 
 
 @pytest.mark.slow
