@@ -101,9 +101,10 @@ def test_steep_lever_is_searched_to_the_target(monkeypatch):
     """Soybean in the 0.04 m box (253 grains, seed 1), its beds' porosity against the lever as
     packed on one x86-64 host: steep between deposition friction 0.15 and 0.22 (0.3918 ->
     0.4104), not monotone (0.4201 at 0.39, 0.4169 at 1). Plain regula falsi from the two ends
-    missed 0.40 after 6 packings; from the range's three beds, by regula falsi with bisection
-    after two beds on one side, every target in the range lands within 0.005 within the default
-    6 packings (the range's not counted)."""
+    spends 6 packings there without landing on 0.40 (-1, 1, 0.39, -0.087, 0.152, 0.221); from
+    the range's three beds, by regula falsi with bisection after two beds on one side, every
+    target in the range lands within 0.005 within the default 6 packings (the range's not
+    counted)."""
     pts = [(-1, 0.3616), (-0.087, 0.3799), (0, 0.3727), (0.152, 0.3918), (0.221, 0.4104),
            (0.39, 0.4201), (1, 0.4169)]
     calls = []
