@@ -3,6 +3,7 @@
 Examples
 --------
     python -m network.report --grain wheat --depth 3 --diameter 6   # bundled wheat bed
+    python -m network.report --grain corn --depth 5 --diameter 8    # the bin's beds (corn's set)
     python -m network.report --grain soybean --depth 3 --diameter 6 --fan fan.csv --html r.html
     python -m network.report --grain wheat --porosity 0.41 --packing bed.csv --json r.json
     python -m network.report --grain wheat --seed 2        # packs a new bed (dem.pack, minutes)
@@ -11,6 +12,8 @@ The inertial resistance curve (vertical z and horizontal x) of a packing, with A
 Ergun beside it and the fits of :func:`network.flow.fit_curve`; the porosity band (d ln(ΔP/L)/dε
 computed by packing and solving neighbouring porosities, :mod:`network.report.band`); the
 system curve of a bin and, with ``--fan``, its operating point (:mod:`network.report.system`).
+Given a bin (``--diameter`` with ``--depth``), a grain's rain-filled bed set is solved and
+integrated over the depth in Janssen's stress (:mod:`network.report.binbeds`).
 The porosity reported is the grain's measured loose-fill porosity, ``--porosity``, or the
 packing's own, moved along the band's slope (:mod:`network.report.porosity`); ``--seed`` or a
 porosity away from the bundled bed's packs a new bed with ``dem.pack``
