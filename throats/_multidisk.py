@@ -23,7 +23,8 @@ from ._boundary import region_boundary
 from ._geometry import triangle_area, triangle_vertices
 from ._mesh import DELTA_DEFAULT, _extract
 
-__all__ = ["section_area_perimeter", "section_fem", "section_geometry", "section_ratio"]
+__all__ = ["NARROW_FRACTION", "section_area_perimeter", "section_fem", "section_geometry",
+           "section_ratio", "shape_factor_ratio"]
 
 
 def _prepare(sides, centers, radii):
@@ -132,6 +133,31 @@ def _barycentric(n):
 NARROW_FRACTION = 0.1
 
 
+def shape_factor_ratio(sides, vertex_radii, centers, radii):
+    r"""Ratio of the shape-factor form :math:`Q \propto A^3/P_w^2` (exact open area and wetted
+    perimeter, :func:`section_area_perimeter`) of N sections with extra disks (``centers``
+    (N, E, 2), ``radii`` (N, E), the disks first in each row, radius 0 after them) to their
+    three-disk sections: :func:`section_ratio`'s answer for narrow sections. Rows are
+    grouped by their number of disks, so a row's value does not depend on the others."""
+    s = np.atleast_2d(np.asarray(sides, dtype=float))
+    rv = np.asarray(vertex_radii, dtype=float)
+    cs = np.asarray(centers, dtype=float)
+    rs = np.asarray(radii, dtype=float)
+    V = triangle_vertices(s)
+    count = np.count_nonzero(rs > 0, axis=1)
+    out = np.ones(s.shape[0])
+    for e in np.unique(count):
+        k = np.flatnonzero(count == e)
+        e = max(int(e), 1)
+        a_all, p_all = section_area_perimeter(s[k], np.concatenate([V[k], cs[k, :e]], axis=1),
+                                              np.concatenate([rv[k], rs[k, :e]], axis=1))
+        a_3, p_3 = section_area_perimeter(s[k], V[k], rv[k])
+        with np.errstate(invalid="ignore", divide="ignore"):
+            sf = (a_all**3 / p_all**2) / (a_3**3 / p_3**2)
+        out[k] = np.where((a_3 > 0) & (p_3 > 0), np.where(p_all > 0, sf, 1.0), 1.0)
+    return out
+
+
 def section_ratio(sides, vertex_radii, centers, radii, *, n=16, chunk=4000):
     r"""Flow rate of N sections with extra disks relative to their three-disk sections.
 
@@ -210,14 +236,6 @@ def section_ratio(sides, vertex_radii, centers, radii, *, n=16, chunk=4000):
         # the three-disk open fraction: the share of the sub-triangles' centroids outside
         frac[rows] = np.count_nonzero(d3 > 0, axis=1) / b1.size
     narrow = np.flatnonzero(~(frac >= NARROW_FRACTION) | np.isnan(out))
-    for e in np.unique(count[narrow]):
-        # grouped by their number of disks: a row's value does not depend on the others
-        k = narrow[count[narrow] == e]
-        e = max(int(e), 1)
-        a_all, p_all = section_area_perimeter(s[k], np.concatenate([V[k], cs[k, :e]], axis=1),
-                                              np.concatenate([rv[k], rs[k, :e]], axis=1))
-        a_3, p_3 = section_area_perimeter(s[k], V[k], rv[k])
-        with np.errstate(invalid="ignore", divide="ignore"):
-            sf = (a_all**3 / p_all**2) / (a_3**3 / p_3**2)
-        out[k] = np.where((a_3 > 0) & (p_3 > 0), np.where(p_all > 0, sf, 1.0), 1.0)
+    if narrow.size:
+        out[narrow] = shape_factor_ratio(s[narrow], rv[narrow], cs[narrow], rs[narrow])
     return np.clip(np.nan_to_num(out, nan=1.0), 0.0, 1.0)

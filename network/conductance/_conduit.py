@@ -38,7 +38,7 @@ from ..pores import PoreMerge, column_norm, cross_components, merge_pores
 from ._qstar import SOURCES, qstar_from_function, throat_qstar as policy_qstar
 from ._result import ConductanceResult
 from ._conduit_kernel import compiled_conduit_rows
-from ._mates import MateDisks, grain_mates as grain_mates_of, section_factors, window_factors
+from ._mates import grain_mates as grain_mates_of, section_factors, window_factors_compiled
 from ._sections import colmax, side_resistance
 from ._table import grid_alone
 
@@ -195,16 +195,16 @@ def conduit_conductance(tessellation, throats_idx=None, *, viscosity_pa_s: float
         if not use_mates or blk.size == 0:
             return None, np.zeros(0, dtype=np.int64)
         t0 = time.perf_counter()
-        reach = np.minimum(h[blk], rmax[blk, None]) if grain_mates == "all" else 0 * h[blk]
-        mates = grain_mates_of(t.packing, t.throat_vertices[idx[blk]], reach, sign[blk])
-        has = mates.rows
-        if grain_mates == "window":
-            wf = window_factors(mates, radii[blk[has]], sides[blk[has]], n=mate_points)
-            cut = wf < 1.0
-            has, wf = has[cut], wf[cut]
+        if grain_mates == "window":     # the compiled loop over the block's windows
+            wf = window_factors_compiled(t.packing, t.throat_vertices[idx[blk]],
+                                         n=mate_points)
+            has = np.flatnonzero(wf < 1.0)
             mate_counts.append(int(has.size))
             mate_seconds.append(time.perf_counter() - t0)
-            return ((wf, has) if has.size else None), has
+            return ((wf[has], has) if has.size else None), has
+        mates = grain_mates_of(t.packing, t.throat_vertices[idx[blk]],
+                               np.minimum(h[blk], rmax[blk, None]), sign[blk])
+        has = mates.rows
         mate_counts.append(int(has.size))
         mate_seconds.append(time.perf_counter() - t0)
         if has.size == 0:

@@ -21,7 +21,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-__all__ = ["MateDisks", "grain_mates", "mate_radii", "section_factors", "window_factors"]
+__all__ = ["MateDisks", "candidates", "grain_mates", "mate_radii", "section_factors",
+           "window_factors", "window_factors_compiled"]
 
 
 @dataclass(frozen=True)
@@ -55,6 +56,20 @@ def _grain_table(grain_id):
     return table, row
 
 
+def candidates(grain_id, vertices):
+    """(N, C) sphere indices of the other spheres of each face's grains (-1 pads; a grain
+    shared by two vertices listed once; the face's own spheres left out)."""
+    table, grow = _grain_table(grain_id)
+    tv = np.asarray(vertices, dtype=np.int64)
+    g = grow[tv]                                                   # (N, 3)
+    cand = table[g]                                                # (N, 3, S)
+    cand[:, 1][g[:, 1] == g[:, 0]] = -1
+    cand[:, 2][(g[:, 2] == g[:, 0]) | (g[:, 2] == g[:, 1])] = -1
+    cand = cand.reshape(tv.shape[0], -1)
+    own = (cand == tv[:, :1]) | (cand == tv[:, 1:2]) | (cand == tv[:, 2:3])
+    return np.where(own, -1, cand)
+
+
 def grain_mates(packing, vertices, heights, signs):
     r"""The grain mates of N conduits that cut any of their sections inside the triangle.
 
@@ -81,15 +96,9 @@ def grain_mates(packing, vertices, heights, signs):
                       np.zeros((0, 0)))
     if packing.grain_id is None or n == 0:
         return empty
-    table, grow = _grain_table(packing.grain_id)
     tv = np.asarray(vertices, dtype=np.int64)
-    g = grow[tv]                                                   # (N, 3)
-    cand = table[g]                                                # (N, 3, S)
-    # a grain shared by two vertices is listed once
-    cand[:, 1][g[:, 1] == g[:, 0]] = -1
-    cand[:, 2][(g[:, 2] == g[:, 0]) | (g[:, 2] == g[:, 1])] = -1
-    cand = cand.reshape(n, -1)
-    ok = (cand >= 0) & (cand != tv[:, :1]) & (cand != tv[:, 1:2]) & (cand != tv[:, 2:3])
+    cand = candidates(packing.grain_id, tv)
+    ok = cand >= 0
     cen = packing.centers
     x0, x1, x2 = cen[tv[:, 0]], cen[tv[:, 1]], cen[tv[:, 2]]
     e1 = x1 - x0
@@ -207,6 +216,42 @@ def window_factors(mates, radii, sides, *, n=16):
     V = triangle_vertices(sides)
     rho = mate_radii(mates, np.zeros(mates.rows.size))                      # (M, E)
     return _ratio(mates, rho, _live(mates, rho, V, radii), sides, radii, n)
+
+
+def window_factors_compiled(packing, vertices, *, n=16, n_angles=16, max_live=32):
+    r""":func:`window_factors` of N faces (``vertices`` (N, 3)) from the packing directly, by
+    the compiled loop of :mod:`._mates_kernel` (the mates, the circle test and the
+    distance-squared rule per window), the narrow windows by
+    :func:`throats.shape_factor_ratio`: (N,) factors, 1 where no mate takes area."""
+    from throats._multidisk import NARROW_FRACTION, _barycentric, shape_factor_ratio
+
+    from ._mates_kernel import compiled_window_rows
+
+    tv = np.ascontiguousarray(vertices, dtype=np.int64)
+    n_w = tv.shape[0]
+    cand = np.ascontiguousarray(candidates(packing.grain_id, tv))
+    b1, b2 = _barycentric(int(n))
+    factor = np.ones(n_w)
+    flagged = np.zeros(n_w, dtype=bool)
+    live_c = np.zeros((n_w, max_live, 2))
+    live_r = np.zeros((n_w, max_live))
+    n_live = np.zeros(n_w, dtype=np.int64)
+    th = np.linspace(0.0, 2.0 * np.pi, int(n_angles), endpoint=False)   # as :func:`_live`
+    compiled_window_rows()(np.ascontiguousarray(packing.centers, dtype=float),
+                           np.ascontiguousarray(packing.radii, dtype=float), tv, cand, b1, b2,
+                           np.cos(th), np.sin(th), float(NARROW_FRACTION), factor, flagged,
+                           live_c, live_r, n_live)
+    k = np.flatnonzero(flagged)
+    if k.size:
+        e = max(int(n_live[k].max()), 1)
+        r3 = packing.radii[tv[k]]
+        c = packing.centers[tv[k]]
+        sides = np.stack([np.linalg.norm(c[:, 1] - c[:, 0], axis=1),
+                          np.linalg.norm(c[:, 2] - c[:, 0], axis=1),
+                          np.linalg.norm(c[:, 2] - c[:, 1], axis=1)], axis=1)
+        factor[k] = np.clip(shape_factor_ratio(sides, r3, live_c[k, :e], live_r[k, :e]),
+                            0.0, 1.0)
+    return factor
 
 
 def section_factors(mates, rows, h_nodes, signs, radii, sides, *, n=16):

@@ -7,7 +7,10 @@ import pytest
 
 from network import Packing, tessellate
 from network.conductance import conduit_conductance
-from network.conductance._mates import grain_mates, mate_radii
+from network.conductance._mates import (grain_mates, mate_radii, window_factors,
+                                        window_factors_compiled)
+from network.pores import merge_pores
+from network.conductance._conduit import conduit_heights
 from network.packing import read_packing
 
 
@@ -69,6 +72,20 @@ def test_grain_mates_lower_only_the_conduits_they_cut():
     assert 0.1 < cut.sum() / ok.sum() < 0.9
     # the uncut conduits keep their values to the last bit
     assert np.array_equal(win[ok & ~cut], off[ok & ~cut])
+
+
+def test_compiled_window_loop_equals_the_numpy_path():
+    # the window factors by the compiled loop (what conduit_conductance uses) against the
+    # numpy path (grain_mates at the face plane, the circle test, throats.section_ratio)
+    t = tessellate(_sub_bed())
+    idx = np.flatnonzero(~merge_pores(t).internal_throat)
+    h, sign = conduit_heights(t, idx, merge_pores(t))
+    m = grain_mates(t.packing, t.throat_vertices[idx], 0 * h, sign)
+    f_np = np.ones(idx.size)
+    f_np[m.rows] = window_factors(m, t.throat_radii[idx][m.rows], t.throat_sides[idx][m.rows])
+    f_c = window_factors_compiled(t.packing, t.throat_vertices[idx])
+    assert np.sum(f_np < 1) > 100
+    np.testing.assert_allclose(f_c, f_np, rtol=1e-11, atol=1e-13)
 
 
 def test_unknown_mode_is_refused():
