@@ -72,8 +72,8 @@ def build_parser() -> CliParser:
                     help="conduit model on multi-sphere grains: take the other spheres of a "
                          "window's grains out of its section, at the window or at every "
                          "section (docs/validation-grains.md: the bundled wheat bed's Stokes "
-                         "k against resolved flow +7.4 %% off, -1.0 %% window, -13.9 %% all; "
-                         "window costs time); sphere packings are unchanged")
+                         "k against resolved flow +7.4 %% off, -1.0 %% window, -13.9 %% all); "
+                         "sphere packings are unchanged")
     add_table(ap)
     ap.add_argument("--workers", type=int, default=1, help="processes for FE solves, >= 1")
     ap.add_argument("--threads", type=int, default=available_cores(),

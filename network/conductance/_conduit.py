@@ -111,8 +111,8 @@ def conduit_conductance(tessellation, throats_idx=None, *, viscosity_pa_s: float
         between the two pore bodies crosses; 'all' at the window and every section; 'off'
         (default) nowhere. Sphere packings have no grain mates and are unchanged.
         ``docs/validation-grains.md`` compares the three with resolved flow (Stokes k of the
-        bundled wheat bed: +7.4 % 'off', -1.0 % 'window', -13.9 % 'all') and gives what
-        'window' costs in time.
+        bundled wheat bed: +7.4 % 'off', -1.0 % 'window', -13.9 % 'all'). 'window' runs the
+        compiled loop of :mod:`._mates_kernel`, 'all' numpy at every section.
     mate_points : int, keyword-only
         Sub-triangles per side of :func:`throats.section_ratio` (default 16).
 
