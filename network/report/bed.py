@@ -321,6 +321,9 @@ def bed_label(bed: dict, meta: dict) -> str:
         return (how + f": dem.pack --porosity {bed['porosity']:g} reached "
                 + ("?" if e is None else f"{e:.4f}") + f" in network's sample region (tolerance "
                 f"{PACK_TOL}); the report is for this bed's own porosity")
+    if bed["action"] == "binset":
+        return (f"the surface bed of the bin's bed set (rain-filled, packed on first use in "
+                f"{bed['bed_dir']})")
     label = ("bundled bed" if bed["action"] == "bundled" else "the user's packing (--packing)")
     if bed["action"] == "bundled" and bed.get("move_along_band"):
         label += ", moved along the band (--move-along-band)"
@@ -336,7 +339,8 @@ def user_bed_json(path) -> dict:
 
 def bed_json(b: dict, path) -> dict:
     """The ``bed`` entry of the report's JSON: how the bed came, its path, seed, dem.pack's run."""
-    how = {"pack": "packed anew", "bundled": "bundled", "user": "user's packing"}[b["action"]]
+    how = {"pack": "packed anew", "bundled": "bundled", "user": "user's packing",
+           "binset": "the bin set's surface bed"}[b["action"]]
     return {"how": how, "path": str(path), "seed": b.get("seed"),
             "porosity_requested": b.get("porosity"), "box_m": b.get("box"),
             "bed_dir": b.get("bed_dir"), "reused": b.get("reused"),

@@ -207,15 +207,15 @@ def plan_bin_beds(grain: str, *, depth_m: float, diameter_m, depth_given: bool,
     """
     if diameter_m is None or not depth_given:
         return None
-    if other is not None:
-        return {"used": False, "why": f"{other} asks for one bed: the report is for that bed "
-                                      "alone, not the bin's beds"}
     jk = janssen_inputs(grain)
     if jk is None:
         return {"used": False, "why": (
             f"{grain} has no lateral pressure ratio K and wall friction mu_w in the grain library "
             "(Janssen's stress needs both; docs/grain-library.md): the report is for its single "
-            "bed at its loose-fill porosity, not the bin's beds")}
+            "bed, not the bin's beds")}
+    if other is not None:
+        return {"used": False, "why": f"{other} asks for one bed: the report is for that bed "
+                                      "alone, not the bin's beds"}
     from .bed import TEMPLATE_GRAINS
     beds = bed_set_files(grain, data_dir)
     plan = {"used": True, "grain": grain, "k_lat": jk[0], "mu_w": jk[1], "bed_dir": str(bed_dir),
@@ -433,7 +433,7 @@ def pack_bed_set(plan: dict, grain: str, *, quiet: bool = False) -> dict:
                                 stdin=subprocess.DEVNULL, text=True, env=env)
         with tqdm(total=len(stages), desc=f"packing the {grain} bed set", unit="stage",
                   disable=quiet, file=sys.stderr) as bar:
-            k, last, prev_step = 0, None, 0
+            k, last, prev_step, shown = 0, None, 0, 0.0
             for line in proc.stdout:
                 lines.append(line)
                 m = re.match(r"\[(\w+)\s*\] step\s+(\d+)\s+t =\s+([0-9.]+) s", line)
@@ -444,7 +444,10 @@ def pack_bed_set(plan: dict, grain: str, *, quiet: bool = False) -> dict:
                     bar.update(1)
                     k += 1
                 last, prev_step = m[1], int(m[2])
-                bar.set_postfix_str(f"{stages[min(k, len(stages) - 1)]}: step {m[2]}, t {m[3]} s")
+                if time.perf_counter() - shown > 1.0:        # at most once a second
+                    shown = time.perf_counter()
+                    bar.set_postfix_str(f"{stages[min(k, len(stages) - 1)]}: step {m[2]}, "
+                                        f"t {m[3]} s")
             code = proc.wait()
             if code == 0:
                 bar.update(len(stages) - bar.n)
@@ -462,6 +465,8 @@ def pack_bed_set(plan: dict, grain: str, *, quiet: bool = False) -> dict:
         if proc is not None and proc.poll() is None:
             proc.kill()
             proc.wait()
+        if proc is not None and proc.stdout is not None:
+            proc.stdout.close()
         shutil.rmtree(tmp, ignore_errors=True)
     plan["beds"] = _set_in(grain, d)
     if not plan["beds"]:

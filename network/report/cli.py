@@ -132,20 +132,7 @@ def _check(args) -> dict:
         if getattr(args, opt) is not None and getattr(args, opt) < 0:
             raise ValueError(f"--{opt.replace('_', '-')} must be >= 0, got {getattr(args, opt)}")
     target, why = requested_porosity(key, args.porosity)
-    if args.packing is None and bundled_packing(key) is None and args.seed is None \
-            and args.porosity is None:
-        raise ValueError(f"no bundled packing for {key} (bundled: "
-                         f"{', '.join(bundled_grains())}): give --porosity P or --seed N to pack "
-                         f"one (dem.pack, minutes), or pack it with python -m dem.pack --scene "
-                         f"box --grain {key} --porosity P --out bed.csv, then add --packing "
-                         "bed.csv")
     bed_dir = args.bed_dir or Path(args.plot_dir or f"report_{key}") / "beds"
-    bed = plan_bed(key, porosity=args.porosity, seed=args.seed, packing=args.packing,
-                   move_along_band=args.move_along_band, bed_box=args.bed_box, bed_dir=bed_dir)
-    if bed["action"] == "bundled" and args.porosity is None and packing_meta(
-            bed["packing"]).get("fill", {}).get("method") in ("rain", "spout"):
-        target, why = None, ("the poured bed's own (a rain-filled bed makes its own porosity; "
-                             f"the bundled bed of {key} is the surface bed of its bin bed set)")
     other = next((opt for opt, v in (("--packing", args.packing), ("--porosity", args.porosity),
                                      ("--seed", args.seed),
                                      ("--move-along-band", args.move_along_band or None),
@@ -156,9 +143,36 @@ def _check(args) -> dict:
                          other=other)
     if bins is not None:
         bins["grain"] = key
+    # a grain without a bundled bed whose bin set is packed on first use: its single bed is
+    # the set's surface bed
+    from_set = (bins is not None and bins["used"] and bins["source"] == "packed"
+                and args.packing is None and bundled_packing(key) is None)
+    if args.packing is None and bundled_packing(key) is None and args.seed is None \
+            and args.porosity is None and not from_set:
+        raise ValueError(f"no bundled packing for {key} (bundled: "
+                         f"{', '.join(bundled_grains())}): give --porosity P or --seed N to pack "
+                         f"one (dem.pack, minutes), give a bin (--depth H --diameter B) to pack "
+                         f"its bed set, or pack it with python -m dem.pack --scene "
+                         f"box --grain {key} --porosity P --out bed.csv, then add --packing "
+                         "bed.csv")
+    if from_set:
+        bed = {"grain": key, "action": "binset", "packing": None if bins["beds"] is None else
+               str(bins["beds"][0][1]), "not_packed": None, "seed": None,
+               "move_along_band": False, "bed_dir": str(bed_dir)}
+    else:
+        bed = plan_bed(key, porosity=args.porosity, seed=args.seed, packing=args.packing,
+                       move_along_band=args.move_along_band, bed_box=args.bed_box,
+                       bed_dir=bed_dir)
+    if bed["action"] in ("bundled", "binset") and args.porosity is None and (
+            from_set or packing_meta(bed["packing"]).get("fill", {}).get("method")
+            in ("rain", "spout")):
+        target, why = None, ("the poured bed's own (a rain-filled bed makes its own porosity; "
+                             f"the single bed of {key} is the surface bed of its bin bed set)")
     reach = None
     if bed["action"] == "pack":
         target, why = None, "requested: " + bed["porosity_why"]  # the new bed's own
+    elif bed["packing"] is None:        # the bin set's surface bed, packed in _main
+        pass
     else:
         args.packing = bed["packing"]
         meta = packing_meta(args.packing)
@@ -354,7 +368,6 @@ def _main(args) -> int:
     with bad_input():
         opts = _check(args)
     bed = opts["bed"]
-    args.packing = prepare_bed(bed, quiet=args.quiet)
     bins = opts["bin_beds"]
     if bins is not None and bins["used"] and bins.get("beds") is None:
         if not args.quiet:
@@ -365,6 +378,9 @@ def _main(args) -> int:
             bins["pack"] = pack_bed_set(bins, opts["grain"], quiet=args.quiet)
         with bad_input():
             check_bin_depth(bins)
+        if bed["action"] == "binset":
+            bed["packing"] = str(bins["beds"][0][1])
+    args.packing = prepare_bed(bed, quiet=args.quiet)
     if bed["action"] == "pack":
         opts["reachable"] = reach_record(packing_meta(args.packing),
                                          Path(args.packing).with_suffix(".json"))

@@ -118,8 +118,10 @@ def test_a_depth_beyond_the_set_is_refused_with_the_deepest_it_covers(tmp_path):
 def test_grains_without_janssen_inputs_or_a_bin_get_one_line(tmp_path):
     kw = dict(depth_m=3.0, diameter_m=6.0, depth_given=True, particle_density=1400.0,
               bed_dir=tmp_path)
-    p = plan_bin_beds("rough_rice", **kw)
-    assert p["used"] is False and "no lateral pressure ratio K" in p["why"]
+    for grain in ("rough_rice", "sorghum"):
+        p = plan_bin_beds(grain, **kw)
+        assert p["used"] is False and "no lateral pressure ratio K" in p["why"]
+        assert plan_bin_beds(grain, other="--packing", **kw)["why"] == p["why"]
     p = plan_bin_beds("wheat", other="--packing", **kw)
     assert p["used"] is False and p["why"].startswith("--packing asks for one bed")
     assert plan_bin_beds("wheat", **{**kw, "diameter_m": None}) is None
@@ -207,6 +209,11 @@ def test_the_report_on_a_bin_s_bundled_beds(tmp_path, monkeypatch, capsys, grain
         g = p["vertical_gradient_pa_per_m"]
         assert min(g.values()) <= p["vertical_mean_gradient_pa_per_m"] <= max(g.values())
     assert not any(b["cached"] for b in bb["beds"])
+    # at the surface (stress 0, the poured bed's own) the interpolation is that bed's solve
+    for j, p in enumerate(bb["points"]):
+        assert p["vertical_gradient_pa_per_m"]["surface"] == bb["beds"][0]["gradient_z_pa_per_m"][j]
+        assert p["horizontal_gradient_pa_per_m"]["surface"] == bb["beds"][0]["gradient_x_pa_per_m"][j]
+    assert bb["porosity"]["surface"] == bb["beds"][0]["porosity"]
     out = capsys.readouterr().out
     assert "bin's beds (bundled" in out and "layers in series" in out
     assert main(args) == 0
