@@ -22,8 +22,8 @@ from ..curve import DEFAULT_VELOCITIES, parse_velocities
 from ..flow import DEFAULT_DEPTH_M
 from ..packing import UNITS, read_container
 from .band import BAND_OFFSETS
-from .bed import add_bed_options, bed_json, plan_bed, prepare_bed
-from .binbeds import check_bin_depth, pack_bed_set, plan_bin_beds
+from .bed import TEMPLATE_GRAINS, add_bed_options, bed_json, plan_bed, prepare_bed
+from .binbeds import check_bin_depth, janssen_inputs, pack_bed_set, plan_bin_beds
 from .build import build_report
 from .figures import FIGURES, write_figures, write_html
 from .options import ReportOptions, grain_key
@@ -151,8 +151,10 @@ def _check(args) -> dict:
             and args.porosity is None and not from_set:
         raise ValueError(f"no bundled packing for {key} (bundled: "
                          f"{', '.join(bundled_grains())}): give --porosity P or --seed N to pack "
-                         f"one (dem.pack, minutes), give a bin (--depth H --diameter B) to pack "
-                         f"its bed set, or pack it with python -m dem.pack --scene "
+                         f"one (dem.pack, minutes), "
+                         + ("give a bin (--depth H --diameter B) to pack its bed set, "
+                            if key in TEMPLATE_GRAINS and janssen_inputs(key) else "")
+                         + f"or pack it with python -m dem.pack --scene "
                          f"box --grain {key} --porosity P --out bed.csv, then add --packing "
                          "bed.csv")
     if from_set:
