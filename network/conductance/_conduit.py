@@ -121,6 +121,8 @@ def conduit_conductance(tessellation, throats_idx=None, *, viscosity_pa_s: float
     ConductanceResult
         ``g`` (M,) m³ Pa⁻¹ s⁻¹, window ``qstar``, conduit heights ``h_m`` (M, 2), ``internal``;
         ``stats``: sections, n_sections, merge summary, n_internal, qstar_stats (the windows),
+        grain_mates (mode; n_windows_cut, the windows whose flow rate the mates lower, or
+        with 'all' n_conduits_reached, the conduits a mate reaches; seconds),
         section_qstar_stats (the sections away from the windows: count and Q* sources, e.g.
         how many ran FE), seconds.
 
@@ -262,7 +264,10 @@ def conduit_conductance(tessellation, throats_idx=None, *, viscosity_pa_s: float
     g[internal] = g_big
     g[np.isnan(g)] = g_big            # both sides of zero length (sliver to sliver)
     seconds = time.perf_counter() - t0
-    mate_stats = {"mode": grain_mates, "n_windows_cut": int(sum(mate_counts)),
+    # 'window': the windows the mates cut; 'all': the conduits a mate reaches
+    mate_stats = {"mode": grain_mates,
+                  ("n_windows_cut" if grain_mates != "all" else "n_conduits_reached"):
+                  int(sum(mate_counts)),
                   "seconds": float(sum(mate_seconds))}
     stats = jsonable({"model": "conduit", "sections": sections, "n_sections": int(n_sections),
                       "grain_mates": mate_stats,
