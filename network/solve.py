@@ -171,6 +171,10 @@ def _check_inputs(args, axes) -> None:
     check_common(args)
     if args.grain is not None:
         grain_key(args.grain)
+    if args.grain_mates != "off" and args.conductance_model != "conduit":
+        raise ValueError(f"--grain-mates {args.grain_mates}: grain mates are taken out of the "
+                         f"conduit model's sections; --conductance-model "
+                         f"{args.conductance_model} has none (give --grain-mates off)")
     if args.vtk and Path(args.vtk).suffix.lower() not in ("", ".vtu"):
         raise ValueError(f"--vtk {args.vtk}: the writer makes VTK XML (.vtu, read by ParaView "
                          f"and meshio), not legacy VTK; name the file "
@@ -255,8 +259,7 @@ def _main(args) -> int:
         container = None if box else read_container(path)
         regions = {ax: sample_region(packing, box=box, margin=margin, cylinder=args.cylinder,
                                      container=container, axis=ax) for ax in axes}
-        mates = ({"grain_mates": args.grain_mates}
-                 if args.conductance_model == "conduit" and args.grain_mates != "off" else None)
+        mates = {"grain_mates": args.grain_mates} if args.grain_mates != "off" else None
         conductance = ConductanceOptions(model=args.conductance_model, policy=args.policy,
                                          rtol=args.rtol, db=args.db, workers=args.workers,
                                          progress=not args.quiet, model_options=mates)

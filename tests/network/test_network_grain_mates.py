@@ -93,3 +93,12 @@ def test_unknown_mode_is_refused():
     t = tessellate(_sub_bed(10))
     with pytest.raises(ValueError, match="grain_mates"):
         conduit_conductance(t, policy="table-only", grain_mates="yes")
+
+
+def test_solve_refuses_grain_mates_with_the_thesis_model(capsys):
+    from network.solve import main
+
+    assert main(["network/data/soybean_grains.csv", "--grain-mates", "window",
+                 "--conductance-model", "thesis", "-q"]) == 2
+    err = capsys.readouterr().err
+    assert "error: --grain-mates window" in err and "thesis" in err
