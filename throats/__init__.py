@@ -19,10 +19,11 @@ shape_factor_qstar, deep_overlap
     Fast Q* estimate c_t A² G (Patzek & Silin 2001) fitted per contact type, over 1e6
     throats/s; median error about 20 % against FE (``docs/throats-shape-factor.md``); the rows
     with a deep overlap (two spheres of one grain) that take their own constants.
-section_ratio, section_fem, section_area_perimeter
+section_ratio, section_fem, section_area_perimeter, shape_factor_ratio
     Sections with more disks than the three vertex disks (other spheres of the vertices'
     grains cutting the plane): the flow rate relative to the three-disk section by the
-    distance-squared estimate, Q by finite elements, exact open area and wetted perimeter.
+    distance-squared estimate (the shape-factor form for narrow sections), Q by finite
+    elements, exact open area and wetted perimeter.
 solve_fem, ThroatSolution, SOLVER_VERSION
     Q* by finite elements (gmsh + scikit-fem), batch, ``rtol``-driven, with an error estimate;
     the version string is bumped whenever results could change.
@@ -39,11 +40,13 @@ Lagrange P3/P4, the error estimate, and what each costs) in
 from ._area import open_area
 from ._geometry import (as_throats, canonical_form, contact_type, triangle_area, triangle_vertices,
                         validate_throats)
-from ._multidisk import section_area_perimeter, section_fem, section_ratio
+from ._multidisk import (NARROW_FRACTION, section_area_perimeter, section_fem, section_ratio,
+                         shape_factor_ratio, sub_triangle_centroids)
 from ._shape_factor import deep_overlap, shape_factor_qstar
 from ._solve import SOLVER_VERSION, ThroatSolution, solve_fem
 
 __all__ = ["SOLVER_VERSION", "as_throats", "ThroatSolution", "canonical_form", "contact_type",
            "deep_overlap", "open_area", "section_area_perimeter", "section_fem", "section_ratio",
+           "NARROW_FRACTION", "shape_factor_ratio", "sub_triangle_centroids",
            "shape_factor_qstar", "solve_fem", "triangle_area", "triangle_vertices",
            "validate_throats"]

@@ -24,7 +24,7 @@ from ._geometry import triangle_area, triangle_vertices
 from ._mesh import DELTA_DEFAULT, _extract
 
 __all__ = ["NARROW_FRACTION", "section_area_perimeter", "section_fem", "section_geometry",
-           "section_ratio", "shape_factor_ratio"]
+           "section_ratio", "shape_factor_ratio", "sub_triangle_centroids"]
 
 
 def _prepare(sides, centers, radii):
@@ -118,7 +118,7 @@ def section_fem(sides, centers, radii, *, rtol=1e-3):
     return q, status
 
 
-def _barycentric(n):
+def sub_triangle_centroids(n):
     """Centroids of the n² sub-triangles of a triangle split n times per side (barycentric
     b1, b2 of the 'up' and 'down' sub-triangles; each carries area 1/n²)."""
     i, j = np.meshgrid(np.arange(n), np.arange(n), indexing="ij")
@@ -204,7 +204,7 @@ def section_ratio(sides, vertex_radii, centers, radii, *, n=16, chunk=4000):
     c = np.asarray(centers, dtype=float)
     r = np.asarray(radii, dtype=float)
     V = triangle_vertices(s)
-    b1, b2 = _barycentric(int(n))
+    b1, b2 = sub_triangle_centroids(int(n))
     out = np.ones(s.shape[0])
     frac = np.zeros(s.shape[0])
     # rows by their number of extra disks, most first: disk e is computed for a prefix

@@ -12,7 +12,10 @@ cuts the plane at signed height t in a disk of radius
 centred at the projection of :math:`c_j` on the face (coordinates in the frame of
 :func:`throats.triangle_vertices`: vertex 1 at the origin, vertex 2 on +x, vertex 3 above).
 The section is then the triangle minus the union of all the disks (:mod:`throats._multidisk`).
-Sphere packings (no ``grain_id``) have no mates.
+Sphere packings (no ``grain_id``) have no mates. The windows' flow-rate factors:
+:func:`window_factors_compiled` (the compiled loop of :mod:`._mates_kernel`, what the conduit
+model runs) and :func:`window_factors` (numpy, the reference it is tested against); every
+section's: :func:`section_factors`.
 """
 
 from __future__ import annotations
@@ -223,14 +226,14 @@ def window_factors_compiled(packing, vertices, *, n=16, n_angles=16, max_live=32
     the compiled loop of :mod:`._mates_kernel` (the mates, the circle test and the
     distance-squared rule per window), the narrow windows by
     :func:`throats.shape_factor_ratio`: (N,) factors, 1 where no mate takes area."""
-    from throats._multidisk import NARROW_FRACTION, _barycentric, shape_factor_ratio
+    from throats import NARROW_FRACTION, shape_factor_ratio, sub_triangle_centroids
 
     from ._mates_kernel import compiled_window_rows
 
     tv = np.ascontiguousarray(vertices, dtype=np.int64)
     n_w = tv.shape[0]
     cand = np.ascontiguousarray(candidates(packing.grain_id, tv))
-    b1, b2 = _barycentric(int(n))
+    b1, b2 = sub_triangle_centroids(int(n))
     factor = np.ones(n_w)
     flagged = np.zeros(n_w, dtype=bool)
     live_c = np.zeros((n_w, max_live, 2))
