@@ -21,7 +21,7 @@ series for vertical airflow,
 gradient is reported at the surface, mid-depth and bottom and as its depth mean
 (1/H)∫ g_x dz. The bin velocities are the report's velocities where there are at most three,
 else the first, the one nearest their geometric mean and the last (:func:`bin_velocities`):
-each bed is solved at those only, so the set costs three solves per direction.
+each bed is solved once per direction at those only.
 
 Solves are cached in ``--bed-dir`` (``bin_solves/<key>.json``), keyed by the bed file's SHA-256,
 the code version (package version and a hash of the network, throats and cache sources) and the
