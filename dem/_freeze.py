@@ -45,7 +45,7 @@ from ._rigid import quat_to_matrix
 __all__ = ["ActiveRegion", "FreezePolicy", "FREEZE_DEPTH_LENGTHS"]
 
 #: depth below the local surface, in kernel lengths, below which a slow grain may freeze
-FREEZE_DEPTH_LENGTHS = 3.0
+FREEZE_DEPTH_LENGTHS = 4.0
 
 
 # ---------------------------------------------------------------------------- the cell grid

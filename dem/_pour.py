@@ -256,7 +256,7 @@ def rest_steps(dt_s, *, rest_time_s=None, min_steps=60_000):
 
 
 #: largest drift of a grain that freezes over :data:`FREEZE_WINDOW_S`, in volume-equivalent diameters d_v
-FREEZE_DRIFT_FRACTION = 0.01
+FREEZE_DRIFT_FRACTION = 0.002
 #: window over which a grain must drift less than that before it freezes, s
 FREEZE_WINDOW_S = 0.03
 #: normal force of an active neighbour, in weights of the frozen grain, that releases it

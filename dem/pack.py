@@ -147,7 +147,7 @@ def _parser():
     p.add_argument("--spout-diameter", type=float, default=None,
                    help="spout: diameter, m (default three kernel lengths)")
     p.add_argument("--no-freeze", action="store_const", const=True, default=None,
-                   help="poured fill: step every grain to the end (default: grains settled more than three kernel "
+                   help="poured fill: step every grain to the end (default: grains settled more than four kernel "
                         "lengths below the surface are frozen while the pour goes on, and released before the "
                         "bed's rest is judged and before a load; docs/dem-fill.md, Speed)")
     p.add_argument("--depth", type=float, default=None,
