@@ -31,6 +31,7 @@ written) or stopped at the step limit before equilibrium (written, marked ``"con
 from __future__ import annotations
 
 import argparse
+import contextlib
 import copy
 import math
 import sys
@@ -41,8 +42,8 @@ from pathlib import Path
 import numpy as np
 from network.core import check_physical_porosity, recorded_reach
 
-from ._cli import (EXIT_FAILED, check_counts, check_output, check_seed, progress_printer, resolve_container,
-                   run_main)
+from ._cli import (EXIT_FAILED, OneLineParser, check_counts, check_output, check_seed, progress_printer,
+                   resolve_container, run_main)
 from ._container import SCENE_DEFAULTS, SCENES, default_measure_spheres
 from ._material import Material
 from ._io import summary_path, write_packing
@@ -62,7 +63,7 @@ SPHERE_MAX_STEPS, GRAIN_MAX_STEPS = 200_000, 60_000
 
 
 def _parser():
-    p = argparse.ArgumentParser(prog="python -m dem.pack", description=__doc__.split("\n")[1])
+    p = OneLineParser(prog="python -m dem.pack", description=__doc__.split("\n")[1])
     p.add_argument("--scene", required=True, choices=sorted(SCENES) + ["box", "cylinder"],
                    help="container: the thesis's rect-bin or cyl-bin, or a box/cylinder sized by --size and --height")
     p.add_argument("--out", required=True, help="packing CSV path (JSON summary written beside it)")
@@ -92,7 +93,7 @@ def _parser():
                         "bed; friction then loosens it); the material's friction holds afterwards")
     p.add_argument("--n-particles", type=int, help="default: thesis Eq. 3.10")
     p.add_argument("--mass-scale", type=float, default=None,
-                   help="density scaling S during packing (1 = real masses; default 100, poured grain fills 1)")
+                   help="density scaling S >= 1 during packing (1 = real masses; default 100, poured grain fills 1)")
     p.add_argument("--packing-friction", type=float, default=None,
                    help="particle friction during expansion/closed stage (default: the material's)")
     p.add_argument("--procedure", choices=list(PROCEDURES), default=None,
@@ -192,8 +193,8 @@ def _pack_grains(args, fill) -> int:
     material, used = _grain_material(args, template.name)
     pr = progress_printer(quiet=args.quiet)
     size_cv, size_cv_source = _size_cv(args, template.name)
-    kw = dict(material=material, n_grains=args.n_grains, rng=args.seed, mass_scale=args.mass_scale or 100.0,
-              size_cv=size_cv,
+    kw = dict(material=material, n_grains=args.n_grains, rng=args.seed,
+              mass_scale=100.0 if args.mass_scale is None else args.mass_scale, size_cv=size_cv,
               tol=args.tol, max_steps=GRAIN_MAX_STEPS if args.max_steps is None else args.max_steps,
               progress=lambda sim, f: pr("grains", _Progress(sim), None))
     if args.porosity is not None and args.deposition_friction is None:
@@ -314,7 +315,12 @@ def _check_outputs(args):
     cannot be written or is the --grain template file, before any work."""
     inputs = [("--grain", Path(args.grain))] if args.grain is not None and Path(
         str(args.grain)).is_file() else []
-    for _, out in _stress_outputs(args):
+    outs = _stress_outputs(args)
+    for k, (s, out) in enumerate(outs):
+        clash = next((t for t, o in outs[:k] if o.name == out.name), None)
+        if clash is not None:
+            raise ValueError(f"--stress {clash:.12g} and {s:.12g} Pa both write {out.name} (the names keep six "
+                             "significant digits of kPa): give stresses that differ there")
         check_output(out, inputs=inputs)
         files = [summary_path(out)] + ([grains_path(out)] if args.grain is not None else [])
         for f in files:
@@ -370,15 +376,23 @@ def _fill_options(args):
         raise ValueError("--bin-diameter and --bin-height go with --depth")
     if args.depth is not None and args.bin_height is not None and args.depth > args.bin_height:
         raise ValueError(f"--depth {args.depth:g} m is beyond the bin's wall height (--bin-height {args.bin_height:g} m)")
-    try:
+    with _fill_options_named():
         return FillOptions(method=method, drop_height_m=0.3 if args.drop_height is None else args.drop_height,
                            rate_kg_s=args.rate, spout_diameter_m=args.spout_diameter,
                            mass_scale=1.0 if args.mass_scale is None else args.mass_scale,
                            freeze=not args.no_freeze)
+
+
+@contextlib.contextmanager
+def _fill_options_named():
+    """A fill's ValueError (:class:`FillOptions`, :func:`check_fill_options`: "drop height 11 m:
+    ...") re-raised naming the command-line option ("--drop-height 11 m: ...")."""
+    try:
+        yield
     except ValueError as e:
         opt = {"drop height": "--drop-height", "rate": "--rate", "spout diameter": "--spout-diameter",
                "mass scale": "--mass-scale"}
-        raise ValueError(next((f"{o} " + str(e).split(" ", len(k.split())) [-1] for k, o in opt.items()
+        raise ValueError(next((f"{o} " + str(e).split(" ", len(k.split()))[-1] for k, o in opt.items()
                                if str(e).startswith(k)), str(e))) from None
 
 
@@ -430,7 +444,8 @@ def _pour(args, fill, template, container) -> int:
     """--fill rain|spout, then the load of --depth or --stress (several stresses: each from a copy
     of the same poured state)."""
     t0, c0 = time.perf_counter(), time.process_time()
-    check_fill_options(fill, container, template)
+    with _fill_options_named():
+        check_fill_options(fill, container, template)
     janssen = _janssen_inputs(template.name) if args.depth is not None else None
     material, used, e_pp = _pour_material(args, template.name)
     phi_count = _grain_porosity(args, template.name)
@@ -523,6 +538,9 @@ def _pack(args) -> int:
     if args.max_steps is not None and args.max_steps < 1:
         raise ValueError(f"--max-steps must be >= 1, got {args.max_steps}")
     check_counts(args)
+    ms = args.mass_scale
+    if ms is not None and not (math.isfinite(ms) and ms >= 1):
+        raise ValueError(f"--mass-scale {ms:g}: must be finite and >= 1 (1: real masses)")
     fill = _fill_options(args)
     _check_outputs(args)
     if args.porosity is not None:       # a porosity no bed has: refused before any packing

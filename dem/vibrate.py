@@ -15,14 +15,14 @@ Exit status 0 on success, 2 on bad arguments, 1 when the run went unstable or wa
 
 from __future__ import annotations
 
-import argparse
 import json
 import time
 from pathlib import Path
 
 import numpy as np
 
-from ._cli import check_counts, check_output_list, check_seed, progress_printer, resolve_container, run_main
+from ._cli import (OneLineParser, check_counts, check_output_list, check_seed, progress_printer,
+                   resolve_container, run_main)
 from ._container import SCENES
 from ._integrate import DemInstabilityError
 from ._material import Material
@@ -37,7 +37,7 @@ MAX_INTENSITY_G = 10.0
 
 
 def _parser():
-    p = argparse.ArgumentParser(prog="python -m dem.vibrate", description=__doc__.split("\n")[0])
+    p = OneLineParser(prog="python -m dem.vibrate", description=__doc__.split("\n")[0])
     p.add_argument("packing", nargs="?", help="packing CSV (x,y,z,r) with its JSON summary beside it (not with "
                    "--study, which packs or reuses its own bed)")
     p.add_argument("--study", choices=["thesis"], help="the thesis's vibration study, resumable (dem.study): "

@@ -78,3 +78,29 @@ def test_vibrate_names_the_bad_run_option_before_any_work(argv, words, tmp_path,
     assert err.count("\n") == 1 and words in err
     assert not out.exists()
 
+
+
+@pytest.mark.parametrize("main, argv, named", [
+    (pack.main, ["--scene", "box", "--grain", "wheat", "--drop-height", "abc"],
+     "error: argument --drop-height: invalid float value: 'abc'"),
+    (vibrate.main, ["b.csv", "--intensity", "abc"], "error: argument --intensity: invalid float value: 'abc'"),
+    (pack.main, ["--scene", "box", "--grain", "wheat", "--fill", "grow", "--mass-scale", "0"],
+     "error: --mass-scale 0: must be finite and >= 1"),
+    (pack.main, ["--scene", "box", "--size", "0.03", "0.03", "--height", "0.03", "--mass-scale", "-1"],
+     "error: --mass-scale -1: must be finite and >= 1"),
+    (pack.main, ["--scene", "box", "--grain", "wheat", "--mass-scale", "nan"],
+     "error: --mass-scale nan: must be finite and >= 1"),
+    (pack.main, ["--scene", "box", "--grain", "wheat", "--stress", "20000", "20000.0001"],
+     "error: --stress 20000 and 20000.0001 Pa both write out_20kPa.csv"),
+    (pack.main, ["--scene", "box", "--grain", "wheat", "--fill", "spout", "--spout-diameter", "0.05"],
+     "error: --spout-diameter 0.05 m is wider than the container (0.04 m)"),
+])
+def test_bad_option_values_are_one_error_line_exit_2_nothing_written(main, argv, named, tmp_path, capsys,
+                                                                       monkeypatch):
+    """A value the parser or the checks refuse: exit 2, one ``error:`` line naming the option and
+    the value (not the usage block, not an internal name), and no file written."""
+    monkeypatch.chdir(tmp_path)
+    rc = main(argv + ["--out", "out.csv", "--quiet"] if main is pack.main else argv)
+    err = capsys.readouterr().err.strip().splitlines()
+    assert rc == 2 and len(err) == 1 and err[0].startswith(named), err
+    assert list(tmp_path.iterdir()) == []

@@ -173,7 +173,7 @@ def test_rest_check_fails_a_bed_not_at_rest(tmp_path, capsys):
     (["--drop-height", "10.01"], "--drop-height 10.01"),
     (["--rate", "0"], "--rate 0"),
     (["--rate", "-1"], "--rate -1"),
-    (["--fill", "spout", "--spout-diameter", "0.5"], "spout diameter 0.5"),
+    (["--fill", "spout", "--spout-diameter", "0.5"], "--spout-diameter 0.5"),
     (["--stress", "-1"], "--stress -1"),
     (["--depth", "12", "--bin-diameter", "6", "--bin-height", "10"], "--depth 12"),
     (["--depth", "3", "--bin-diameter", "6", "--stress", "100"], "--stress 100 together with --depth 3"),
