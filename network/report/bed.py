@@ -39,7 +39,7 @@ from ..core import reach_refusal, recorded_reach
 from .porosity import bundled_packing, packing_meta
 
 __all__ = ["TEMPLATE_GRAINS", "PACK_TOL", "add_bed_options", "plan_bed", "bed_paths", "find_bed",
-           "pack_bed", "pack_command", "prepare_bed", "bed_label", "bed_json",
+           "pack_bed", "pack_command", "prepare_bed", "bed_label", "bed_json", "check_bed_dir",
            "user_bed_json"]
 
 #: grains with a multi-sphere template in ``dem.templates.TEMPLATE_GRAINS`` (a copy: network may
@@ -155,14 +155,7 @@ def plan_bed(grain: str, *, porosity, seed, packing, move_along_band: bool, bed_
     if rec is not None and not rec["range"][0] - rec["tol"] <= porosity <= rec["range"][1] \
             + rec["tol"]:
         raise ValueError(f"{reach_refusal(porosity, grain, rec)}; no bed packed")
-    d = Path(bed_dir)
-    for p in [d, *d.parents]:
-        if p.exists():
-            if not p.is_dir():
-                raise ValueError(f"--bed-dir {bed_dir}: {p} exists and is not a folder")
-            if not os.access(p, os.W_OK | os.X_OK):
-                raise ValueError(f"--bed-dir {bed_dir}: folder {p} is not writable")
-            break
+    d = check_bed_dir(bed_dir)
     plan.update(action="pack", packing=None, porosity=float(porosity), porosity_why=p_why,
                 seed=int(seed), box=box, bed_dir=str(d), why=why)
     if (bundled is not None and bed_box is None and int(seed) == int(meta.get("seed", -1))
@@ -171,6 +164,20 @@ def plan_bed(grain: str, *, porosity, seed, packing, move_along_band: bool, bed_
             f"the bundled bed is dem.pack's packing of {grain} at {porosity:g} with seed {seed} "
             "in this box: the same bed"))
     return plan
+
+
+def check_bed_dir(bed_dir) -> Path:
+    """``bed_dir`` as a Path; ValueError naming ``--bed-dir`` when it, or the nearest of its
+    folders that exists, is not a folder or not writable (missing folders are made on packing)."""
+    d = Path(bed_dir)
+    for p in [d, *d.parents]:
+        if p.exists():
+            if not p.is_dir():
+                raise ValueError(f"--bed-dir {bed_dir}: {p} exists and is not a folder")
+            if not os.access(p, os.W_OK | os.X_OK):
+                raise ValueError(f"--bed-dir {bed_dir}: folder {p} is not writable")
+            break
+    return d
 
 
 def bed_paths(plan: dict) -> Path:

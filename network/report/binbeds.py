@@ -53,7 +53,7 @@ from .._cli import EXIT_BAD_INPUT, EXIT_FAILED, CliError
 from .porosity import DATA_DIR, packing_meta
 
 __all__ = ["BED_SET_STRESSES_PA", "BUNDLED_SETS", "BIN_SOLVES", "N_LAYERS", "STRESS_TOL", "bed_set_files",
-           "bin_velocities", "interpolate_in_stress", "layers_in_series", "janssen_inputs",
+           "bed_set_inputs", "bin_velocities", "interpolate_in_stress", "layers_in_series", "janssen_inputs",
            "plan_bin_beds", "pack_bed_set", "set_box", "solve_cache_key", "bin_section"]
 
 #: the grains whose bed sets ship in network/data (the others with a dem template pack theirs on
@@ -181,6 +181,21 @@ def set_box(grain: str) -> tuple[float, float, float]:
 _TEMPLATE_VOLUME_M3 = {"soybean": 1.4877665881225434e-07, "wheat": 3.6124005251161877e-08,
                        "shelled_corn": 1.4695563591763196e-07, "barley": 3.972006698120529e-08,
                        "canola": 2.1928725783600206e-09}
+
+
+def bed_set_inputs(plan: dict | None) -> list[tuple[str, Path]]:
+    """``(what, path)`` of every file of a used bin plan's bed set, to keep the report's outputs
+    off them: each bed's CSV, companion JSON and ``.grains.csv``, bundled or in ``bed_dir`` (a set
+    still to pack: the files it will have there). [] where no set is used."""
+    if not plan or not plan.get("used"):
+        return []
+    if plan.get("beds"):
+        csvs = [p for _, p in plan["beds"]]
+    else:
+        csvs = [Path(plan["bed_dir"]) / f"{plan['grain']}_rain_{s / 1000:g}kPa.csv"
+                for s in BED_SET_STRESSES_PA]
+    return [("a bed of the bin's bed set", f) for p in csvs
+            for f in (Path(p), Path(p).with_suffix(".json"), Path(p).with_name(Path(p).stem + ".grains.csv"))]
 
 
 def _set_in(grain: str, folder) -> list[tuple[float, Path]]:

@@ -22,8 +22,9 @@ from ..curve import DEFAULT_VELOCITIES, parse_velocities
 from ..flow import DEFAULT_DEPTH_M
 from ..packing import UNITS, read_container
 from .band import BAND_OFFSETS
-from .bed import TEMPLATE_GRAINS, add_bed_options, bed_json, plan_bed, prepare_bed
-from .binbeds import check_bin_depth, janssen_inputs, pack_bed_set, plan_bin_beds
+from .bed import (TEMPLATE_GRAINS, add_bed_options, bed_json, bed_paths, check_bed_dir, plan_bed,
+                  prepare_bed)
+from .binbeds import bed_set_inputs, check_bin_depth, janssen_inputs, pack_bed_set, plan_bin_beds
 from .build import build_report
 from .figures import FIGURES, write_figures, write_html
 from .options import ReportOptions, grain_key
@@ -132,6 +133,8 @@ def _check(args) -> dict:
         if getattr(args, opt) is not None and getattr(args, opt) < 0:
             raise ValueError(f"--{opt.replace('_', '-')} must be >= 0, got {getattr(args, opt)}")
     target, why = requested_porosity(key, args.porosity)
+    if args.bed_dir is not None:
+        check_bed_dir(args.bed_dir)
     bed_dir = args.bed_dir or Path(args.plot_dir or f"report_{key}") / "beds"
     other = next((opt for opt, v in (("--packing", args.packing), ("--porosity", args.porosity),
                                      ("--seed", args.seed),
@@ -143,6 +146,8 @@ def _check(args) -> dict:
                          other=other)
     if bins is not None:
         bins["grain"] = key
+        if bins.get("used") and bins.get("source") == "packed":
+            check_bed_dir(bed_dir)
     # a grain without a bundled bed whose bin set is packed on first use: its single bed is
     # the set's surface bed
     from_set = (bins is not None and bins["used"] and bins["source"] == "packed"
@@ -189,7 +194,11 @@ def _check(args) -> dict:
         if args.diameter is None and args.floor_area is None:
             raise ValueError("--fan needs the bin: --diameter (round) or --floor-area")
         fan = read_fan(args.fan)
-    inputs = packing_inputs(args) + ([("--fan", args.fan)] if args.fan is not None else [])
+    inputs = (packing_inputs(args) + ([("--fan", args.fan)] if args.fan is not None else [])
+              + bed_set_inputs(bins)
+              + ([("the bed to pack", p) for c in [bed_paths(bed)]
+                  for p in (c, c.with_suffix(".json"), c.with_name(c.stem + ".grains.csv"))]
+                 if bed["action"] == "pack" else []))
     check_outputs(json=args.json_out, html=args.html, inputs=inputs)
     if args.plot_dir is not None and not Path(args.plot_dir).is_dir():
         raise ValueError(f"--plot-dir {args.plot_dir}: not an existing folder")

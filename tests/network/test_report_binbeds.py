@@ -237,3 +237,40 @@ def test_a_bed_set_is_packed_on_first_use_with_a_progress_bar(tmp_path, monkeypa
     err = capsys.readouterr().err
     assert "packing the soybean bed set" in err and "3/3" in err
     assert bb._set_in("soybean", tmp_path / "beds") == plan["beds"]      # found next time
+
+
+@pytest.mark.parametrize("packed, target", [
+    (True, "barley_rain_20kPa.json"), (True, "barley_rain_45kPa.csv"), (True, "barley_rain_0kPa.grains.csv"),
+    (False, "barley_rain_20kPa.json"),
+])
+def test_report_outputs_never_land_on_the_bed_set(tmp_path, monkeypatch, capsys, packed, target):
+    """--json onto a file of the bin's bed set (packed already, or the name a set still to pack
+    takes): exit 2, one line naming --json and the bed, the set's files unchanged."""
+    monkeypatch.chdir(tmp_path)
+    beds = tmp_path / "beds"
+    if packed:
+        _fake_set(beds, "barley", BED_SET_STRESSES_PA)
+    else:
+        beds.mkdir()
+    before = {p.name: p.read_bytes() for p in beds.iterdir()}
+    argv = ["--grain", "barley", "--depth", "5", "--diameter", "8", "--bed-dir", str(beds),
+            "--no-band", "--no-figures", "-q", "--json", str(beds / target)]
+    assert main(argv) == 2
+    err = [line for line in capsys.readouterr().err.strip().splitlines()
+           if not line.startswith("warning:")]     # the fake set's JSONs hold no container
+    assert len(err) == 1 and err[0].startswith(f"error: --json {beds / target}: the same file as a bed of "
+                                               "the bin's bed set"), err
+    assert {p.name: p.read_bytes() for p in beds.iterdir()} == before
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["beds"]
+
+
+@pytest.mark.parametrize("grain", ["corn", "barley"])
+def test_a_bed_dir_that_is_a_file_is_refused_before_any_work(tmp_path, monkeypatch, capsys, grain):
+    """--bed-dir naming a file: exit 2 naming it, whether or not the report would pack there."""
+    monkeypatch.chdir(tmp_path)
+    (tmp_path / "f.csv").write_text("x\n")
+    assert main(["--grain", grain, "--depth", "5", "--diameter", "8", "--bed-dir", "f.csv",
+                 "--no-band", "--no-figures", "-q", "--json", "r.json"]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert err == ["error: --bed-dir f.csv: f.csv exists and is not a folder"]
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["f.csv"]
