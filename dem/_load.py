@@ -29,12 +29,17 @@ import numpy as np
 
 from ._walls import PlaneWall
 
-__all__ = ["janssen_stress", "load_bed", "SERVO_GAIN", "LID_SPEED_M_S"]
+__all__ = ["janssen_stress", "load_bed", "SERVO_GAIN", "LID_SPEED_M_S", "MAX_STRESS_PA"]
 
 #: fraction α of the force gap the lid closes per step
 SERVO_GAIN = 0.3
 #: largest lid speed, m/s
 LID_SPEED_M_S = 0.05
+#: largest lid stress the command lines take, Pa: twice the deep-bin limit of Janssen's stress,
+#: rho_b g D / (4 mu_w K), of every library grain with Janssen inputs in a bin 40 m across
+#: (0.35-0.47 MPa at rho_b 850 kg/m^3); a larger stress is a slip (1e9 for 1e4), which the lid
+#: would drive to a DEM blow-up only after the whole pour
+MAX_STRESS_PA = 1.0e6
 
 
 def janssen_stress(depth_m, *, bulk_density_kg_m3, diameter_m, wall_friction, lateral_ratio, g=9.81):

@@ -40,6 +40,7 @@ import numpy as np
 from ._cli import (EXIT_FAILED, MAX_REPEATS, MAX_SPHERES, MAX_STEPS, MAX_WORKERS, OneLineParser,
                    check_count, check_output_list, run_main)
 from ._container import Container, make_simulation
+from ._load import MAX_STRESS_PA
 from ._procedures import PackOptions, RunOptions, pack_bed
 from .clumps import ClumpSimulation
 from .templates import library_template
@@ -299,8 +300,10 @@ def _check_args(args) -> None:
     positive("--grains", args.grains or [])
     positive("--grain-pack", [args.grain_pack])
     positive("--pour", [args.pour])
-    if args.pour_stress is not None and not (math.isfinite(args.pour_stress) and args.pour_stress > 0):
-        raise ValueError(f"--pour-stress must be finite and > 0, got {args.pour_stress:g}")
+    if args.pour_stress is not None and not (math.isfinite(args.pour_stress)
+                                             and 0 < args.pour_stress <= MAX_STRESS_PA):
+        raise ValueError(f"--pour-stress must be finite, > 0 and <= {MAX_STRESS_PA:g} Pa (dem.pack --stress), "
+                         f"got {args.pour_stress:g}")
     if (args.pour_stress is not None or args.pour_no_freeze) and not args.pour:
         raise ValueError(f"{'--pour-stress' if args.pour_stress is not None else '--pour-no-freeze'}: only with --pour")
     for v in args.scales or []:

@@ -50,7 +50,7 @@ from ._io import summary_path, write_packing
 from ._clump_pack import grains_path, pack_grains, write_grain_packing
 from ._grain_search import grain_count, pack_grains_to_porosity
 from ._contacts import damping_ratio_for_restitution
-from ._load import janssen_stress, load_bed
+from ._load import MAX_STRESS_PA, janssen_stress, load_bed
 from ._reach import count_porosity
 from ._pour import FILL_METHODS, FillOptions, check_fill_options, poured_bed_summary, pour_grains, rest_steps
 from ._procedures import PROCEDURES, PackOptions, RunOptions, pack_bed
@@ -143,23 +143,25 @@ def _parser():
     p.add_argument("--drop-height", type=float, default=None,
                    help="rain/spout: height the grains fall from onto the surface, m (default 0.3, at most 10)")
     p.add_argument("--rate", type=float, default=None,
-                   help="rain/spout: mass flow, kg/s (default: the surface rises one grain diameter per "
+                   help="rain/spout: mass flow, kg/s, > 0 (default: the surface rises one grain diameter per "
                         "rebound flight 2 e v0/g of a landed grain, so it is at rest before it is covered)")
     p.add_argument("--spout-diameter", type=float, default=None,
-                   help="spout: diameter, m (default three kernel lengths)")
+                   help="spout: diameter, m, between a grain's width and the container's narrowest width "
+                        "(default three kernel lengths)")
     p.add_argument("--no-freeze", action="store_const", const=True, default=None,
                    help="poured fill: step every grain to the end (default: grains settled more than four kernel "
                         "lengths below the surface are frozen while the pour goes on, and released before the "
                         "bed's rest is judged and before a load; docs/dem-fill.md, Speed)")
     p.add_argument("--depth", type=float, default=None,
-                   help="rain/spout: load the bed to Janssen's vertical stress at this depth of a bin, m "
-                        "(needs --bin-diameter)")
-    p.add_argument("--bin-diameter", type=float, default=None, help="--depth: the bin's diameter, m")
+                   help="rain/spout: load the bed to Janssen's vertical stress at this depth of a bin, m, >= 0 "
+                        "(needs --bin-diameter; default: no load)")
+    p.add_argument("--bin-diameter", type=float, default=None, help="--depth: the bin's diameter, m, > 0")
     p.add_argument("--bin-height", type=float, default=None,
-                   help="--depth: the bin's wall height, m (a deeper --depth is refused)")
+                   help="--depth: the bin's wall height, m, > 0: a deeper --depth is refused (default: "
+                        "no wall height, any depth)")
     p.add_argument("--stress", type=float, nargs="+", default=None,
-                   help="rain/spout: load the bed through a lid to this vertical stress, Pa (not with --depth); "
-                        "several: one pour, each stress loaded from a copy of the poured state and written to "
+                   help=f"rain/spout: load the bed through a lid to this vertical stress, Pa, 0 to "
+                        f"{MAX_STRESS_PA:g} (not with --depth; default: no load); several: one pour, each stress loaded from a copy of the poured state and written to "
                         "<stem>_<kPa>kPa.csv")
     p.add_argument("--quiet", action="store_true", help="no progress lines on stderr")
     return p
@@ -364,8 +366,8 @@ def _fill_options(args):
             raise ValueError(f"{opt} {v:g} m: must be a finite length, {'>= 0' if key == 'depth' else '> 0'}")
     if args.stress is not None:
         for v in args.stress:
-            if not (math.isfinite(v) and v >= 0):
-                raise ValueError(f"--stress {v:g} Pa: must be finite and >= 0")
+            if not (math.isfinite(v) and 0 <= v <= MAX_STRESS_PA):
+                raise ValueError(f"--stress {v:g} Pa: must be finite, >= 0 and <= {MAX_STRESS_PA:g} Pa")
         if len(set(args.stress)) != len(args.stress):
             raise ValueError(f"--stress {' '.join(f'{v:g}' for v in args.stress)}: a stress is given twice")
         if args.depth is not None:

@@ -79,9 +79,9 @@ def build_parser() -> CliParser:
                          "(floor aeration, default) or x horizontal (cross-flow: the floor area "
                          "options then give the face the air enters); both curves are reported")
     area = ap.add_mutually_exclusive_group()
-    area.add_argument("--diameter", type=float, default=None, help="round bin diameter, m")
+    area.add_argument("--diameter", type=float, default=None, help="round bin diameter, m, > 0 (default: none, the floor area's bin)")
     area.add_argument("--floor-area", type=float, default=None,
-                      help="floor area, m^2 (default without --diameter: 1 m^2)")
+                      help="floor area, m^2, > 0 (default without --diameter: 1 m^2)")
     ap.add_argument("--airflow", nargs=2, default=None, metavar=("VALUE", "UNIT"),
                     help=f"an airflow to report, UNIT one of {', '.join(AIRFLOW_UNITS)} (any "
                          "case; per tonne, per m^3 of grain, and ft^3/min per US bushel, 1 "

@@ -5,7 +5,7 @@ import json
 
 import pytest
 
-from dem import pack, vibrate
+from dem import bench, pack, vibrate
 
 
 def test_unconverged_packing_is_written_marked_and_exits_1(tmp_path, capsys):
@@ -94,6 +94,10 @@ def test_vibrate_names_the_bad_run_option_before_any_work(argv, words, tmp_path,
      "error: --stress 20000 and 20000.0001 Pa both write out_20kPa.csv"),
     (pack.main, ["--scene", "box", "--grain", "wheat", "--fill", "spout", "--spout-diameter", "0.05"],
      "error: --spout-diameter 0.05 m is wider than the container (0.04 m)"),
+    (pack.main, ["--scene", "box", "--grain", "wheat", "--stress", "0", "1e9"],
+     "error: --stress 1e+09 Pa: must be finite, >= 0 and <= 1e+06 Pa"),
+    (bench.main, ["--pour", "10", "--pour-stress", "1e9", "--json", "b.json"],
+     "error: --pour-stress must be finite, > 0 and <= 1e+06 Pa"),
 ])
 def test_bad_option_values_are_one_error_line_exit_2_nothing_written(main, argv, named, tmp_path, capsys,
                                                                        monkeypatch):
