@@ -451,6 +451,13 @@ def _pour(args, fill, template, container) -> int:
     janssen = _janssen_inputs(template.name) if args.depth is not None else None
     material, used, e_pp = _pour_material(args, template.name)
     phi_count = _grain_porosity(args, template.name)
+    if janssen is not None:
+        est = janssen_stress(args.depth, bulk_density_kg_m3=material.density_kg_m3 * (1 - phi_count),
+                             diameter_m=args.bin_diameter, wall_friction=janssen[0], lateral_ratio=janssen[1])
+        if est > MAX_STRESS_PA:
+            raise ValueError(f"--depth {args.depth:g} m of a {args.bin_diameter:g} m bin: Janssen's stress there, "
+                             f"about {est / 1e3:.0f} kPa at the grain's loose-fill porosity {phi_count:.3f}, is "
+                             f"beyond the {MAX_STRESS_PA / 1e3:g} kPa a load takes")
     n = args.n_grains if args.n_grains is not None else int((1 - phi_count) * container.volume_m3 / template.volume_m3)
     if n < 1:
         raise ValueError(f"no grain of {template.volume_m3:.3g} m^3 fits the container")

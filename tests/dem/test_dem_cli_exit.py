@@ -96,6 +96,8 @@ def test_vibrate_names_the_bad_run_option_before_any_work(argv, words, tmp_path,
      "error: --spout-diameter 0.05 m is wider than the container (0.04 m)"),
     (pack.main, ["--scene", "box", "--grain", "wheat", "--stress", "0", "1e9"],
      "error: --stress 1e+09 Pa: must be finite, >= 0 and <= 1e+06 Pa"),
+    (pack.main, ["--scene", "box", "--grain", "wheat", "--depth", "1000", "--bin-diameter", "1000"],
+     "error: --depth 1000 m of a 1000 m bin: Janssen's stress there, about 49"),
     (bench.main, ["--pour", "10", "--pour-stress", "1e9", "--json", "b.json"],
      "error: --pour-stress must be finite, > 0 and <= 1e+06 Pa"),
 ])
