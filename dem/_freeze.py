@@ -371,6 +371,19 @@ def _load_history(pi, pj, hist, nbr, cnt, shear, touch):
 
 
 @numba.njit(cache=True)
+def _in_contact(sidx, frozen, nbr, cnt, touch, out):
+    """``out`` (N,) bool: the spheres in contact with a sphere of another grain (from the
+    evaluating rows of the active spheres ``sidx``; frozen spheres count as in contact)."""
+    for a in range(sidx.shape[0]):
+        i = sidx[a]
+        for s in range(cnt[i]):
+            j = nbr[i, s]
+            if (j > i or frozen[j]) and touch[i, s]:
+                out[i] = True
+                out[j] = True
+
+
+@numba.njit(cache=True)
 def _contact_sums(sidx, frozen, nbr, cnt, touch, fn):
     """(sum, count) of the normal forces of the touching pairs evaluated from the rows ``sidx``."""
     total, n = 0.0, 0
@@ -628,7 +641,8 @@ class FreezePolicy:
     At each check of :meth:`dem.clumps.ClumpSimulation.run` an active grain freezes when
 
     * its centre lies more than ``depth_m`` below the local surface (the highest sphere top of
-      the grains not falling, over the 3 x 3 lateral cells ``cell_m`` wide around it), and
+      the grains on the bed, touching another grain or a wall and not falling, over the 3 x 3
+      lateral cells ``cell_m`` wide around it), and
     * over the last ``window_s`` it moved less than ``drift_m``, its centre and the tips of its
       long axis alike (:math:`|\Delta\mathbf X|` and :math:`\theta\,\ell/2`, θ the angle it
       turned, ℓ the kernel length), and it moves now slower than ``speed_m_s`` (centre,
@@ -697,16 +711,24 @@ class FreezePolicy:
                 w = np.linalg.norm(_omega_of(sim, cand), axis=1) * tip
                 cand = cand[(v < self.speed_m_s) & (w < self.speed_m_s)]
             if len(cand):
-                depth = self._local_surface(sim, sim.X[cand, :2]) - sim.X[cand, 2]
+                depth = self._local_surface(region, sim.X[cand, :2]) - sim.X[cand, 2]
                 frozen[cand[depth > self.depth_m]] = True
         n_new = int(np.sum(frozen & ~region.frozen_g))
         region.set_frozen(frozen)
         return n_new, int(release.sum())
 
-    def _local_surface(self, sim, xy):
-        """Highest sphere top of the grains not falling over the 3 x 3 cells around each point, m."""
+    def _local_surface(self, region, xy):
+        """Highest sphere top of the grains on the bed (touching another grain or a wall, not
+        falling: a kernel in a rebound's flight is not the surface) over the 3 x 3 cells around
+        each point, m."""
+        sim = region.sim
         xs, r = sim._x, sim.radii
-        keep = (np.linalg.norm(sim.V, axis=1) < self.falling_m_s)[sim.gid]
+        touching = region.frozen_s[:sim.n].copy()
+        _in_contact(region.sidx, region.frozen_s, region.nbr, region.cnt, region.touch, touching)
+        touching |= sim._wall_touch.any(axis=0).astype(bool)
+        on_bed = np.zeros(sim.n_grains, bool)
+        on_bed[sim.gid[touching]] = True
+        keep = (on_bed & (np.linalg.norm(sim.V, axis=1) < self.falling_m_s))[sim.gid]
         lo = np.min(xs[:, :2], axis=0) - self.cell_m
         nc = np.floor((np.max(xs[:, :2], axis=0) + self.cell_m - lo) / self.cell_m).astype(int) + 1
         top = np.full((nc[0] + 2, nc[1] + 2), -np.inf)
