@@ -67,13 +67,13 @@ def build_parser() -> CliParser:
                          "shape-factor (fast closed form)")
     ap.add_argument("--conductance-model", default="conduit", choices=MODELS,
                     help="throat conductance model (thesis = Eq. 3.41, L = 2 r̄)")
-    ap.add_argument("--grain-mates", default="off", type=str.lower,
+    ap.add_argument("--grain-mates", default=None, type=str.lower,
                     choices=["off", "window", "all"],
                     help="conduit model on multi-sphere grains: take the other spheres of a "
-                         "window's grains out of its section, at the window or at every "
-                         "section (docs/validation-grains.md: the bundled wheat bed's Stokes "
-                         "k against resolved flow +7.4 %% off, -1.0 %% window, -13.9 %% all); "
-                         "sphere packings are unchanged")
+                         "window's grains out of its section, at the window (default) or at "
+                         "every section, or leave them in (off) (docs/validation-grains.md: the "
+                         "bundled wheat bed's Stokes k against resolved flow -1.0 %% window, "
+                         "+7.4 %% off, -13.9 %% all); sphere packings are unchanged")
     add_table(ap)
     ap.add_argument("--workers", type=int, default=1, help="processes for FE solves, >= 1")
     ap.add_argument("--threads", type=int, default=available_cores(),
@@ -171,10 +171,10 @@ def _check_inputs(args, axes) -> None:
     check_common(args)
     if args.grain is not None:
         grain_key(args.grain)
-    if args.grain_mates != "off" and args.conductance_model != "conduit":
+    if args.grain_mates not in (None, "off") and args.conductance_model != "conduit":
         raise ValueError(f"--grain-mates {args.grain_mates}: grain mates are taken out of the "
                          f"conduit model's sections; --conductance-model "
-                         f"{args.conductance_model} has none (give --grain-mates off)")
+                         f"{args.conductance_model} has none (leave --grain-mates out or give off)")
     if args.vtk and Path(args.vtk).suffix.lower() not in ("", ".vtu"):
         raise ValueError(f"--vtk {args.vtk}: the writer makes VTK XML (.vtu, read by ParaView "
                          f"and meshio), not legacy VTK; name the file "
@@ -259,7 +259,9 @@ def _main(args) -> int:
         container = None if box else read_container(path)
         regions = {ax: sample_region(packing, box=box, margin=margin, cylinder=args.cylinder,
                                      container=container, axis=ax) for ax in axes}
-        mates = {"grain_mates": args.grain_mates} if args.grain_mates != "off" else None
+        # no --grain-mates: the conduit model's default ('window'), nothing for 'thesis'
+        mates = ({"grain_mates": args.grain_mates}
+                 if args.grain_mates is not None and args.conductance_model == "conduit" else None)
         conductance = ConductanceOptions(model=args.conductance_model, policy=args.policy,
                                          rtol=args.rtol, db=args.db, workers=args.workers,
                                          progress=not args.quiet, model_options=mates)

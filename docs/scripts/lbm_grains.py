@@ -209,7 +209,7 @@ def curve(mask_npz, *, backend="numba", reynolds=(0.1, 5, 10, 20), u_max=0.02, t
     return res
 
 
-def network_rows(ref, policy="table-only", beds=None, grain_mates="off"):
+def network_rows(ref, policy="table-only", beds=None, grain_mates="window"):
     """The network's Stokes k (``permeability_m2``, as ``network.solve`` reports it: the whole
     sample in the grain beds' narrow samples, the inset window in wider ones; the whole sample's
     beside it) and k_app/k at the Reynolds numbers each LBM run obtained, per bed of ``ref``
@@ -281,7 +281,7 @@ def main(argv=None):
     n.add_argument("--json", default=None)
     n.add_argument("--bed", action="append", default=[], metavar="NAME=FILE",
                    help="a bed of the reference that is not bundled (corn=shelled_corn.csv)")
-    n.add_argument("--grain-mates", choices=("off", "window", "all"), default="off",
+    n.add_argument("--grain-mates", choices=("off", "window", "all"), default="window",
                    help="where the conduit model takes grain mates out of the sections "
                         "(network.conductance.conduit_conductance's grain_mates)")
     a = ap.parse_args(argv)

@@ -9,7 +9,7 @@ over the beds:
 .. math:: k_v(\varepsilon) = k_p\,e^{\kappa_1(\varepsilon - \varepsilon_p)}, \qquad
           \beta_v(\varepsilon) = \beta_p\,e^{b_1(\varepsilon - \varepsilon_p)}
 
-(wheat: eight beds, ε 0.376-0.431), the slopes κ_1, b_1 from the beds and the values k_p, β_p
+(wheat: eight beds, ε 0.373-0.425), the slopes κ_1, b_1 from the beds and the values k_p, β_p
 from the Forchheimer fit of the bundled bed's own vertical curve at its porosity ε_p, the bed
 ``network.report`` moves along its band (``network/data/anisotropy_<grain>.json``, which also
 holds the horizontal curve). The horizontal permeability is k_h = a k_v with a = k_x/k_z of

@@ -160,8 +160,8 @@ def measured_band(grain: str) -> dict | None:
 
     The bundled beds' porosities and gradients are fitted here as :func:`pack_band` fits its
     sphere beds (:func:`fit_log_slope`, one family), and the same keys are returned. Sphere beds
-    of the grain's volume-equivalent size give a steeper slope: for wheat -12.8 / -12.4 / -11.6
-    against its grain beds' -10.8 / -10.4 / -9.0 at 0.005 / 0.039 / 0.3 m/s
+    of the grain's volume-equivalent size give a steeper slope: for wheat -11.2 / -10.9 / -10.6
+    against its grain beds' -9.7 / -9.2 / -7.6 at 0.005 / 0.039 / 0.3 m/s
     (``docs/report.md``), so a grain with measured beds uses them.
     """
     path = GRAIN_BANDS.get(grain)

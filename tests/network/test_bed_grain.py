@@ -115,14 +115,15 @@ def test_solve_compares_a_bed_with_its_own_grain(tmp_path, capsys):
 
 
 def test_grain_names_take_spaces_and_any_case(tmp_path, monkeypatch, capsys):
-    """'shelled corn' is shelled_corn: the report gets past the name (and stops at the missing
+    """'Rough Rice' is rough_rice: the report gets past the name (and stops at the missing
     bundled bed of that grain, exit 2, nothing written)."""
     from network._grains import grain_key
     assert grain_key("shelled corn") == grain_key("Shelled_Corn") == "shelled_corn"
+    assert grain_key("rough rice") == grain_key("Rough_Rice") == "rough_rice"
     monkeypatch.chdir(tmp_path)
-    assert report_main(["--grain", "shelled corn", "--particle-density", "1300", "-q"]) == 2
+    assert report_main(["--grain", "Rough Rice", "--particle-density", "1300", "-q"]) == 2
     err = capsys.readouterr().err
-    assert "unknown grain" not in err and "shelled_corn" in err
+    assert "unknown grain" not in err and "no bundled packing for rough_rice" in err
     assert list(tmp_path.iterdir()) == []
 
 

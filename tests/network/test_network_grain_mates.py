@@ -75,6 +75,16 @@ def test_grain_mates_lower_only_the_conduits_they_cut():
     assert np.array_equal(win[ok & ~cut], off[ok & ~cut])
 
 
+def test_the_default_takes_the_mates_out_of_the_windows():
+    # conduit_conductance's default is 'window': equal to it to the last bit, and it cuts
+    t = tessellate(_sub_bed(20))
+    default = conduit_conductance(t, policy="table-only")
+    win = conduit_conductance(t, policy="table-only", grain_mates="window")
+    assert default.stats["grain_mates"]["mode"] == "window"
+    assert default.stats["grain_mates"]["n_windows_cut"] > 0
+    assert np.array_equal(default.g, win.g)
+
+
 def test_compiled_window_loop_equals_the_numpy_path():
     # the window factors by the compiled loop (what conduit_conductance uses) against the
     # numpy path (grain_mates at the face plane, the circle test, throats.section_ratio)
@@ -102,3 +112,13 @@ def test_solve_refuses_grain_mates_with_the_thesis_model(capsys):
                  "--conductance-model", "thesis", "-q"]) == 2
     err = capsys.readouterr().err
     assert "error: --grain-mates window" in err and "thesis" in err
+
+
+def test_solve_takes_window_for_the_conduit_model_and_nothing_for_the_thesis_model():
+    from network.solve import _check_inputs, build_parser
+
+    args = build_parser().parse_args(["network/data/soybean_grains.csv"])
+    assert args.grain_mates is None and args.conductance_model == "conduit"
+    thesis = build_parser().parse_args(["network/data/soybean_grains.csv",
+                                        "--conductance-model", "thesis"])
+    _check_inputs(thesis, ["z"])       # the default asks for no mates of the thesis model
