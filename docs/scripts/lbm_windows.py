@@ -86,15 +86,17 @@ def run_field(bed, resolution, *, tau=1.5, max_steps=12000, tol=1e-5, log=print)
 
 
 def _network(bed):
-    """Tessellation, the conduit network's Stokes solution in the sample box (table-only)."""
+    """Tessellation, the conduit network's Stokes solution in the sample box (table-only, the
+    grain mates left in the sections: the model the per-conduit comparison measures)."""
     from network import tessellate
     from network.flow import ConductanceOptions, SampleOptions, solve_network
     from network.packing import read_container, read_packing
 
     pk = read_packing(bed)
     tess = tessellate(pk)
+    off = ConductanceOptions(policy="table-only", model_options={"grain_mates": "off"})
     res = solve_network(pk, axis="z", sample=SampleOptions(container=read_container(bed)),
-                        conductance=ConductanceOptions(policy="table-only"), tessellation=tess)
+                        conductance=off, tessellation=tess)
     return pk, tess, res
 
 
@@ -319,7 +321,8 @@ def intrusion_report(bed, log=print):
     tr = tess.throat_radii.copy()
     tr[th] = r_new
     res2 = solve_network(pk, axis="z", sample=SampleOptions(container=read_container(bed)),
-                         conductance=ConductanceOptions(policy="table-only"),
+                         conductance=ConductanceOptions(policy="table-only",
+                                                        model_options={"grain_mates": "off"}),
                          tessellation=dataclasses.replace(tess, throat_radii=tr))
     out["window_area_removed"] = removed
     out["k_equivalent_disks_m2"] = res2.permeability_whole_m2
@@ -337,7 +340,7 @@ def intrusion_report(bed, log=print):
         from network.conductance import conduit_conductance
 
         def fn(tt, ids):
-            cr = conduit_conductance(tt, ids, policy="table-only")
+            cr = conduit_conductance(tt, ids, policy="table-only", grain_mates="off")
             gg = np.asarray(cr.g).copy()
             if on:
                 rr = np.array([rmap.get(i, 1.0) for i in np.asarray(ids).tolist()])
