@@ -30,6 +30,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from ._freeze import ActiveRegion
 from ._grain_kernels import grain_poses, grain_update
 from ._integrate import DemInstabilityError, Simulation
 from ._material import SOYBEAN, Material
@@ -184,7 +185,6 @@ class ClumpSimulation(Simulation):
         """Step the active grains only, with per-sphere neighbour rows (:class:`dem._freeze.ActiveRegion`,
         box ``lo_m``-``hi_m`` of its cell grid, rows for ``capacity`` spheres); ``policy``
         (:class:`dem._freeze.FreezePolicy`) freezes and releases grains at each check of :meth:`run`."""
-        from ._freeze import ActiveRegion
         self.active = ActiveRegion(self, capacity=capacity, lo_m=lo_m, hi_m=hi_m)
         self.active.policy = policy
         return self.active

@@ -21,11 +21,14 @@ constants were not found has ``a = b = None`` and a note. Grain names are those 
 from __future__ import annotations
 
 import json
+import math
 import logging
 from dataclasses import dataclass
 from pathlib import Path
 
-__all__ = ["D272Constants", "D272", "GRAIN_ALIASES", "HUKILL_IVES_RANGE_M_S", "d272_constants",
+import numpy as np
+
+__all__ = ["G_M_S2", "JANSSEN", "janssen_stress", "D272Constants", "D272", "GRAIN_ALIASES", "HUKILL_IVES_RANGE_M_S", "d272_constants",
            "d272_line", "d272_velocity_range", "grain_key", "packing_grain", "template_grain",
            "grains_with_d272",
            "BedProperties", "BED"]
@@ -299,3 +302,37 @@ def packing_grain(path, given=None, *, default=None, option: str = "--grain") ->
         log.warning("%s %s: taken to be %s (%s); its D272 line and grain data are %s's", path,
                     what, key, src, key)
     return key
+
+
+#: standard gravity, m/s²
+G_M_S2 = 9.80665
+
+#: Janssen's inputs (lateral pressure ratio K, bulk-on-smooth-steel wall friction mu_w): copies of
+#: dem.grains' lateral_pressure_ratio and wall_friction_steel (EN 1991-4:2006 Annex E Table E.1;
+#: canola: Jaky's K from its angle of internal friction), checked against it by the tests
+JANSSEN = {
+    "soybean": (0.63, 0.38),
+    "wheat": (0.54, 0.38),
+    "shelled_corn": (0.53, 0.36),
+    "barley": (0.59, 0.33),
+    "canola": (1.0 - math.sin(math.radians(23.91)), 0.301),
+}
+
+
+def janssen_stress(depth_m, *, bulk_density_kg_m3, diameter_m, wall_friction, lateral_ratio):
+    r"""Janssen's vertical stress, Pa, at depth h below the surface of a round bin:
+
+    .. math:: \sigma_v(h) = \frac{\rho_b g R_h}{\mu_w K}\big(1 - e^{-\mu_w K h/R_h}\big),
+              \qquad R_h = B/4,
+
+    μ_w the grain-wall friction coefficient, K the lateral-to-vertical stress ratio.
+
+    >>> s = janssen_stress(1e-6, bulk_density_kg_m3=750.0, diameter_m=8.0, wall_friction=0.4,
+    ...                    lateral_ratio=0.5)
+    >>> round(float(s / (750.0 * G_M_S2 * 1e-6)), 6)   # hydrostatic near the surface
+    1.0
+    """
+    rh = diameter_m / 4.0
+    c = wall_friction * lateral_ratio / rh
+    h = np.asarray(depth_m, dtype=float)
+    return bulk_density_kg_m3 * G_M_S2 / c * -np.expm1(-c * h)

@@ -216,10 +216,10 @@ def _geometries(verts, r, delta, feature_width, robust):
                                                            robust)
     res = region_boundary(verts, verts, r, la, lb, owner, present, rects,
                           extra_lt=xl, extra_cu=xc)
-    return [_extract(res, verts, r, q) for q in range(r.shape[0])]
+    return [extract_section(res, verts, r, q) for q in range(r.shape[0])]
 
 
-def _extract(res, verts, radii, q):
+def extract_section(res, verts, radii, q):
     """Pieces of throat q → points, curves, loops (small per-throat work)."""
     tol = 1e-9
     pieces = []   # (kind, p0, p1, center, radius, bc)

@@ -21,7 +21,8 @@ import numpy as np
 
 from ._boundary import region_boundary
 from ._geometry import triangle_area, triangle_vertices
-from ._mesh import DELTA_DEFAULT, _extract
+from ._mesh import DELTA_DEFAULT, extract_section
+from ._solve import solve_geometry
 
 __all__ = ["NARROW_FRACTION", "section_area_perimeter", "section_fem", "section_geometry",
            "section_ratio", "shape_factor_ratio", "sub_triangle_centroids"]
@@ -77,7 +78,7 @@ def section_geometry(sides, centers, radii):
     s, c, r = _prepare(sides, centers, radii)
     verts = triangle_vertices(s)
     res = region_boundary(verts, c, np.maximum(r, 1e-300))
-    return [_extract(res, c, r, q) for q in range(s.shape[0])]
+    return [extract_section(res, c, r, q) for q in range(s.shape[0])]
 
 
 def section_fem(sides, centers, radii, *, rtol=1e-3):
@@ -101,8 +102,6 @@ def section_fem(sides, centers, radii, *, rtol=1e-3):
     q : (N,) ndarray
     status : list of str ('ok', 'closed', 'failed')
     """
-    from ._solve import _solve_geometry
-
     s, c, r = _prepare(sides, centers, radii)
     ell = np.sqrt(2.0 * triangle_area(s))[:, None]
     geoms = section_geometry(s / ell, c / ell[:, :, None], r / ell)
@@ -110,7 +109,7 @@ def section_fem(sides, centers, radii, *, rtol=1e-3):
     status = []
     for k, g in enumerate(geoms):
         try:
-            qq, _, _, st, _ = _solve_geometry(g, rtol, delta=DELTA_DEFAULT)
+            qq, _, _, st, _ = solve_geometry(g, rtol, delta=DELTA_DEFAULT)
         except Exception:       # one section's mesh failure does not stop the others
             qq, st = np.nan, "failed"
         q[k] = qq * ell[k, 0] ** 4 if st in ("ok", "closed") else np.nan

@@ -255,7 +255,7 @@ def _h_for_rtol(rtol, area=0.0):
     return float(np.clip(0.6 * s, 0.05, 1.0)) * grow, float(np.clip(0.5 * s, 0.08, 0.8))
 
 
-def _solve_geometry(geom, rtol, *, max_refine=2, delta=DELTA_DEFAULT):
+def solve_geometry(geom, rtol, *, max_refine=2, delta=DELTA_DEFAULT):
     """Q*, error estimate, element count, status, message for one ThroatGeometry.
 
     A region that the closing rule leaves smaller than ``delta``² (every passage narrower
@@ -335,7 +335,7 @@ def _solve_chunk(radii, sides, rtol, delta):
     for g, d in zip(geoms, widths):
         t0, c0 = time.perf_counter(), time.process_time()
         try:
-            res = _solve_geometry(g, rtol, delta=float(d))
+            res = solve_geometry(g, rtol, delta=float(d))
         except Exception as exc:   # never raise for one throat
             res = (np.nan, np.nan, 0, "failed", f"{type(exc).__name__}: {exc}")
         out.append(res + (time.perf_counter() - t0, time.process_time() - c0))

@@ -36,7 +36,7 @@ from pathlib import Path
 
 import numpy as np
 
-from .._grains import BED, D272
+from .._grains import BED, D272, G_M_S2, JANSSEN, janssen_stress
 from ..core import read_table
 from ..report.porosity import requested_porosity
 from ._law import ForchheimerLaw, SheddLaw
@@ -45,7 +45,6 @@ __all__ = ["ANGLE_OF_REPOSE", "JANSSEN", "Material", "network_material", "d272_m
            "read_profile", "janssen_stress", "PorosityProfile", "G_M_S2"]
 
 DATA = Path(__file__).resolve().parent.parent / "data"
-G_M_S2 = 9.80665
 
 _EN = ("EN 1991-4:2006 Annex E Table E.1, angle of repose phi_r, as the grain library records it "
        "(dem.grains, the note of internal_friction_deg, with the table's transcription as source)")
@@ -60,16 +59,7 @@ ANGLE_OF_REPOSE = {
     "shelled_corn": (35.0, f"{_EN}: 'Maize' row; {_FARM}"),
     "barley": (31.0, f"{_EN}: 'Barley' row; {_FARM}"),
 }
-#: Janssen's inputs (lateral pressure ratio K, bulk-on-smooth-steel wall friction mu_w): copies of
-#: dem.grains' lateral_pressure_ratio and wall_friction_steel (EN 1991-4:2006 Annex E Table E.1;
-#: canola: Jaky's K from its angle of internal friction), checked against it by the tests
-JANSSEN = {
-    "soybean": (0.63, 0.38),
-    "wheat": (0.54, 0.38),
-    "shelled_corn": (0.53, 0.36),
-    "barley": (0.59, 0.33),
-    "canola": (1.0 - math.sin(math.radians(23.91)), 0.301),
-}
+
 
 
 @dataclass(frozen=True)
@@ -132,25 +122,6 @@ def read_profile(path, option: str = "--porosity-profile") -> tuple[np.ndarray, 
     if len(xs) == 1:
         xs, ys = [xs[0], xs[0] + 1.0], [ys[0], ys[0]]
     return np.array(xs), np.array(ys)
-
-
-def janssen_stress(depth_m, *, bulk_density_kg_m3, diameter_m, wall_friction, lateral_ratio):
-    r"""Janssen's vertical stress, Pa, at depth h below the surface of a round bin:
-
-    .. math:: \sigma_v(h) = \frac{\rho_b g R_h}{\mu_w K}\big(1 - e^{-\mu_w K h/R_h}\big),
-              \qquad R_h = B/4,
-
-    μ_w the grain-wall friction coefficient, K the lateral-to-vertical stress ratio.
-
-    >>> s = janssen_stress(1e-6, bulk_density_kg_m3=750.0, diameter_m=8.0, wall_friction=0.4,
-    ...                    lateral_ratio=0.5)
-    >>> round(float(s / (750.0 * G_M_S2 * 1e-6)), 6)   # hydrostatic near the surface
-    1.0
-    """
-    rh = diameter_m / 4.0
-    c = wall_friction * lateral_ratio / rh
-    h = np.asarray(depth_m, dtype=float)
-    return bulk_density_kg_m3 * G_M_S2 / c * -np.expm1(-c * h)
 
 
 @dataclass(frozen=True)

@@ -24,6 +24,11 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from throats import (NARROW_FRACTION, section_ratio, shape_factor_ratio, sub_triangle_centroids,
+                     triangle_vertices)
+
+from ._mates_kernel import compiled_window_rows
+
 __all__ = ["MateDisks", "candidates", "grain_mates", "mate_radii", "section_factors",
            "window_factors", "window_factors_compiled"]
 
@@ -194,7 +199,6 @@ def _live(mates, rho, V, rv, n_angles=16):
 
 def _ratio(mates, rho, live, s3, rv, n):
     """:func:`throats.section_ratio` of the rows with a live mate (others 1)."""
-    from throats import section_ratio
 
     f = np.ones(rho.shape[0])
     sec = np.flatnonzero(live.any(axis=1))
@@ -214,7 +218,6 @@ def window_factors(mates, radii, sides, *, n=16):
     r"""Flow rate of the conduits' windows with their grain mates relative to the three-disk
     windows (:func:`throats.section_ratio`), (M,) for the M rows of ``mates``; 1 where no
     mate takes area from the window. ``radii``, ``sides`` (M, 3): the faces'."""
-    from throats import triangle_vertices
 
     V = triangle_vertices(sides)
     rho = mate_radii(mates, np.zeros(mates.rows.size))                      # (M, E)
@@ -226,9 +229,7 @@ def window_factors_compiled(packing, vertices, *, n=16, n_angles=16, max_live=32
     the compiled loop of :mod:`._mates_kernel` (the mates, the circle test and the
     distance-squared rule per window), the narrow windows by
     :func:`throats.shape_factor_ratio`: (N,) factors, 1 where no mate takes area."""
-    from throats import NARROW_FRACTION, shape_factor_ratio, sub_triangle_centroids
 
-    from ._mates_kernel import compiled_window_rows
 
     tv = np.ascontiguousarray(vertices, dtype=np.int64)
     n_w = tv.shape[0]
@@ -267,7 +268,6 @@ def section_factors(mates, rows, h_nodes, signs, radii, sides, *, n=16):
     The vertex disks are floored at 2e-2 of the shortest side, as the conduit model's
     sections are.
     """
-    from throats import triangle_vertices
 
     m1 = h_nodes.shape[1]
     out = np.ones((h_nodes.shape[0], 2, m1))

@@ -7,7 +7,7 @@ the same poured state) is reported layer by layer. The vertical stress at depth 
 .. math:: \sigma_v(z) = \frac{\rho_b g B}{4 \mu_w K}\left(1 - e^{-4 \mu_w K z / B}\right),
 
 with the grain library's wall friction μ_w and lateral pressure ratio K (copies,
-``network.bin._material.JANSSEN``) and ρ_b = ρ_p (1 - ε_0) from the kernel density and the
+``network._grains.JANSSEN``) and ρ_b = ρ_p (1 - ε_0) from the kernel density and the
 surface bed's porosity ε_0 (network's sample region, as ``dem.pack --depth`` takes it). Each bed
 of the set is solved by the network (inertial, both directions) at the bin velocities; its
 porosity ε_i and pressure gradients g_i(U) are interpolated **linearly in stress** between the
@@ -50,6 +50,9 @@ from pathlib import Path
 import numpy as np
 
 from .._cli import EXIT_BAD_INPUT, EXIT_FAILED, CliError
+from .._grains import BED, JANSSEN, janssen_stress
+from ..flow import asabe_d272_gradient
+from .bed import TEMPLATE_GRAINS
 from .porosity import DATA_DIR, packing_meta
 
 __all__ = ["BED_SET_STRESSES_PA", "BUNDLED_SETS", "BIN_SOLVES", "N_LAYERS", "STRESS_TOL", "bed_set_files",
@@ -152,13 +155,11 @@ def layers_in_series(depth_m: float, gradient_of_depth, n: int = N_LAYERS) -> fl
 
 
 def janssen_inputs(grain: str):
-    """(K, μ_w) of the grain library (``network.bin._material.JANSSEN``), or None."""
-    from ..bin._material import JANSSEN
+    """(K, μ_w) of the grain library (``network._grains.JANSSEN``), or None."""
     return JANSSEN.get(grain)
 
 
 def _janssen(z, rho_b, diameter_m, k_lat, mu_w):
-    from ..bin._material import janssen_stress
     return janssen_stress(z, bulk_density_kg_m3=rho_b, diameter_m=diameter_m,
                           wall_friction=mu_w, lateral_ratio=k_lat)
 
@@ -166,8 +167,6 @@ def _janssen(z, rho_b, diameter_m, k_lat, mu_w):
 def set_box(grain: str) -> tuple[float, float, float]:
     """The cube (lx, ly, h m) of a bed set packed on first use: :data:`SET_GRAINS` kernels of
     the grain's volume at its loose-fill solid fraction (0.6 without one), side rounded to mm."""
-    from .bed import TEMPLATE_GRAINS
-    from .._grains import BED
     if grain not in TEMPLATE_GRAINS:
         raise ValueError(f"{grain} has no dem template")
     vol = _TEMPLATE_VOLUME_M3[grain]
@@ -231,7 +230,6 @@ def plan_bin_beds(grain: str, *, depth_m: float, diameter_m, depth_given: bool,
     if other is not None:
         return {"used": False, "why": f"{other} asks for one bed: the report is for that bed "
                                       "alone, not the bin's beds"}
-    from .bed import TEMPLATE_GRAINS
     beds = bed_set_files(grain, data_dir)
     plan = {"used": True, "grain": grain, "k_lat": jk[0], "mu_w": jk[1], "bed_dir": str(bed_dir),
             "depth_m": float(depth_m), "diameter_m": float(diameter_m),
@@ -261,7 +259,6 @@ def _surface_porosity(plan) -> tuple[float, str]:
         e = meta.get("porosity_network_region")
         if isinstance(e, (int, float)) and 0 < e < 1:
             return float(e), f"the surface bed's own ({plan['beds'][0][1].name})"
-    from .._grains import BED
     e = BED[plan.get("grain", "")].loose_fill_porosity if plan.get("grain") in BED else None
     return (0.4 if e is None else float(e)), "the grain's loose-fill porosity (set not yet packed)"
 
@@ -383,7 +380,6 @@ def bin_section(plan: dict, solved: list[dict], velocities, d272) -> dict:
                "horizontal_to_vertical": dpx_mean / (dp / H),
                "converged": bool(all(b["converged"][j] for b in solved))}
         if d272 is not None:
-            from ..flow import asabe_d272_gradient
             g = float(asabe_d272_gradient(u, a=d272[0], b=d272[1]))
             row["d272_pressure_drop_pa"] = g * H
             row["ratio_to_d272"] = dp / (g * H)
@@ -396,7 +392,7 @@ def bin_section(plan: dict, solved: list[dict], velocities, d272) -> dict:
         "janssen": {"lateral_ratio_K": k_lat, "wall_friction_mu_w": mu_w,
                     "bulk_density_kg_m3": rho_b, "bulk_density_porosity": e0,
                     "bulk_density_porosity_source": e0_src,
-                    "source": "network.bin._material.JANSSEN (copies of the grain library's "
+                    "source": "network._grains.JANSSEN (copies of the grain library's "
                               "lateral_pressure_ratio and wall_friction_steel)"},
         "stress_pa": st, "porosity": por, "porosity_depth_mean": mean_eps,
         "beds": [{"stress_pa": b["stress_pa"], "path": _name(b["path"]), "porosity": b["porosity"],

@@ -17,7 +17,7 @@ from .._cli import available_cores
 from .._grains import D272, d272_velocity_range
 from ..flow import (INERTIAL_LAW, FlowOptions, SampleOptions, asabe_d272_gradient, ergun_gradient,
                     fit_curve, inset_window, solve_network)
-from ..packing import read_container
+from ..packing import read_container, read_packing
 from ..pores import region_porosity, sample_region
 from .band import BAND_OFFSETS, band_gradients, measured_band, pack_band, slope_at
 from .bed import user_bed_json
@@ -63,7 +63,6 @@ def _points(res):
 def solve_bin_bed(o: ReportOptions, path, us) -> dict:
     """One bed of the bin's set solved at velocities ``us`` in both directions: its porosity
     (where k is measured, as the report's own) and gradients, Pa/m."""
-    from ..packing import read_packing
     packing = read_packing(path)
     container = None if o.sample_box_m else read_container(path)
     rz = _solve(o, packing, container, "z", us)

@@ -6,7 +6,7 @@ import pytest
 from throats import SOLVER_VERSION, canonical_form, solve_fem
 from throats._mesh import ThroatGeometry, build_geometries, disk_geometry, polygon_geometry
 from throats._trimesh import mesh_geometry
-from throats._solve import _fe_solve, _solve_geometry
+from throats._solve import _fe_solve, solve_geometry
 
 PERMS = [(0, 1, 2), (0, 2, 1), (1, 0, 2), (1, 2, 0), (2, 0, 1), (2, 1, 0)]
 PAIR = {(0, 1): 0, (1, 0): 0, (0, 2): 1, (2, 0): 1, (1, 2): 2, (2, 1): 2}
@@ -23,7 +23,7 @@ def q_raw(r, s, rtol=1e-4, **kw):
     s = np.asarray([s], dtype=float)
     rbar = r.mean()
     g = build_geometries(r / rbar, s / rbar, **kw)[0]
-    return _solve_geometry(g, rtol)
+    return solve_geometry(g, rtol)
 
 
 def test_solver_version_is_a_string():
@@ -32,7 +32,7 @@ def test_solver_version_is_a_string():
 
 def test_circle_duct_pi_over_8():
     # Hagen-Poiseuille: u = (1 - r^2)/4, Q* = pi/8 for the unit circle (DESIGN.md)
-    q, est, n, status, _ = _solve_geometry(disk_geometry(1.0), 1e-4)
+    q, est, n, status, _ = solve_geometry(disk_geometry(1.0), 1e-4)
     assert status == "ok"
     err = abs(q / (np.pi / 8) - 1)
     assert err < 5e-4          # <= 0.05 %
@@ -43,7 +43,7 @@ def test_equilateral_triangle_duct():
     # Saint-Venant: u = cubic, Q* = sqrt(3) a^4 / 320 (DESIGN.md), side a = 1.7
     a = 1.7
     v = np.array([[0, 0], [a, 0], [a / 2, a * np.sqrt(3) / 2]])
-    q, est, n, status, _ = _solve_geometry(polygon_geometry(v), 1e-3)
+    q, est, n, status, _ = solve_geometry(polygon_geometry(v), 1e-3)
     assert status == "ok"
     assert q == pytest.approx(np.sqrt(3) * a**4 / 320, rel=5e-4)
 
@@ -153,7 +153,7 @@ def test_lost_piece_is_detected():
     # a geometry whose exact area disagrees with what gets meshed must not pass silently
     g = build_geometries([[1, 1, 1]], [[2.2, 2.2, 2.2]])[0]
     wrong = ThroatGeometry(g.points, g.lfs, g.curves, g.loops, 1.2 * g.area)
-    q, est, n, status, msg = _solve_geometry(wrong, 1e-3)
+    q, est, n, status, msg = solve_geometry(wrong, 1e-3)
     assert status == "failed" and np.isnan(q) and "lost" in msg
 
 
@@ -238,11 +238,11 @@ def test_other_gmsh_users_in_the_process_do_not_change_q():
     # first-order elements and a tiny size cap, then finalizes, must not change our answer
     import gmsh
 
-    q0 = _solve_geometry(disk_geometry(1.0), 1e-4)[0]
+    q0 = solve_geometry(disk_geometry(1.0), 1e-4)[0]
     gmsh.option.setNumber("Mesh.ElementOrder", 1)
     gmsh.option.setNumber("Mesh.MeshSizeMax", 1e-3)
-    q1 = _solve_geometry(disk_geometry(1.0), 1e-4)[0]
+    q1 = solve_geometry(disk_geometry(1.0), 1e-4)[0]
     gmsh.finalize()
-    q2 = _solve_geometry(disk_geometry(1.0), 1e-4)[0]
+    q2 = solve_geometry(disk_geometry(1.0), 1e-4)[0]
     assert abs(q0 - np.pi / 8) < 1e-4 * np.pi / 8
     assert q1 == q0 and q2 == q0
