@@ -52,7 +52,8 @@ from ._grain_search import grain_count, pack_grains_to_porosity
 from ._contacts import damping_ratio_for_restitution
 from ._load import MAX_STRESS_PA, janssen_stress, load_bed
 from ._reach import count_porosity
-from ._pour import FILL_METHODS, FillOptions, check_fill_options, poured_bed_summary, pour_grains, rest_steps
+from ._pile import poured_bed_summary
+from ._pour import FILL_METHODS, FillOptions, check_fill_options, pour_grains, rest_steps
 from ._procedures import PROCEDURES, PackOptions, RunOptions, pack_bed
 from .grains import grain
 from .templates import resolve_template

@@ -10,8 +10,8 @@ import numpy as np
 import pytest
 
 from dem import Container, FillOptions, Material, janssen_stress, load_bed, pour_grains
-from dem._pour import (AIR_DENSITY_KG_M3, DRAG_COEFFICIENT, _grown, angle_of_repose, default_rate,
-                       entry_speed, orientation_order, porosity_by_depth, terminal_velocity)
+from dem._pile import angle_of_repose, orientation_order, porosity_by_depth
+from dem._pour import AIR_DENSITY_KG_M3, DRAG_COEFFICIENT, _grown, default_rate, entry_speed, terminal_velocity
 from dem._rigid import random_quaternions
 from dem.clumps import ClumpSimulation
 from dem.pack import main
