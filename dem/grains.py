@@ -11,8 +11,10 @@ moisture series, the value kept is the low-moisture end (storage-dry grain, the 
 ASABE D272 airflow data) and the note gives the series. Where sources disagree the choice and the
 reason are in the note and in ``docs/grain-library.md``. Kernel axes are length x width x
 thickness in mm; densities kg/m^3; porosity a fraction; friction and restitution dimensionless.
-``friction_pp``/``restitution_pp`` are grain-grain contacts, ``*_pw`` grain-wall (the wall
-material is named in the note). The D272 airflow constants live in ``network/_grains.py``
+``friction_pp``/``restitution_pp``/``rolling_friction_pp`` are grain-grain contacts, ``*_pw``
+grain-wall (the wall material is named in the note). ``rolling_friction_*`` is the dimensionless
+coefficient of rolling friction of a DEM calibration (the torque model it belongs to is in
+``docs/dem-fill.md``, section Rolling friction). The D272 airflow constants live in ``network/_grains.py``
 (DESIGN: network owns the empirical equations), under the same grain names.
 
 Bin loads. The vertical stress at depth z of a round bin of diameter D (Janssen):
@@ -56,6 +58,11 @@ class Sourced:
             raise ValueError(f"a missing value needs a note saying so (source {self.source!r})")
 
 
+#: what was searched for a coefficient of rolling friction (pages corpus, by crop)
+_ROLL_SEARCH = ("DEM calibration abstracts of this crop with rolling friction (pages corpus: "
+                "'<crop> DEM calibration rolling friction coefficient angle of repose'): none gave a value")
+
+
 def _missing(what: str, searched: str) -> Sourced:
     return Sourced(None, "not found", f"no source found for {what}; searched: {searched}")
 
@@ -95,13 +102,21 @@ class Grain:
     #: measured loose-fill bulk density (low, high) over the source's moisture series, kg/m^3
     bulk_density_kg_m3: Sourced = Sourced(None, "not found", "the abstracts found for this crop give no "
                                           "bulk density")
+    #: grain-grain coefficient of rolling friction of a DEM calibration (mu_r of the rolling torque
+    #: mu_r F_n R, docs/dem-fill.md); not found: the DEM runs without rolling friction
+    rolling_friction_pp: Sourced = Sourced(None, "not found", "no source found for a grain-grain "
+                                           "coefficient of rolling friction; searched: " + _ROLL_SEARCH)
+    #: grain-wall coefficient of rolling friction of the same calibration (wall material in the note)
+    rolling_friction_pw: Sourced = Sourced(None, "not found", "no source found for a grain-wall "
+                                           "coefficient of rolling friction; searched: " + _ROLL_SEARCH)
 
 
 #: the Sourced fields of :class:`Grain`, in order
 GRAIN_FIELDS = ("axes_mm", "axes_sd_mm", "particle_density_kg_m3", "bulk_porosity",
                 "friction_pp", "friction_pw", "restitution_pp", "restitution_pw",
                 "lateral_pressure_ratio", "internal_friction_deg", "wall_friction_steel",
-                "wall_friction_corrugated", "bulk_unit_weight_kn_m3", "bulk_density_kg_m3")
+                "wall_friction_corrugated", "bulk_unit_weight_kn_m3", "bulk_density_kg_m3",
+                "rolling_friction_pp", "rolling_friction_pw")
 
 _SD_SEARCH = "the abstracts found report means/ranges only, no standard deviations"
 _THESIS = ("thesis Table 3.1 (seed/thesis.txt; PFC parameters reported by Liu et al. 2008a; "
@@ -158,6 +173,11 @@ _EN1991_WHEAT = ("EN 1991-4:2006 (Eurocode 1, Actions on silos and tanks) Annex 
                  "(mean values), as tabulated in Studia Geotechnica et Mechanica 2018, "
                  "doi:10.2478/sgem-2018-0043; https://reference-global.com/article/10.2478/sgem-2018-0043")
 _DEM_SEARCH = "DEM calibration abstracts (pages corpus) for this crop gave no value"
+_MAIZE_ROLL = ("the polyhedral maize calibration (Agriculture, Sep 2024) has no rolling friction; 'DEM "
+               "Parameter Calibration of Maize Seeds and the Effect of Rolling Friction', Processes "
+               "9(6):914 (2021, https://mdpi.com/2227-9717/9/6/914) and 'Modeling of Typically Shaped Corn "
+               "Seeds and Calibration of the Coefficient of Rolling Friction', Agronomy 13(6):1573 (2023, "
+               "https://www.mdpi.com/2073-4395/13/6/1573): the stored abstracts give no value")
 _EN_E1 = ("EN 1991-4:2006 (Eurocode 1, Actions on silos and tanks) Annex E Table E.1, mean values and "
           "conversion factors, as transcribed in the 'particles' sheet of @Silo/constants.xls of the sandTES "
           "Engineering Manual software (S. Thanheiser, TU Wien 2023, GPL-3.0, doi:10.5281/zenodo.10207330; "
@@ -213,6 +233,13 @@ GRAINS: dict[str, Grain] = {
         bulk_unit_weight_kn_m3=Sourced((7.0, 8.0), _EN_E1, "'Soya beans' row: gamma_l 7.0, gamma_u 8.0"),
         bulk_density_kg_m3=Sourced((644.4, 749.1), _WANDKAR, "749.1 at 7.37 % d.b. to 644.4 at 15.80 %; "
                                    "Kibar 2008: 766.12-719.00 over 8-16 %"),
+        rolling_friction_pp=Sourced(0.05, _BOAC, "particle coefficient of rolling friction of the best "
+                                    "(single-sphere) soybean model, calibrated with its static friction "
+                                    "0.45 (soybean-soybean), 0.30 (soybean-steel) and restitution 0.6 "
+                                    "against bulk density and angle of repose"),
+        rolling_friction_pw=_missing("a soybean-wall coefficient of rolling friction",
+                                     "Boac 2010 abstract gives one particle coefficient of rolling "
+                                     "friction (0.05), no soybean-steel value"),
     ),
     "wheat": Grain(
         "wheat",
@@ -245,6 +272,12 @@ GRAINS: dict[str, Grain] = {
         bulk_density_kg_m3=Sourced((538.8, 740.0), _WHEAT_PROPS, "740 at 0 % to 538.8 kg/m^3 at 22 % d.b. "
                                    "(rewetted wheat); 1 - 740/1240 = 0.403, inside Ramaj's in-bin "
                                    "porosity range"),
+        rolling_friction_pp=Sourced(0.04, _WHEAT_DEM, "wheat-wheat, calibrated with static friction 0.53 "
+                                    "and restitution 0.52 against the angle of repose (simulated 26.83-"
+                                    "27.57 deg, no significant difference from the measured); the "
+                                    "abstract names neither the DEM software nor the rolling model"),
+        rolling_friction_pw=Sourced(0.111, _WHEAT_DEM, "wheat-steel (static friction 0.5023, restitution "
+                                    "0.47); wheat-rubber 0.137"),
     ),
     "shelled_corn": Grain(
         "shelled_corn",
@@ -270,6 +303,8 @@ GRAINS: dict[str, Grain] = {
         bulk_unit_weight_kn_m3=Sourced((7.0, 8.0), _EN_E1, "'Maize' row: gamma_l 7.0, gamma_u 8.0"),
         bulk_density_kg_m3=Sourced((709.50, 746.00), _CORN_DARFOUR, "five varieties and the moisture "
                                    "series; with the true density 1250: porosity 0.4324-0.4032"),
+        rolling_friction_pp=_missing("a maize grain-grain coefficient of rolling friction", _MAIZE_ROLL),
+        rolling_friction_pw=_missing("a maize-wall coefficient of rolling friction", _MAIZE_ROLL),
     ),
     "barley": Grain(
         "barley",

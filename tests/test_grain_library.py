@@ -25,6 +25,8 @@ BOUNDS = {
     "wall_friction_corrugated": (0.1, 1.0),
     "bulk_unit_weight_kn_m3": (5.0, 10.0),
     "bulk_density_kg_m3": (500.0, 900.0),
+    "rolling_friction_pp": (0.001, 0.5),
+    "rolling_friction_pw": (0.001, 0.5),
 }
 
 
@@ -273,3 +275,20 @@ def test_dem_pack_takes_janssen_inputs_from_the_library():
     for name in ("rough_rice", "sorghum"):
         with pytest.raises(ValueError, match=f"no lateral pressure ratio K nor angle of internal friction for {name}"):
             _janssen_inputs(name)
+
+
+def test_rolling_friction_is_the_calibrations_value_or_none_with_a_note():
+    """Wheat: INMATEH 78(1) 2026 (0.04 wheat-wheat, 0.111 wheat-steel, the calibration of its
+    friction 0.53 / 0.5023); soybean: Boac et al. 2010's single-sphere model (0.05, no wall value);
+    every other grain None, with what was searched."""
+    w, s = grain("wheat"), grain("soybean")
+    assert w.rolling_friction_pp.value == 0.04 and w.rolling_friction_pw.value == 0.111
+    assert w.rolling_friction_pp.source == w.friction_pp.source == w.rolling_friction_pw.source
+    assert "inmateh-78-73" in w.rolling_friction_pp.source and "wheat-steel" in w.rolling_friction_pw.note
+    assert s.rolling_friction_pp.value == 0.05 and "Boac" in s.rolling_friction_pp.source
+    assert s.rolling_friction_pw.value is None and "0.05" in s.rolling_friction_pw.note
+    for name in ("shelled_corn", "barley", "rough_rice", "canola", "sorghum"):
+        for field in ("rolling_friction_pp", "rolling_friction_pw"):
+            v = getattr(grain(name), field)
+            assert v.value is None and v.source == "not found" and "searched" in v.note, (name, field)
+    assert "Processes 9(6):914" in grain("shelled_corn").rolling_friction_pp.note
