@@ -31,12 +31,8 @@ written) or stopped at the step limit before equilibrium (written, marked ``"con
 from __future__ import annotations
 
 import argparse
-import contextlib
-import copy
 import math
 import sys
-import time
-from dataclasses import replace
 from pathlib import Path
 
 import numpy as np
@@ -45,15 +41,13 @@ from network.core import check_physical_porosity, recorded_reach
 from ._cli import (EXIT_FAILED, OneLineParser, check_counts, check_output, check_seed, progress_printer,
                    resolve_container, run_main)
 from ._container import SCENE_DEFAULTS, SCENES, default_measure_spheres
-from ._material import Material
 from ._io import summary_path, write_packing
 from ._clump_pack import grains_path, pack_grains, write_grain_packing
 from ._grain_search import grain_count, pack_grains_to_porosity
-from ._contacts import damping_ratio_for_restitution
-from ._load import MAX_STRESS_PA, janssen_stress, load_bed
-from ._reach import count_porosity
-from ._pile import poured_bed_summary
-from ._pour import FILL_METHODS, FillOptions, check_fill_options, pour_grains, rest_steps
+from ._load import MAX_STRESS_PA
+from ._pack_inputs import Progress, fmt_num, grain_material, grain_porosity, material_from_args
+from ._pack_pour import fill_options, pour_and_load, stress_outputs
+from ._pour import FILL_METHODS
 from ._procedures import PROCEDURES, PackOptions, RunOptions, pack_bed
 from .grains import grain
 from .templates import resolve_template
@@ -168,23 +162,6 @@ def _parser():
     return p
 
 
-def _grain_material(args, name):
-    """Library density and friction of a grain (thesis values for soybean); the rest from the options."""
-    mat = _material(args)
-    try:
-        g = grain(name)
-    except ValueError:
-        return mat, {}
-    used = {}
-    for field, attr in [("particle_density_kg_m3", "density_kg_m3"), ("friction_pp", "friction"),
-                        ("friction_pw", "wall_friction")]:
-        v = getattr(g, field)
-        if v.value is not None:
-            used[attr] = {"value": v.value, "source": v.source}
-    vals = {k: v["value"] for k, v in used.items()}
-    return replace(mat, **vals), used
-
-
 def _pack_grains(args, fill) -> int:
     template = resolve_template(args.grain, units=args.template_units)
     size, height = args.size, args.height
@@ -192,14 +169,14 @@ def _pack_grains(args, fill) -> int:
         size, height = [0.04, 0.04], 0.04
     container = resolve_container(args.scene, size_m=size, height_m=height)
     if fill.method != "grow":
-        return _pour(args, fill, template, container)
-    material, used = _grain_material(args, template.name)
+        return pour_and_load(args, fill, template, container)
+    material, used = grain_material(args, template.name)
     pr = progress_printer(quiet=args.quiet)
     size_cv, size_cv_source = _size_cv(args, template.name)
     kw = dict(material=material, n_grains=args.n_grains, rng=args.seed,
               mass_scale=100.0 if args.mass_scale is None else args.mass_scale, size_cv=size_cv,
               tol=args.tol, max_steps=GRAIN_MAX_STEPS if args.max_steps is None else args.max_steps,
-              progress=lambda sim, f: pr("grains", _Progress(sim), None))
+              progress=lambda sim, f: pr("grains", Progress(sim), None))
     if args.porosity is not None and args.deposition_friction is None:
         n, _, _ = grain_count(container, template, size_cv=size_cv, n_grains=args.n_grains)
         rec = recorded_reach(template.name, container.to_dict(), args.seed)
@@ -215,7 +192,7 @@ def _pack_grains(args, fill) -> int:
             print(f"error: {e}", file=sys.stderr)
             return EXIT_FAILED
     else:
-        xs, r, gid, grains, s = pack_grains(container, template, porosity=_grain_porosity(args, template.name),
+        xs, r, gid, grains, s = pack_grains(container, template, porosity=grain_porosity(args, template.name),
                                             deposition_friction=args.deposition_friction or 0.0, **kw)
     s.update(scene=args.scene, seed=args.seed, container=container.to_dict(), material_from_library=used,
              size_cv_source=size_cv_source, fill={"method": "grow"})
@@ -267,28 +244,6 @@ def _size_cv(args, name):
     return float(np.mean(np.asarray(sd) / np.asarray(ax))), f"library axes_sd_mm / axes_mm ({lib.axes_sd_mm.source})"
 
 
-def _grain_porosity(args, name):
-    """The porosity that sets the grain count of one packing: --porosity, else the middle of the
-    grain's measured loose-fill range, else 0.408 (thesis Table 3.1): dem._reach.count_porosity."""
-    return args.porosity if args.porosity is not None else count_porosity(name)[0]
-
-
-class _Progress:
-    """The few attributes progress_printer reads, from a ClumpSimulation."""
-
-    def __init__(self, sim):
-        self.steps, self.n, self.time_s = sim.steps, sim.n_grains, sim.time_s
-        self.kinetic_energy = sim.kinetic_energy
-
-
-def _material(args):
-    return Material(
-        density_kg_m3=args.density, kn_n_m=args.kn, ks_n_m=args.ks, friction=args.friction,
-        wall_kn_n_m=args.wall_kn, wall_ks_n_m=args.wall_ks, wall_friction=args.wall_friction,
-        damping_ratio=args.damping, radius_min_m=args.r_min, radius_max_m=args.r_max,
-    )
-
-
 def _procedure_options(args):
     """The scene's default procedure options, overridden by the ones given on the command line."""
     opts = dict(SCENE_DEFAULTS.get(args.scene, {}))
@@ -304,21 +259,12 @@ def _procedure_options(args):
     return opts
 
 
-def _stress_outputs(args):
-    """[(stress Pa or None, packing path)]: ``--out`` itself, or with several ``--stress`` values
-    one ``<stem>_<kPa>kPa<suffix>`` per stress."""
-    if args.stress is None or len(args.stress) == 1:
-        return [(None if args.stress is None else args.stress[0], Path(args.out))]
-    out = Path(args.out)
-    return [(s, out.with_name(f"{out.stem}_{s / 1000:g}kPa{out.suffix}")) for s in args.stress]
-
-
 def _check_outputs(args):
     """ValueError naming --out when the packing, its JSON summary or (--grain) its grain table
     cannot be written or is the --grain template file, before any work."""
     inputs = [("--grain", Path(args.grain))] if args.grain is not None and Path(
         str(args.grain)).is_file() else []
-    outs = _stress_outputs(args)
+    outs = stress_outputs(args)
     for k, (s, out) in enumerate(outs):
         clash = next((t for t, o in outs[:k] if o.name == out.name), None)
         if clash is not None:
@@ -333,216 +279,6 @@ def _check_outputs(args):
             check_output(f, f"--out {args.out}: companion", inputs=inputs)
 
 
-_POUR_ONLY = (("--drop-height", "drop_height"), ("--rate", "rate"), ("--spout-diameter", "spout_diameter"),
-              ("--depth", "depth"), ("--bin-diameter", "bin_diameter"), ("--bin-height", "bin_height"),
-              ("--stress", "stress"), ("--no-freeze", "no_freeze"))
-
-
-def _fill_options(args):
-    """The fill of a grain bed from the command line (None for spheres); ValueError naming the
-    option and its value for every combination or value the fill and the load refuse."""
-    given = [opt for opt, key in _POUR_ONLY if getattr(args, key) is not None]
-    if args.grain is None:
-        if given or args.fill is not None:
-            raise ValueError(f"{(given or ['--fill'])[0]} needs --grain (poured fills and loads are grain beds)")
-        return None
-    grow_only = args.porosity is not None or args.deposition_friction is not None or args.size_cv is not None
-    method = args.fill or ("grow" if grow_only else "rain")
-    if method == "grow":
-        if given:
-            raise ValueError(f"{given[0]} needs a poured fill (--fill rain or spout), not --fill grow")
-        return FillOptions(method="grow")
-    if args.porosity is not None:
-        raise ValueError(f"--porosity {args.porosity:g} with --fill {method}: a poured bed makes its own porosity; "
-                         "the porosity search grows the bed (--fill grow)")
-    if args.deposition_friction is not None:
-        raise ValueError("--deposition-friction belongs to --fill grow (a poured bed keeps the library's friction)")
-    if args.size_cv is not None:
-        raise ValueError(f"--size-cv {args.size_cv:g} with --fill {method}: poured fills take one kernel size")
-    if args.spout_diameter is not None and method != "spout":
-        raise ValueError(f"--spout-diameter {args.spout_diameter:g} needs --fill spout")
-    for opt, key in (("--depth", "depth"), ("--bin-diameter", "bin_diameter"), ("--bin-height", "bin_height")):
-        v = getattr(args, key)
-        if v is not None and not (math.isfinite(v) and (v >= 0 if key == "depth" else v > 0)):
-            raise ValueError(f"{opt} {v:g} m: must be a finite length, {'>= 0' if key == 'depth' else '> 0'}")
-    if args.stress is not None:
-        for v in args.stress:
-            if not (math.isfinite(v) and 0 <= v <= MAX_STRESS_PA):
-                raise ValueError(f"--stress {v:g} Pa: must be finite, >= 0 and <= {MAX_STRESS_PA:g} Pa")
-        if len(set(args.stress)) != len(args.stress):
-            raise ValueError(f"--stress {' '.join(f'{v:g}' for v in args.stress)}: a stress is given twice")
-        if args.depth is not None:
-            raise ValueError(f"--stress {args.stress[0]:g} together with --depth {args.depth:g}: give one")
-    if args.depth is not None and args.bin_diameter is None:
-        raise ValueError(f"--depth {args.depth:g} needs --bin-diameter (Janssen's stress depends on it)")
-    if args.depth is None and (args.bin_diameter is not None or args.bin_height is not None):
-        raise ValueError("--bin-diameter and --bin-height go with --depth")
-    if args.depth is not None and args.bin_height is not None and args.depth > args.bin_height:
-        raise ValueError(f"--depth {args.depth:g} m is beyond the bin's wall height (--bin-height {args.bin_height:g} m)")
-    with _fill_options_named():
-        return FillOptions(method=method, drop_height_m=0.3 if args.drop_height is None else args.drop_height,
-                           rate_kg_s=args.rate, spout_diameter_m=args.spout_diameter,
-                           mass_scale=1.0 if args.mass_scale is None else args.mass_scale,
-                           freeze=not args.no_freeze)
-
-
-@contextlib.contextmanager
-def _fill_options_named():
-    """A fill's ValueError (:class:`FillOptions`, :func:`check_fill_options`: "drop height 11 m:
-    ...") re-raised naming the command-line option ("--drop-height 11 m: ...")."""
-    try:
-        yield
-    except ValueError as e:
-        opt = {"drop height": "--drop-height", "rate": "--rate", "spout diameter": "--spout-diameter",
-               "mass scale": "--mass-scale"}
-        raise ValueError(next((f"{o} " + str(e).split(" ", len(k.split()))[-1] for k, o in opt.items()
-                               if str(e).startswith(k)), str(e))) from None
-
-
-def _janssen_inputs(name):
-    """(wall friction mu_w, lateral pressure ratio K, what they are) of a library grain for Janssen's
-    stress: the bulk's friction on a smooth steel wall (``wall_friction_steel``, not the DEM walls'
-    contact friction) and K (measured, or Jaky's 1 - sin(phi) as the library notes); ValueError
-    when the library lacks them."""
-    try:
-        g = grain(name)
-    except ValueError:
-        raise ValueError(f"--depth needs a library grain (wall friction and K); {name!r} is a template file: "
-                         "give --stress") from None
-    mu = g.wall_friction_steel.value
-    if mu is None:
-        raise ValueError(f"--depth: the grain library has no wall friction against steel for {g.name}: give --stress")
-    if g.lateral_pressure_ratio.value is not None:
-        k, k_src = g.lateral_pressure_ratio.value, g.lateral_pressure_ratio.source
-    elif g.internal_friction_deg.value is not None:
-        phi = g.internal_friction_deg.value
-        k, k_src = 1 - math.sin(math.radians(phi)), f"Jaky 1 - sin({phi:g} deg): {g.internal_friction_deg.source}"
-    else:
-        raise ValueError(f"--depth: the grain library has no lateral pressure ratio K nor angle of internal friction "
-                         f"for {g.name} (Janssen's stress needs one): give --stress")
-    return float(mu), float(k), {"wall_friction": mu, "wall_friction_source": g.wall_friction_steel.source,
-                                 "lateral_pressure_ratio": k, "lateral_pressure_ratio_source": k_src}
-
-
-def _pour_material(args, name):
-    """The grow fill's library material plus the damping of the library's restitution
-    (grain-grain, and grain-wall where sourced; else the grain-grain value)."""
-    mat, used = _grain_material(args, name)
-    try:
-        g = grain(name)
-    except ValueError:
-        return mat, used, None
-    e_pp, e_pw = g.restitution_pp.value, g.restitution_pw.value
-    if e_pp is None:
-        return mat, used, None
-    used["restitution_pp"] = {"value": e_pp, "source": g.restitution_pp.source}
-    if e_pw is not None:
-        used["restitution_pw"] = {"value": e_pw, "source": g.restitution_pw.source}
-    mat = replace(mat, damping_ratio=float(damping_ratio_for_restitution(e_pp)),
-                  wall_damping_ratio=float(damping_ratio_for_restitution(e_pw if e_pw is not None else e_pp)))
-    return mat, used, float(e_pp)
-
-
-def _pour(args, fill, template, container) -> int:
-    """--fill rain|spout, then the load of --depth or --stress (several stresses: each from a copy
-    of the same poured state)."""
-    t0, c0 = time.perf_counter(), time.process_time()
-    with _fill_options_named():
-        check_fill_options(fill, container, template)
-    janssen = _janssen_inputs(template.name) if args.depth is not None else None
-    material, used, e_pp = _pour_material(args, template.name)
-    phi_count = _grain_porosity(args, template.name)
-    if janssen is not None:
-        est = janssen_stress(args.depth, bulk_density_kg_m3=material.density_kg_m3 * (1 - phi_count),
-                             diameter_m=args.bin_diameter, wall_friction=janssen[0], lateral_ratio=janssen[1])
-        if est > MAX_STRESS_PA:
-            raise ValueError(f"--depth {args.depth:g} m of a {args.bin_diameter:g} m bin: Janssen's stress there, "
-                             f"about {est / 1e3:.0f} kPa at the grain's loose-fill porosity {phi_count:.3f}, is "
-                             f"beyond the {MAX_STRESS_PA / 1e3:g} kPa a load takes")
-    n = args.n_grains if args.n_grains is not None else int((1 - phi_count) * container.volume_m3 / template.volume_m3)
-    if n < 1:
-        raise ValueError(f"no grain of {template.volume_m3:.3g} m^3 fits the container")
-    pr = progress_printer(quiet=args.quiet)
-    max_steps = args.max_steps                       # None: the pour's own rest budget (0.5 s)
-    cb = lambda sim, f: pr(fill.method, _Progress(sim), None)
-    sim, record = pour_grains(container, template, material=material, fill=fill, n_grains=n, rng=args.seed,
-                              tol=args.tol, max_steps=max_steps, progress=cb, restitution=e_pp, porosity=phi_count)
-    outs = _stress_outputs(args)
-    poured = copy.deepcopy(sim) if len(outs) > 1 else None
-    rc = 0
-    for k, (stress, out) in enumerate(outs):
-        bed = sim if poured is None else (poured if k == len(outs) - 1 else copy.deepcopy(poured))
-        rc = max(rc, _load_and_write(args, out, bed, stress, janssen=janssen, fill=fill, template=template,
-                                     container=container, material=material, used=used, record=record, n=n,
-                                     max_steps=max_steps, pr=pr, t0=t0, c0=c0))
-    return rc
-
-
-def _load_and_write(args, out, sim, stress, *, janssen, fill, template, container, material, used, record, n,
-                    max_steps, pr, t0, c0) -> int:
-    """Load one poured bed to ``stress`` (or Janssen's at --depth), write it to ``out``, print its
-    lines; the exit status."""
-    s = {"n_grains": n, "n_spheres": sim.n, "template": template.name, "template_source": template.source,
-         "spheres_per_grain": template.n, "grain_volume_m3": template.volume_m3, "fill": record}
-    converged = record["converged"]
-    if janssen is not None or (stress is not None and stress > 0):
-        before = poured_bed_summary(sim, template, container, record)
-        load = {"porosity_before_load": before["porosity_network_region"]}
-        if janssen is not None:
-            mu, k, load_src = janssen
-            rho_b = material.density_kg_m3 * (1 - before["porosity_network_region"])
-            stress = janssen_stress(args.depth, bulk_density_kg_m3=rho_b, diameter_m=args.bin_diameter,
-                                    wall_friction=mu, lateral_ratio=k)
-            load.update(depth_m=args.depth, bin_diameter_m=args.bin_diameter, bin_height_m=args.bin_height,
-                        bulk_density_kg_m3=rho_b, janssen=load_src)
-        if stress > 0:
-            tl, cl = time.perf_counter(), time.process_time()
-            load.update(load_bed(sim, container, stress, tol=args.tol,
-                                 max_steps=rest_steps(sim.dt) if max_steps is None else max_steps,
-                                 callback=lambda sim, f: pr("load", _Progress(sim), None)))
-            load.update(wall_time_s=time.perf_counter() - tl, cpu_time_s=time.process_time() - cl)
-            converged = converged and load["converged"]
-        else:
-            load.update(target_pa=0.0, converged=True)
-        s["load"] = load
-    elif stress is not None:
-        s["load"] = {"target_pa": 0.0, "converged": True}
-    s.update(poured_bed_summary(sim, template, container, record))
-    s.update(steps=sim.steps, simulated_time_s=sim.time_s, dt_s=sim.dt, mass_scale=fill.mass_scale,
-             wall_time_s=time.perf_counter() - t0, cpu_time_s=time.process_time() - c0,
-             particle_steps=record["particle_steps"] + s.get("load", {}).get("steps", 0) * sim.n,
-             material={k: getattr(material, k) for k in material.__dataclass_fields__},
-             engine="dem.clumps (numba: the sphere step's kernels and a rigid-body update)",
-             scene=args.scene, seed=args.seed, container=container.to_dict(), material_from_library=used,
-             converged=bool(converged))
-    if args.stress is not None and len(args.stress) > 1:
-        s["bed_set"] = {"stresses_pa": [float(v) for v in args.stress],
-                        "note": "one pour; each stress loaded from a copy of the same poured state; "
-                                "wall and CPU times count the pour and every load before this one"}
-    s["particle_steps_per_cpu_s"] = s["particle_steps"] / max(s["cpu_time_s"], 1e-9)
-    write_grain_packing(out, sim.sphere_centers(), sim.radii.copy(), sim.gid.copy(),
-                        {"centers": sim.X.copy(), "quaternions": sim.q.copy(), "volume_m3": sim.volume_m3.copy(),
-                         "template": [template.name] * sim.n_grains}, s)
-    print(f"{n} grains of {template.n} spheres ({sim.n} spheres), {fill.method} from {fill.drop_height_m:g} m at "
-          f"{record['rate_kg_s']:.3g} kg/s -> {out} (+ {grains_path(out).name}, {summary_path(out).name})")
-    print(f"porosity (union of spheres): network's sample region {s['porosity_network_region']:.4f} +- "
-          f"{s['porosity_network_region_error']:.4f}; orientation order S {_num(s['orientation_order_S'], 3)}"
-          + (f"; angle of repose {_num(s['angle_of_repose']['angle_deg'], 1)} deg" if "angle_of_repose" in s else "")
-          + f"; {sim.steps} steps, wall {s['wall_time_s']:.1f} s")
-    if "load" in s and s["load"].get("target_pa"):
-        ld = s["load"]
-        print(f"load: lid stress {ld['lid_stress_pa']:.4g} Pa (target {ld['target_pa']:.4g} Pa), porosity "
-              f"{ld['porosity_before_load']:.4f} -> {s['porosity_network_region']:.4f}")
-    if not converged:
-        what = "fill" if not record["converged"] else "load"
-        st = record["rest"] if what == "fill" else s["load"]
-        print(f"error: not at rest: the {what} stopped at its step limit ({st['steps']} steps, unbalanced force "
-              f"ratio {st['ratio']:.3g} > tol {args.tol:.3g}); written with \"converged\": false (give --max-steps)",
-              file=sys.stderr)
-        return EXIT_FAILED
-    return 0
-
-
 def _pack(args) -> int:
     check_seed(args.seed)
     if args.max_steps is not None and args.max_steps < 1:
@@ -551,7 +287,7 @@ def _pack(args) -> int:
     ms = args.mass_scale
     if ms is not None and not (math.isfinite(ms) and ms >= 1):
         raise ValueError(f"--mass-scale {ms:g}: must be finite and >= 1 (1: real masses)")
-    fill = _fill_options(args)
+    fill = fill_options(args)
     _check_outputs(args)
     if args.porosity is not None:       # a porosity no bed has: refused before any packing
         check_physical_porosity(args.porosity)
@@ -559,7 +295,7 @@ def _pack(args) -> int:
         return _pack_grains(args, fill)
     if args.mass_scale is None:
         args.mass_scale = 100.0
-    material = _material(args)
+    material = material_from_args(args)
     container = resolve_container(args.scene, size_m=args.size, height_m=args.height)
     measure = None
     if args.measure:
@@ -585,8 +321,8 @@ def _pack(args) -> int:
     print(f"porosity: interior {s['porosity_interior']:.4f}, global (surface {s['bed_height_surface_m']:.4f} m) "
           f"{s['porosity_global_surface']:.4f}, measurement spheres {s['measure_spheres']['mean']:.4f}")
     c = s["coordination"]
-    print("coordination: 1.05 d_max cutoff " + _num(c["cutoff_mean"]) + ", true contacts "
-          + _num(c["contact_mean"]) + ("" if c["cutoff_mean"] is not None
+    print("coordination: 1.05 d_max cutoff " + fmt_num(c["cutoff_mean"]) + ", true contacts "
+          + fmt_num(c["contact_mean"]) + ("" if c["cutoff_mean"] is not None
                                        else " (no interior sphere to count)"))
     print(f"{s['steps']} steps, simulated {s['simulated_time_s']:.3f} s (mass scale {s['mass_scale']:g}), "
           f"wall {s['wall_time_s']:.1f} s, {s['particle_steps_per_s']:.3e} particle-steps/s")
@@ -597,10 +333,6 @@ def _pack(args) -> int:
               f"\"converged\": false (give --max-steps or --tol)", file=sys.stderr)
         return EXIT_FAILED
     return 0
-
-
-def _num(v, digits=2) -> str:
-    return "n/a" if v is None else f"{v:.{digits}f}"
 
 
 def main(argv=None) -> int:

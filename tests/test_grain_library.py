@@ -265,7 +265,7 @@ def test_dem_pack_takes_janssen_inputs_from_the_library():
     """dem.pack --depth takes mu_w = wall_friction_steel and the library's K for the five grains
     that have both, and refuses rough rice and sorghum (no K, no phi) with a message naming the
     grain."""
-    from dem.pack import _janssen_inputs
+    from dem._pack_pour import _janssen_inputs
     for name in ("soybean", "wheat", "shelled_corn", "barley", "canola"):
         g = GRAINS[name]
         mu, k, src = _janssen_inputs(name)

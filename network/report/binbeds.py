@@ -34,9 +34,6 @@ for its single bed alone.
 
 from __future__ import annotations
 
-import hashlib
-import importlib.metadata
-import json
 import math
 import os
 import re
@@ -52,12 +49,13 @@ import numpy as np
 from .._cli import EXIT_BAD_INPUT, EXIT_FAILED, CliError
 from .._grains import BED, JANSSEN, janssen_stress
 from ..flow import asabe_d272_gradient
+from ._binsolves import BIN_SOLVES, solve_cache_key, solve_set
 from .bed import TEMPLATE_GRAINS
 from .porosity import DATA_DIR, packing_meta
 
 __all__ = ["BED_SET_STRESSES_PA", "BUNDLED_SETS", "BIN_SOLVES", "N_LAYERS", "STRESS_TOL", "bed_set_files",
            "bed_set_inputs", "bin_velocities", "interpolate_in_stress", "layers_in_series", "janssen_inputs",
-           "plan_bin_beds", "pack_bed_set", "set_box", "solve_cache_key", "bin_section"]
+           "plan_bin_beds", "pack_bed_set", "set_box", "solve_cache_key", "solve_set", "bin_section"]
 
 #: the grains whose bed sets ship in network/data (the others with a dem template pack theirs on
 #: first use)
@@ -71,8 +69,6 @@ BED_SET_STRESSES_PA = (0.0, 20_000.0, 45_000.0)
 STRESS_TOL = 0.02
 #: points of the depth integral (composite Simpson, an odd count)
 N_LAYERS = 2001
-#: the cache folder's subfolder of solves
-BIN_SOLVES = "bin_solves"
 #: kernels of a bed set packed on first use (the bundled sets hold 250-700)
 SET_GRAINS = 600
 _G = 9.80665
@@ -281,72 +277,6 @@ def check_bin_depth(plan: dict) -> None:
             f"{d:g} m bin, {bottom / 1000:.1f} kPa, is beyond the bed set's largest, "
             f"{top / (1 + STRESS_TOL) / 1000:.1f} kPa: its beds cover a depth of at most "
             f"{deepest:.2f} m here")
-
-
-def solve_cache_key(path, inputs: dict) -> str:
-    """SHA-256 of the bed file's bytes, the code version and the solve's inputs (a JSON dict)."""
-    h = hashlib.sha256()
-    h.update(Path(path).read_bytes())
-    h.update(code_version().encode())
-    h.update(json.dumps(inputs, sort_keys=True).encode())
-    return h.hexdigest()
-
-
-_CODE_VERSION = None
-
-
-def code_version() -> str:
-    """The package version and a SHA-256 of the network, throats and cache sources (.py)."""
-    global _CODE_VERSION
-    if _CODE_VERSION is None:
-        h = hashlib.sha256()
-        for pkg in ("network", "throats", "cache"):
-            for p in sorted((_ROOT / pkg).rglob("*.py")):
-                h.update(str(p.relative_to(_ROOT)).encode())
-                h.update(p.read_bytes())
-        try:
-            v = importlib.metadata.version("grainflow")
-        except importlib.metadata.PackageNotFoundError:
-            v = "?"
-        _CODE_VERSION = f"{v}+{h.hexdigest()[:16]}"
-    return _CODE_VERSION
-
-
-def _read_cached(p: Path):
-    try:
-        d = json.loads(p.read_text())
-    except (OSError, ValueError):
-        return None
-    return d if isinstance(d, dict) and d.get("code_version") == code_version() else None
-
-
-def _write_cached(p: Path, d: dict) -> None:
-    p.parent.mkdir(parents=True, exist_ok=True)
-    tmp = p.with_name(p.name + ".tmp")
-    tmp.write_text(json.dumps(d))
-    os.replace(tmp, p)
-
-
-def solve_set(plan: dict, solve_bed, inputs: dict) -> list[dict]:
-    """Each bed of the set solved (``solve_bed(path) -> dict`` with ``porosity``,
-    ``gradient_z_pa_per_m``, ``gradient_x_pa_per_m``, ``converged``), read from the cache where
-    a solve of the same file, code and inputs is there."""
-    out = []
-    cache = Path(plan["bed_dir"]) / BIN_SOLVES
-    for stress, path in plan["beds"]:
-        key = solve_cache_key(path, inputs)
-        cp = cache / f"{key}.json"
-        got = _read_cached(cp)
-        cached = got is not None
-        if got is None:
-            got = solve_bed(path)
-            got = dict(got, code_version=code_version(), inputs=inputs, bed=str(path))
-            try:
-                _write_cached(cp, got)
-            except OSError:
-                pass                    # an unwritable cache: solved, not cached
-        out.append(dict(got, stress_pa=float(stress), path=str(path), cached=cached))
-    return out
 
 
 def bin_section(plan: dict, solved: list[dict], velocities, d272) -> dict:
