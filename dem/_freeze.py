@@ -18,6 +18,12 @@ section Speed):
   A sphere that moves beyond s/2 gets a new reference and its row alone is searched again (a
   linked cell grid over the references, cells 2 r_max + s wide), so a falling grain costs its
   own row, not the bed's list.
+* **Walls only where they can touch.** With each new reference a sphere gets a wall flag: a
+  wall lies within r_p + s of its reference. A sphere without one cannot touch a wall while it
+  stays within s/2 of its reference (its distance to each wall is at least r_p + s/2), so its
+  wall contacts are not evaluated; its wall springs were cleared when it lost the flag, as the
+  step would clear them. When the walls move (the container's ``z_offset_m``, new walls) every
+  flag is set again.
 
 Rows are kept in ascending order. Each pair is listed in both rows and carries its contact history (shear spring, touching flag,
 normal force) in both slots; it is evaluated from one row only, the *evaluator*: min(p, q) when
@@ -35,8 +41,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ._freeze_kernels import (active_forces, active_poses, contact_sums, in_contact, load_history, relist,
-                              sync_history)
+from ._freeze_kernels import (active_forces, active_poses, contact_sums, in_contact, list_walls, load_history,
+                              relist, sync_history)
 from ._rigid import quat_to_matrix
 
 __all__ = ["ActiveRegion", "FreezePolicy", "FREEZE_DEPTH_LENGTHS"]
@@ -85,6 +91,8 @@ class ActiveRegion:
         self.mark = np.zeros(cap_n, np.int64)
         self.moved = np.zeros(cap_n, np.int64)
         self.frozen_s = np.zeros(cap_n, np.bool_)
+        self.near = np.ones(cap_n, np.bool_)
+        self._walls_at = None
         self.frozen_g = np.zeros(0, np.bool_)
         self.push_n = np.zeros(0)
         self.n = 0
@@ -146,7 +154,7 @@ class ActiveRegion:
             setattr(self, name, grow(getattr(self, name), fill, (n, width)))
         self.shear = grow(self.shear, 0.0, (n, width, 3))
         for name, fill in (("nxt", -1), ("prv", -1), ("cellof", -1), ("cnt", 0), ("mark", 0), ("moved", 0),
-                           ("frozen_s", False)):
+                           ("frozen_s", False), ("near", True)):
             setattr(self, name, grow(getattr(self, name), fill, (n,)))
         self.ref = grow(self.ref, np.inf, (n, 3))
 
@@ -162,7 +170,8 @@ class ActiveRegion:
             k = relist(moved, n_moved, k, sim._x, self.ref, sim.radii, sim.gid, sim._ms, self.skin, self.lo,
                        self.cell, self.dims, self.head, self.nxt, self.prv, self.cellof, self.nbr, self.cnt,
                        self.shear, self.touch, self.fn, self.cn, self.ct, mat.damping_ratio, mat.kn_pp, mat.ks_pp,
-                       self.mark, buf, tmp_j, tmp_h, tmp_c)
+                       self.mark, buf, tmp_j, tmp_h, tmp_c, sim._wall_kind, sim._wall_normal, self._walls_at,
+                       sim._wall_cyl, sim._wall_touch, sim.wall_shear, self.near)
             if k >= n_moved:
                 break
             width = int(width * 1.5) + 1          # a row outgrew its width: widen, resume
@@ -179,6 +188,7 @@ class ActiveRegion:
         self.cnt[:] = 0
         self.ref[:] = np.inf
         sim._poses()
+        self._walls_at = sim._wall_offsets()
         self._relist(np.arange(self.n, dtype=np.int64), self.n)
 
     def grown(self, sim):
@@ -187,11 +197,22 @@ class ActiveRegion:
         self._attach(sim)
         return self
 
+    def _list_walls(self, offsets):
+        """Every sphere's wall flag against the walls at ``offsets`` (after the walls moved, or a new
+        simulation bound)."""
+        sim = self.sim
+        list_walls(np.arange(self.n, dtype=np.int64), self.ref, sim.radii, self.skin, sim._wall_kind,
+                   sim._wall_normal, offsets, sim._wall_cyl, sim._wall_touch, sim.wall_shear, self.near)
+        self._walls_at = offsets
+
     # -- the step
     def step(self):
         """One step of the active grains (module notes); returns the net force on every grain (G, 3)."""
         sim = self.sim
         self.active_particle_steps += len(self.sidx)
+        offsets = sim._wall_offsets()
+        if offsets is not self._walls_at:
+            self._list_walls(offsets)
         n_moved = active_poses(self.gidx, sim.X, sim.V, sim.q, sim.L, sim._inertia_s, sim._start, sim.body,
                                sim._x, sim._v, sim._w, sim._arm, self.ref, 0.5 * self.skin, self.moved)
         if n_moved:
@@ -199,7 +220,7 @@ class ActiveRegion:
         mat = sim.material
         active_forces(self.gidx, self.sidx, self.frozen_s, sim.gid, sim._x, sim._v, sim._w, sim.radii, sim._ms,
                       self.nbr, self.cnt, self.shear, self.touch, self.fn, self.cn, self.ct, mat.kn_pp, mat.ks_pp,
-                      mat.friction, sim._dt, sim._wall_kind, sim._wall_normal, sim._wall_offsets(), sim._wall_cyl,
+                      mat.friction, sim._dt, self.near, sim._wall_kind, sim._wall_normal, offsets, sim._wall_cyl,
                       sim._wall_moves, sim.wall_vz_m_s, sim.wall_shear, sim._wall_fn, sim._wall_touch, mat.kn_pw,
                       mat.ks_pw, mat.wall_beta, mat.wall_friction, sim._force, sim._torque, self.push_n, sim.X,
                       sim.V, sim.q, sim.L, sim._inertia_s, sim._start, sim._arm, sim._weight, sim._inv_m_g,

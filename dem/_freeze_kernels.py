@@ -17,7 +17,7 @@ from ._contacts import contact_law
 from ._grain_kernels import pose_one, update_one
 from ._kernels import wall_contacts
 
-__all__ = ["active_forces", "active_poses", "contact_sums", "in_contact", "load_history", "relist",
+__all__ = ["active_forces", "active_poses", "contact_sums", "in_contact", "list_walls", "load_history", "relist",
            "sync_history"]
 
 
@@ -121,10 +121,54 @@ def _row_delete(j, i, nbr, cnt, shear, touch, fn, cn, ct):
     cnt[j] = n - 1
 
 
+@numba.njit(inline="always", cache=True)
+def _near_wall(x0, x1, x2, reach, wall_kind, wall_normal, wall_offset, wall_cyl):
+    """Whether a wall lies closer than ``reach`` (m) to the point (x0, x1, x2) (distances as in
+    :func:`dem._kernels.wall_contacts`)."""
+    for m in range(wall_kind.shape[0]):
+        if wall_kind[m] == 0:
+            d = wall_offset[m]
+            if wall_normal[m, 0] != 0.0:
+                d = d + wall_normal[m, 0] * x0
+            if wall_normal[m, 1] != 0.0:
+                d = d + wall_normal[m, 1] * x1
+            if wall_normal[m, 2] != 0.0:
+                d = d + wall_normal[m, 2] * x2
+        else:
+            ddx = x0 - wall_cyl[m, 0]
+            ddy = x1 - wall_cyl[m, 1]
+            d = wall_cyl[m, 2] - np.sqrt(ddx * ddx + ddy * ddy)
+        if not d >= reach:
+            return True
+    return False
+
+
+@numba.njit(inline="always", cache=True)
+def _list_walls(p, ref, r, skin, wall_kind, wall_normal, wall_offset, wall_cyl, wall_touch, wall_shear, near):
+    """``near[p]``: a wall within r_p + skin of sphere p's reference; without one its wall
+    springs and touching flags are cleared (no wall touches it: the step would clear them)."""
+    hit = _near_wall(ref[p, 0], ref[p, 1], ref[p, 2], r[p] + skin, wall_kind, wall_normal, wall_offset, wall_cyl)
+    near[p] = hit
+    if not hit:
+        for m in range(wall_kind.shape[0]):
+            wall_touch[m, p] = 0
+            wall_shear[m, p, 0] = wall_shear[m, p, 1] = wall_shear[m, p, 2] = 0.0
+
+
+@numba.njit(cache=True)
+def list_walls(idx, ref, r, skin, wall_kind, wall_normal, wall_offset, wall_cyl, wall_touch, wall_shear, near):
+    """:func:`_list_walls` for the spheres ``idx`` (all of them after the walls moved)."""
+    for a in range(idx.shape[0]):
+        _list_walls(idx[a], ref, r, skin, wall_kind, wall_normal, wall_offset, wall_cyl, wall_touch, wall_shear,
+                    near)
+
+
 @numba.njit(cache=True)
 def relist(moved, n_moved, first, x, ref, r, gid, ms, skin, lo, cell, dims, head, nxt, prv, cellof,
-           nbr, cnt, shear, touch, fn, cn, ct, beta, kn, ks, mark, buf, tmp_j, tmp_h, tmp_c):
-    """New reference and row for each sphere ``moved[first:n_moved]`` (module notes), in order.
+           nbr, cnt, shear, touch, fn, cn, ct, beta, kn, ks, mark, buf, tmp_j, tmp_h, tmp_c,
+           wall_kind, wall_normal, wall_offset, wall_cyl, wall_touch, wall_shear, near):
+    """New reference, row and wall flag (:func:`_list_walls`) for each sphere
+    ``moved[first:n_moved]`` (module notes), in order.
 
     Pairs kept keep their slots' history; new pairs start from zero (they did not touch: their
     references were farther apart than the reach); pairs dropped leave both rows. Returns the
@@ -142,6 +186,7 @@ def relist(moved, n_moved, first, x, ref, r, gid, ms, skin, lo, cell, dims, head
                 return k
         # reference and cell
         ref[i, 0], ref[i, 1], ref[i, 2] = x[i, 0], x[i, 1], x[i, 2]
+        _list_walls(i, ref, r, skin, wall_kind, wall_normal, wall_offset, wall_cyl, wall_touch, wall_shear, near)
         c = _cell(x[i, 0], x[i, 1], x[i, 2], lo, cell, dims)
         if cellof[i] != c:
             _grid_remove(i, head, nxt, prv, cellof)
@@ -209,12 +254,13 @@ def active_poses(gidx, X, V, q, L, inertia, start, body, x, v, w, arm, ref, half
 
 @numba.njit(cache=True, error_model="numpy")
 def active_forces(gidx, sidx, frozen, gid, x, v, w, r, ms, nbr, cnt, shear, touch, fn, cn, ct, kn, ks, mu, dt,
-                  wall_kind, wall_normal, wall_offset, wall_cyl, wall_moves, wall_vz, wall_shear, wall_fn,
+                  near, wall_kind, wall_normal, wall_offset, wall_cyl, wall_moves, wall_vz, wall_shear, wall_fn,
                   wall_touch, kn_w, ks_w, beta_w, mu_w, force_s, torque_s, push, X, V, q, L, inertia, start, arm,
                   weight, inv_m, force_g, torque_g, advance):
     """Contact forces of the active spheres ``sidx`` (each pair from its evaluator's row), their
-    walls, and the sums and update of the active grains ``gidx`` (module notes). ``push`` (G,)
-    gets, for each frozen grain, the largest normal force of an active neighbour, N."""
+    walls (of the spheres ``near`` one), and the sums and update of the active grains ``gidx``
+    (module notes). ``push`` (G,) gets, for each frozen grain, the largest normal force of an
+    active neighbour, N."""
     for a in range(sidx.shape[0]):
         p = sidx[a]
         force_s[p, 0] = force_s[p, 1] = force_s[p, 2] = 0.0
@@ -280,6 +326,10 @@ def active_forces(gidx, sidx, frozen, gid, x, v, w, r, ms, nbr, cnt, shear, touc
                 torque_s[j, 0] += tx * r[j]
                 torque_s[j, 1] += ty * r[j]
                 torque_s[j, 2] += tz * r[j]
+        if not near[i]:
+            force_s[i, 0], force_s[i, 1], force_s[i, 2] = fx, fy, fz
+            torque_s[i, 0], torque_s[i, 1], torque_s[i, 2] = tqx, tqy, tqz
+            continue
         wfx, wfy, wfz, wtx, wty, wtz, hits = wall_contacts(i, x, v, w, r, ms, wall_kind, wall_normal, wall_offset,
                                                            wall_cyl, wall_moves, wall_vz, wall_shear, wall_fn,
                                                            wall_touch, kn_w, ks_w, beta_w, mu_w, dt)

@@ -67,6 +67,31 @@ def test_rows_after_partial_relists_are_the_full_rebuild_and_its_contacts():
     assert touching <= listed
 
 
+def _wall_touching(sim):
+    """(walls, spheres) bool: sphere centre closer to the plane than its radius, by brute force."""
+    d = sim._wall_offsets()[:, None] + sim._wall_normal @ sim._x.T
+    return d < sim.radii[None]
+
+
+def test_wall_contacts_are_evaluated_for_every_sphere_that_touches_a_wall():
+    """The wall flags (a wall within r + skin of the reference) miss no wall contact, skip the
+    spheres far from every wall, and follow the walls when the container moves."""
+    sim, _, lo, hi = _bed(jitter=0.3)
+    reg = sim.attach_active(lo_m=lo, hi_m=hi)
+    for _ in range(300):
+        sim.step()
+    truth = _wall_touching(sim)
+    assert truth.any() and not reg.near[:sim.n].all()
+    assert np.array_equal(sim._wall_touch.view(bool), truth)
+    assert not np.any(sim.wall_shear[:, ~reg.near[:sim.n]])
+    near = reg.near[:sim.n].copy()
+    sim.z_offset_m = 8e-3                       # the floor rises through the bottom layer
+    sim.step()
+    truth = _wall_touching(sim)
+    assert np.any(truth[4] & ~near)             # spheres far from every wall before now touch the floor
+    assert np.array_equal(sim._wall_touch.view(bool), truth)
+
+
 def test_active_step_without_frozen_grains_is_the_whole_bed_step():
     """Only the order of each sphere's force sum differs: the same trajectories to round-off."""
     a, _, lo, hi = _bed(seed=1, jitter=0.005)
