@@ -25,14 +25,20 @@ section Speed):
   step would clear them. When the walls move (the container's ``z_offset_m``, new walls) every
   flag is set again.
 
-Rows are kept in ascending order. Each pair is listed in both rows and carries its contact history (shear spring, touching flag,
-normal force) in both slots; it is evaluated from one row only, the *evaluator*: min(p, q) when
-both grains are active, the active one's row when one is frozen, none when both are. Whenever
-the frozen set changes, each changed pair's history is copied from its old evaluator's slot to
-the other, so the new evaluator continues it. The step is the engine's own: the contact law of
-:func:`dem._contacts.contact_law`, the walls of :func:`dem._kernels.wall_contacts`, the rigid
-update of :func:`dem._grain_kernels.update_one`, one thread, each sphere's forces summed in row
-order.
+Rows are kept in ascending order. Each pair is listed in both rows and carries its contact
+history (shear spring, touching flag, normal force) in both slots; it is evaluated from one row
+only, the *evaluator*: min(p, q) when both grains are active, the active one's row when one is
+frozen, none when both are. Whenever the frozen set changes, each changed pair's history is
+copied from its old evaluator's slot to the other, so the new evaluator continues it. A row's
+leading slots that hold active partners below its sphere (``below``, kept with each insert,
+delete and change of the frozen set) are not read: their pairs belong to the partner's row.
+The step is the engine's own: the contact law of :func:`dem._contacts.contact_law`, the walls
+of :func:`dem._kernels.wall_contacts`, the rigid update of :func:`dem._grain_kernels.update_one`
+(its sums and :func:`dem._grain_kernels.advance_one`), one thread, each sphere's forces summed
+in row order. The rows run in ascending order, so a sphere's force is complete when its own row
+is done (later rows add only to partners above them): each grain is summed and advanced right
+after its last sphere, in the operations and order of :func:`dem._grain_kernels.update_one`,
+and the step's trajectories are those of separate force and update passes bit for bit.
 """
 
 from __future__ import annotations
@@ -42,7 +48,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ._freeze_kernels import (active_forces, active_poses, contact_sums, in_contact, list_walls, load_history,
-                              relist, sync_history)
+                              relist, row_starts, sync_history)
 from ._rigid import quat_to_matrix
 
 __all__ = ["ActiveRegion", "FreezePolicy", "FREEZE_DEPTH_LENGTHS"]
@@ -83,6 +89,7 @@ class ActiveRegion:
         self.ref = np.full((cap_n, 3), np.inf)
         self.nbr = np.zeros((cap_n, width), np.int64)
         self.cnt = np.zeros(cap_n, np.int64)
+        self.below = np.zeros(cap_n, np.int64)
         self.shear = np.zeros((cap_n, width, 3))
         self.touch = np.zeros((cap_n, width), np.uint8)
         self.fn = np.zeros((cap_n, width))
@@ -153,8 +160,8 @@ class ActiveRegion:
         for name, fill in (("nbr", 0), ("touch", 0), ("fn", 0.0), ("cn", 0.0), ("ct", 0.0)):
             setattr(self, name, grow(getattr(self, name), fill, (n, width)))
         self.shear = grow(self.shear, 0.0, (n, width, 3))
-        for name, fill in (("nxt", -1), ("prv", -1), ("cellof", -1), ("cnt", 0), ("mark", 0), ("moved", 0),
-                           ("frozen_s", False), ("near", True)):
+        for name, fill in (("nxt", -1), ("prv", -1), ("cellof", -1), ("cnt", 0), ("below", 0), ("mark", 0),
+                           ("moved", 0), ("frozen_s", False), ("near", True)):
             setattr(self, name, grow(getattr(self, name), fill, (n,)))
         self.ref = grow(self.ref, np.inf, (n, 3))
 
@@ -171,7 +178,7 @@ class ActiveRegion:
                        self.cell, self.dims, self.head, self.nxt, self.prv, self.cellof, self.nbr, self.cnt,
                        self.shear, self.touch, self.fn, self.cn, self.ct, mat.damping_ratio, mat.kn_pp, mat.ks_pp,
                        self.mark, buf, tmp_j, tmp_h, tmp_c, sim._wall_kind, sim._wall_normal, self._walls_at,
-                       sim._wall_cyl, sim._wall_touch, sim.wall_shear, self.near)
+                       sim._wall_cyl, sim._wall_touch, sim.wall_shear, self.near, self.frozen_s, self.below)
             if k >= n_moved:
                 break
             width = int(width * 1.5) + 1          # a row outgrew its width: widen, resume
@@ -186,6 +193,7 @@ class ActiveRegion:
         self.head[:] = -1
         self.cellof[:] = -1
         self.cnt[:] = 0
+        self.below[:] = 0
         self.ref[:] = np.inf
         sim._poses()
         self._walls_at = sim._wall_offsets()
@@ -218,8 +226,8 @@ class ActiveRegion:
         if n_moved:
             self._relist(self.moved, n_moved)
         mat = sim.material
-        active_forces(self.gidx, self.sidx, self.frozen_s, sim.gid, sim._x, sim._v, sim._w, sim.radii, sim._ms,
-                      self.nbr, self.cnt, self.shear, self.touch, self.fn, self.cn, self.ct, mat.kn_pp, mat.ks_pp,
+        active_forces(self.sidx, self.frozen_s, sim.gid, sim._x, sim._v, sim._w, sim.radii, sim._ms, self.nbr,
+                      self.cnt, self.below, self.shear, self.touch, self.fn, self.cn, self.ct, mat.kn_pp, mat.ks_pp,
                       mat.friction, sim._dt, self.near, sim._wall_kind, sim._wall_normal, offsets, sim._wall_cyl,
                       sim._wall_moves, sim.wall_vz_m_s, sim.wall_shear, sim._wall_fn, sim._wall_touch, mat.kn_pw,
                       mat.ks_pw, mat.wall_beta, mat.wall_friction, sim._force, sim._torque, self.push_n, sim.X,
@@ -265,6 +273,7 @@ class ActiveRegion:
         self.frozen_s[:self.n] = frozen_g[sim.gid]
         changed_s = np.flatnonzero(before[:self.n] != self.frozen_s[:self.n]).astype(np.int64)
         sync_history(changed_s, before, self.nbr, self.cnt, self.shear, self.touch, self.fn)
+        row_starts(self.n, self.frozen_s, self.nbr, self.cnt, self.below)
         newly = changed_g[frozen_g[changed_g]]
         sim.V[newly] = 0.0
         sim.L[newly] = 0.0

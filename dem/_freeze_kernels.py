@@ -14,11 +14,11 @@ import numba
 import numpy as np
 
 from ._contacts import contact_law
-from ._grain_kernels import pose_one, update_one
+from ._grain_kernels import advance_one, pose_one
 from ._kernels import wall_contacts
 
 __all__ = ["active_forces", "active_poses", "contact_sums", "in_contact", "list_walls", "load_history", "relist",
-           "sync_history"]
+           "row_starts", "sync_history"]
 
 
 # ---------------------------------------------------------------------------- the cell grid
@@ -93,8 +93,9 @@ def _find(row, n, i):
 
 
 @numba.njit(inline="always", cache=True)
-def _row_insert(j, i, a, b, nbr, cnt, shear, touch, fn, cn, ct):
-    """Put partner i into row j at its place in ascending order, zero history, dashpots a, b."""
+def _row_insert(j, i, a, b, nbr, cnt, shear, touch, fn, cn, ct, frozen, below):
+    """Put partner i into row j at its place in ascending order, zero history, dashpots a, b
+    (``below[j]`` kept a count of leading slots that hold active partners below j)."""
     u = cnt[j]
     while u > 0 and nbr[j, u - 1] > i:
         nbr[j, u] = nbr[j, u - 1]
@@ -107,13 +108,20 @@ def _row_insert(j, i, a, b, nbr, cnt, shear, touch, fn, cn, ct):
     fn[j, u] = 0.0
     cn[j, u], ct[j, u] = a, b
     cnt[j] += 1
+    if u <= below[j]:
+        if i < j and not frozen[i]:
+            below[j] += 1
+        else:
+            below[j] = u
 
 
 @numba.njit(inline="always", cache=True)
-def _row_delete(j, i, nbr, cnt, shear, touch, fn, cn, ct):
+def _row_delete(j, i, nbr, cnt, shear, touch, fn, cn, ct, below):
     """Take partner i out of row j (the rest keep their order)."""
     n = cnt[j]
     u = _find(nbr[j], n, i)
+    if u < below[j]:
+        below[j] -= 1
     for t in range(u, n - 1):
         nbr[j, t] = nbr[j, t + 1]
         shear[j, t, 0], shear[j, t, 1], shear[j, t, 2] = shear[j, t + 1, 0], shear[j, t + 1, 1], shear[j, t + 1, 2]
@@ -166,7 +174,7 @@ def list_walls(idx, ref, r, skin, wall_kind, wall_normal, wall_offset, wall_cyl,
 @numba.njit(cache=True)
 def relist(moved, n_moved, first, x, ref, r, gid, ms, skin, lo, cell, dims, head, nxt, prv, cellof,
            nbr, cnt, shear, touch, fn, cn, ct, beta, kn, ks, mark, buf, tmp_j, tmp_h, tmp_c,
-           wall_kind, wall_normal, wall_offset, wall_cyl, wall_touch, wall_shear, near):
+           wall_kind, wall_normal, wall_offset, wall_cyl, wall_touch, wall_shear, near, frozen, below):
     """New reference, row and wall flag (:func:`_list_walls`) for each sphere
     ``moved[first:n_moved]`` (module notes), in order.
 
@@ -215,11 +223,11 @@ def relist(moved, n_moved, first, x, ref, r, gid, ms, skin, lo, cell, dims, head
                 b = 2.0 * beta * np.sqrt(meff * ks)
                 tmp_h[t, 0] = tmp_h[t, 1] = tmp_h[t, 2] = tmp_h[t, 3] = tmp_h[t, 4] = 0.0
                 tmp_c[t, 0], tmp_c[t, 1] = a, b
-                _row_insert(j, i, a, b, nbr, cnt, shear, touch, fn, cn, ct)
+                _row_insert(j, i, a, b, nbr, cnt, shear, touch, fn, cn, ct, frozen, below)
         for s in range(cnt[i]):             # dropped: out of j's row
             j = nbr[i, s]
             if mark[j] > 0:
-                _row_delete(j, i, nbr, cnt, shear, touch, fn, cn, ct)
+                _row_delete(j, i, nbr, cnt, shear, touch, fn, cn, ct, below)
             mark[j] = 0
         for t in range(m):
             nbr[i, t] = tmp_j[t]
@@ -228,7 +236,24 @@ def relist(moved, n_moved, first, x, ref, r, gid, ms, skin, lo, cell, dims, head
             fn[i, t] = tmp_h[t, 4]
             cn[i, t], ct[i, t] = tmp_c[t, 0], tmp_c[t, 1]
         cnt[i] = m
+        below[i] = _below(i, frozen, nbr, m)
     return n_moved
+
+
+@numba.njit(inline="always", cache=True)
+def _below(i, frozen, nbr, n):
+    """Leading slots of row i (``n`` partners, ascending) that hold active partners below i."""
+    u = 0
+    while u < n and nbr[i, u] < i and not frozen[nbr[i, u]]:
+        u += 1
+    return u
+
+
+@numba.njit(cache=True)
+def row_starts(n, frozen, nbr, cnt, below):
+    """``below[:n]`` of every row (:func:`_below`), after the frozen set changed."""
+    for i in range(n):
+        below[i] = _below(i, frozen, nbr, cnt[i])
 
 
 # ---------------------------------------------------------------------------- the step
@@ -253,18 +278,24 @@ def active_poses(gidx, X, V, q, L, inertia, start, body, x, v, w, arm, ref, half
 
 
 @numba.njit(cache=True, error_model="numpy")
-def active_forces(gidx, sidx, frozen, gid, x, v, w, r, ms, nbr, cnt, shear, touch, fn, cn, ct, kn, ks, mu, dt,
+def active_forces(sidx, frozen, gid, x, v, w, r, ms, nbr, cnt, below, shear, touch, fn, cn, ct, kn, ks, mu, dt,
                   near, wall_kind, wall_normal, wall_offset, wall_cyl, wall_moves, wall_vz, wall_shear, wall_fn,
                   wall_touch, kn_w, ks_w, beta_w, mu_w, force_s, torque_s, push, X, V, q, L, inertia, start, arm,
                   weight, inv_m, force_g, torque_g, advance):
-    """Contact forces of the active spheres ``sidx`` (each pair from its evaluator's row), their
-    walls (of the spheres ``near`` one), and the sums and update of the active grains ``gidx``
-    (module notes). ``push`` (G,) gets, for each frozen grain, the largest normal force of an
-    active neighbour, N."""
+    """Contact forces of the active spheres ``sidx`` (ascending; each pair from its evaluator's
+    row, the row's first ``below`` slots skipped), their walls (of the spheres ``near`` one), and
+    the sums and update of their grains (module notes). ``push`` (G,) gets, for each frozen
+    grain, the largest normal force of an active neighbour, N.
+
+    A sphere's force is complete when its row is done (the rows after it add only to partners
+    above them), so each grain is summed (:func:`dem._grain_kernels.update_one`'s sums, in
+    sphere order) and advanced (:func:`dem._grain_kernels.advance_one`) after its last sphere.
+    """
     for a in range(sidx.shape[0]):
         p = sidx[a]
         force_s[p, 0] = force_s[p, 1] = force_s[p, 2] = 0.0
         torque_s[p, 0] = torque_s[p, 1] = torque_s[p, 2] = 0.0
+    gfx = gfy = gfz = gtx = gty = gtz = 0.0
     for a in range(sidx.shape[0]):
         i = sidx[a]
         ri = r[i]
@@ -274,7 +305,7 @@ def active_forces(gidx, sidx, frozen, gid, x, v, w, r, ms, nbr, cnt, shear, touc
         xi0, xi1, xi2 = x[i, 0], x[i, 1], x[i, 2]
         vi0, vi1, vi2 = v[i, 0], v[i, 1], v[i, 2]
         wi0, wi1, wi2 = w[i, 0] * ri, w[i, 1] * ri, w[i, 2] * ri
-        for s in range(cnt[i]):
+        for s in range(below[i], cnt[i]):
             j = nbr[i, s]
             fj = frozen[j]
             if j < i and not fj:
@@ -326,25 +357,36 @@ def active_forces(gidx, sidx, frozen, gid, x, v, w, r, ms, nbr, cnt, shear, touc
                 torque_s[j, 0] += tx * r[j]
                 torque_s[j, 1] += ty * r[j]
                 torque_s[j, 2] += tz * r[j]
-        if not near[i]:
-            force_s[i, 0], force_s[i, 1], force_s[i, 2] = fx, fy, fz
-            torque_s[i, 0], torque_s[i, 1], torque_s[i, 2] = tqx, tqy, tqz
-            continue
-        wfx, wfy, wfz, wtx, wty, wtz, hits = wall_contacts(i, x, v, w, r, ms, wall_kind, wall_normal, wall_offset,
-                                                           wall_cyl, wall_moves, wall_vz, wall_shear, wall_fn,
-                                                           wall_touch, kn_w, ks_w, beta_w, mu_w, dt)
-        if hits:
-            fx += wfx
-            fy += wfy
-            fz += wfz
-            tqx += wtx
-            tqy += wty
-            tqz += wtz
+        if near[i]:
+            wfx, wfy, wfz, wtx, wty, wtz, hits = wall_contacts(i, x, v, w, r, ms, wall_kind, wall_normal,
+                                                               wall_offset, wall_cyl, wall_moves, wall_vz, wall_shear,
+                                                               wall_fn, wall_touch, kn_w, ks_w, beta_w, mu_w, dt)
+            if hits:
+                fx += wfx
+                fy += wfy
+                fz += wfz
+                tqx += wtx
+                tqy += wty
+                tqz += wtz
         force_s[i, 0], force_s[i, 1], force_s[i, 2] = fx, fy, fz
         torque_s[i, 0], torque_s[i, 1], torque_s[i, 2] = tqx, tqy, tqz
-    for a in range(gidx.shape[0]):
-        update_one(gidx[a], X, V, q, L, inertia, start, arm, force_s, torque_s, weight, inv_m, dt, force_g,
-                   torque_g, advance)
+        # the grain's sums, sphere by sphere (update_one's order and operations)
+        g = gid[i]
+        if i == start[g]:
+            gfx = gfy = gfz = 0.0
+            gtx = gty = gtz = 0.0
+        gfx += fx
+        gfy += fy
+        gfz += fz
+        gtx += (arm[i, 1] * fz - arm[i, 2] * fy) + tqx
+        gty += (arm[i, 2] * fx - arm[i, 0] * fz) + tqy
+        gtz += (arm[i, 0] * fy - arm[i, 1] * fx) + tqz
+        if i == start[g + 1] - 1:
+            gfz -= weight[g]
+            force_g[g, 0], force_g[g, 1], force_g[g, 2] = gfx, gfy, gfz
+            torque_g[g, 0], torque_g[g, 1], torque_g[g, 2] = gtx, gty, gtz
+            if advance:
+                advance_one(g, gfx, gfy, gfz, gtx, gty, gtz, X, V, q, L, inertia, inv_m, dt)
 
 
 @numba.njit(inline="always", cache=True)

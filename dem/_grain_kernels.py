@@ -40,7 +40,7 @@ from __future__ import annotations
 import numba
 import numpy as np
 
-__all__ = ["grain_poses", "grain_update", "pose_one", "update_one"]
+__all__ = ["advance_one", "grain_poses", "grain_update", "pose_one", "update_one"]
 
 
 @numba.njit(inline="always", cache=True, error_model="numpy")
@@ -119,8 +119,14 @@ def update_one(g, X, V, q, L, inertia, start, arm, force_s, torque_s, weight, in
     fz -= weight[g]
     force[g, 0], force[g, 1], force[g, 2] = fx, fy, fz
     torque[g, 0], torque[g, 1], torque[g, 2] = tx, ty, tz
-    if not advance:
-        return
+    if advance:
+        advance_one(g, fx, fy, fz, tx, ty, tz, X, V, q, L, inertia, inv_m, dt)
+
+
+@numba.njit(inline="always", cache=True, error_model="numpy")
+def advance_one(g, fx, fy, fz, tx, ty, tz, X, V, q, L, inertia, inv_m, dt):
+    """The update of grain ``g`` under its net force (fx, fy, fz) and torque (tx, ty, tz) (module
+    notes; :func:`update_one` after its sums)."""
     V[g, 0] += fx * inv_m[g]
     V[g, 1] += fy * inv_m[g]
     V[g, 2] += fz * inv_m[g]

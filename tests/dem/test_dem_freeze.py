@@ -44,6 +44,16 @@ def _listed(sim):
     return p[sim.gid[p[:, 0]] != sim.gid[p[:, 1]]]
 
 
+def _skipped_slots_are_evaluated_elsewhere(reg):
+    """The first ``below`` slots of each row, which the step skips, hold only active partners
+    below the row's sphere (their pairs are evaluated from the partner's row); some rows skip."""
+    nbr, below = reg.nbr[:reg.n], reg.below[:reg.n]
+    slot = np.arange(nbr.shape[1])[None, :] < below[:, None]
+    i = np.broadcast_to(np.arange(reg.n)[:, None], nbr.shape)
+    return (bool(np.all(nbr[slot] < i[slot])) and not np.any(reg.frozen_s[nbr[slot]])
+            and np.all(below <= reg.cnt[:reg.n]) and below.sum() > 0)
+
+
 def _touching(sim):
     """Touching pairs (i < j, different grains) by brute force over all spheres."""
     x, r = sim._x, sim.radii
@@ -65,6 +75,7 @@ def test_rows_after_partial_relists_are_the_full_rebuild_and_its_contacts():
     listed = {tuple(p) for p in reg.pairs().tolist()}
     touching = _touching(sim)
     assert touching <= listed
+    assert _skipped_slots_are_evaluated_elsewhere(reg)
 
 
 def _wall_touching(sim):
@@ -122,6 +133,7 @@ def test_frozen_grains_do_not_move_and_active_ones_feel_them_as_walls():
     top = ~frozen
     assert np.all(sim.X[top, 2] > X0[top, 2] - 0.5e-3)   # held up by the frozen layers, not through them
     assert np.max(reg.push_n[frozen]) > 0      # and the frozen grains saw the push
+    assert _skipped_slots_are_evaluated_elsewhere(reg)
 
 
 def test_springs_survive_freezing_release_and_detaching():
