@@ -232,7 +232,7 @@ class ActiveRegion:
                       sim._wall_moves, sim.wall_vz_m_s, sim.wall_shear, sim._wall_fn, sim._wall_touch, mat.kn_pw,
                       mat.ks_pw, mat.wall_beta, mat.wall_friction, sim._force, sim._torque, self.push_n, sim.X,
                       sim.V, sim.q, sim.L, sim._inertia_s, sim._start, sim._arm, sim._weight, sim._inv_m_g,
-                      sim._force_g, sim._torque_g, True)
+                      sim._force_g, sim._torque_g, True, mat.rolling_friction, mat.wall_rolling_friction, sim._roll)
         return sim._force_g
 
     def unbalanced_force_ratio(self):

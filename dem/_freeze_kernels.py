@@ -13,9 +13,9 @@ import math
 import numba
 import numpy as np
 
-from ._contacts import contact_law
-from ._grain_kernels import advance_one, pose_one
-from ._kernels import wall_contacts
+from ._contacts import contact_law, rolling_moment
+from ._grain_kernels import advance_one, grain_rolling, pose_one
+from ._kernels import wall_contacts, wall_rolling
 
 __all__ = ["active_forces", "active_poses", "contact_sums", "in_contact", "list_walls", "load_history", "relist",
            "row_starts", "sync_history"]
@@ -281,11 +281,14 @@ def active_poses(gidx, X, V, q, L, inertia, start, body, x, v, w, arm, ref, half
 def active_forces(sidx, frozen, gid, x, v, w, r, ms, nbr, cnt, below, shear, touch, fn, cn, ct, kn, ks, mu, dt,
                   near, wall_kind, wall_normal, wall_offset, wall_cyl, wall_moves, wall_vz, wall_shear, wall_fn,
                   wall_touch, kn_w, ks_w, beta_w, mu_w, force_s, torque_s, push, X, V, q, L, inertia, start, arm,
-                  weight, inv_m, force_g, torque_g, advance):
+                  weight, inv_m, force_g, torque_g, advance, mu_r, mu_rw, roll_s):
     """Contact forces of the active spheres ``sidx`` (ascending; each pair from its evaluator's
     row, the row's first ``below`` slots skipped), their walls (of the spheres ``near`` one), and
     the sums and update of their grains (module notes). ``push`` (G,) gets, for each frozen
-    grain, the largest normal force of an active neighbour, N.
+    grain, the largest normal force of an active neighbour, N. ``roll_s`` (N,) gets each active
+    sphere's summed rolling moment (pair contacts ``mu_r``, walls ``mu_rw``;
+    :func:`dem._contacts.rolling_moment`), N·m, which the grain's sums turn into the torque
+    against its spin (:func:`dem._grain_kernels.grain_rolling`).
 
     A sphere's force is complete when its row is done (the rows after it add only to partners
     above them), so each grain is summed (:func:`dem._grain_kernels.update_one`'s sums, in
@@ -295,7 +298,9 @@ def active_forces(sidx, frozen, gid, x, v, w, r, ms, nbr, cnt, below, shear, tou
         p = sidx[a]
         force_s[p, 0] = force_s[p, 1] = force_s[p, 2] = 0.0
         torque_s[p, 0] = torque_s[p, 1] = torque_s[p, 2] = 0.0
-    gfx = gfy = gfz = gtx = gty = gtz = 0.0
+        roll_s[p] = 0.0
+    rolling = mu_r > 0.0 or mu_rw > 0.0
+    gfx = gfy = gfz = gtx = gty = gtz = gmr = 0.0
     for a in range(sidx.shape[0]):
         i = sidx[a]
         ri = r[i]
@@ -346,6 +351,10 @@ def active_forces(sidx, frozen, gid, x, v, w, r, ms, nbr, cnt, below, shear, tou
             tqx += tx * ri
             tqy += ty * ri
             tqz += tz * ri
+            if rolling:
+                roll_s[i] += rolling_moment(mu_r, out[3], ri)
+                if not fj:
+                    roll_s[j] += rolling_moment(mu_r, out[3], r[j])
             if fj:
                 g = gid[j]
                 if out[3] > push[g]:
@@ -368,20 +377,28 @@ def active_forces(sidx, frozen, gid, x, v, w, r, ms, nbr, cnt, below, shear, tou
                 tqx += wtx
                 tqy += wty
                 tqz += wtz
+                if rolling:
+                    roll_s[i] += wall_rolling(i, wall_touch, wall_fn, mu_rw, ri)
         force_s[i, 0], force_s[i, 1], force_s[i, 2] = fx, fy, fz
         torque_s[i, 0], torque_s[i, 1], torque_s[i, 2] = tqx, tqy, tqz
         # the grain's sums, sphere by sphere (update_one's order and operations)
         g = gid[i]
         if i == start[g]:
             gfx = gfy = gfz = 0.0
-            gtx = gty = gtz = 0.0
+            gtx = gty = gtz = gmr = 0.0
         gfx += fx
         gfy += fy
         gfz += fz
         gtx += (arm[i, 1] * fz - arm[i, 2] * fy) + tqx
         gty += (arm[i, 2] * fx - arm[i, 0] * fz) + tqy
         gtz += (arm[i, 0] * fy - arm[i, 1] * fx) + tqz
+        gmr += roll_s[i]
         if i == start[g + 1] - 1:
+            if gmr > 0.0:
+                rx, ry, rz = grain_rolling(g, q, L, inertia, gmr, dt, gtx, gty, gtz)
+                gtx += rx
+                gty += ry
+                gtz += rz
             gfz -= weight[g]
             force_g[g, 0], force_g[g, 1], force_g[g, 2] = gfx, gfy, gfz
             torque_g[g, 0], torque_g[g, 1], torque_g[g, 2] = gtx, gty, gtz

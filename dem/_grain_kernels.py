@@ -21,7 +21,11 @@ wall treatment.
    summed in sphere order, :math:`\mathbf F = \sum_s \mathbf F_s - S m g\,\hat{\mathbf z}`,
    :math:`\mathbf T = \sum_s (\mathbf d_s\times\mathbf F_s + \mathbf T_s)` (the arm of each
    contact point is :math:`\mathbf d_s + r_s\mathbf n`, and :math:`\mathbf n\times\mathbf F =
-   \mathbf n\times\mathbf F_t`); then, when asked, the update
+   \mathbf n\times\mathbf F_t`), plus the rolling torque of the grain's contacts
+   (:func:`dem._contacts.rolling_torque` of the summed moments :math:`M = \sum_c \mu_r F_{n,c} r_c`,
+   against the spin :math:`\boldsymbol\omega^*` the step gives without it, limited to the torque
+   that stops that spin in the step, :math:`|\omega^*| / (\Delta t\,\hat\omega^*\cdot (SI)^{-1}\hat\omega^*)`;
+   :func:`grain_rolling`); then, when asked, the update
 
 .. math::
 
@@ -40,7 +44,9 @@ from __future__ import annotations
 import numba
 import numpy as np
 
-__all__ = ["advance_one", "grain_poses", "grain_update", "pose_one", "update_one"]
+from ._contacts import rolling_torque
+
+__all__ = ["advance_one", "grain_poses", "grain_rolling", "grain_update", "pose_one", "update_one"]
 
 
 @numba.njit(inline="always", cache=True, error_model="numpy")
@@ -104,10 +110,29 @@ def grain_poses(X, V, q, L, inertia, start, body, x, v, w, arm):
 
 
 @numba.njit(inline="always", cache=True, error_model="numpy")
-def update_one(g, X, V, q, L, inertia, start, arm, force_s, torque_s, weight, inv_m, dt, force, torque, advance):
+def grain_rolling(g, q, L, inertia, mr, dt, tx, ty, tz):
+    r"""Rolling torque on grain g for the summed rolling moment ``mr`` (N·m), the other torques
+    (tx, ty, tz) acting: against the spin :math:`\boldsymbol\omega^* = I^{-1}(\mathbf L + \mathbf T\Delta t)`
+    the step gives without it, limited to :math:`|\omega^*| / (\Delta t\,\hat\omega^*\cdot I^{-1}\hat\omega^*)`
+    (:func:`dem._contacts.rolling_torque`; I the scaled inertia in the world frame)."""
+    m = _matrix(q[g, 0], q[g, 1], q[g, 2], q[g, 3])
+    ix, iy, iz = inertia[g, 0], inertia[g, 1], inertia[g, 2]
+    ox, oy, oz = _omega(m, L[g, 0] + tx * dt, L[g, 1] + ty * dt, L[g, 2] + tz * dt, ix, iy, iz)
+    w = np.sqrt(ox * ox + oy * oy + oz * oz)
+    if not w > 0.0:
+        return 0.0, 0.0, 0.0
+    ux, uy, uz = ox / w, oy / w, oz / w
+    cx, cy, cz = _omega(m, ux, uy, uz, ix, iy, iz)
+    return rolling_torque(mr, ox, oy, oz, w / (dt * (ux * cx + uy * cy + uz * cz)))
+
+
+@numba.njit(inline="always", cache=True, error_model="numpy")
+def update_one(g, X, V, q, L, inertia, start, arm, force_s, torque_s, roll_s, weight, inv_m, dt, force, torque,
+               advance):
     """:func:`grain_update` for grain ``g`` alone (the body of its loop)."""
     fx = fy = fz = 0.0
     tx = ty = tz = 0.0
+    mr = 0.0
     for s in range(start[g], start[g + 1]):
         f0, f1, f2 = force_s[s, 0], force_s[s, 1], force_s[s, 2]
         fx += f0
@@ -116,6 +141,12 @@ def update_one(g, X, V, q, L, inertia, start, arm, force_s, torque_s, weight, in
         tx += (arm[s, 1] * f2 - arm[s, 2] * f1) + torque_s[s, 0]
         ty += (arm[s, 2] * f0 - arm[s, 0] * f2) + torque_s[s, 1]
         tz += (arm[s, 0] * f1 - arm[s, 1] * f0) + torque_s[s, 2]
+        mr += roll_s[s]
+    if mr > 0.0:
+        rx, ry, rz = grain_rolling(g, q, L, inertia, mr, dt, tx, ty, tz)
+        tx += rx
+        ty += ry
+        tz += rz
     fz -= weight[g]
     force[g, 0], force[g, 1], force[g, 2] = fx, fy, fz
     torque[g, 0], torque[g, 1], torque[g, 2] = tx, ty, tz
@@ -148,12 +179,16 @@ def advance_one(g, fx, fy, fz, tx, ty, tz, X, V, q, L, inertia, inv_m, dt):
 
 
 @numba.njit(parallel=True, cache=True, error_model="numpy")
-def grain_update(X, V, q, L, inertia, start, arm, force_s, torque_s, weight, inv_m, dt, force, torque, advance):
+def grain_update(X, V, q, L, inertia, start, arm, force_s, torque_s, roll_s, weight, inv_m, dt, force, torque,
+                 advance):
     """Net force and torque on every grain (step 2 of the module notes), and the update.
 
     ``arm`` (N, 3) from :func:`grain_poses`; ``force_s``, ``torque_s`` (N, 3) the spheres' contact
-    forces (N) and torques about their centres (N m); ``weight`` (G,) S m g, N; ``inv_m`` (G,)
-    Δt/(S m); writes ``force``, ``torque`` (G, 3); ``advance``: also update V, X, L, q.
+    forces (N) and torques about their centres (N m); ``roll_s`` (N,) the spheres' summed rolling
+    moments (N m), whose torque acts against the grain's spin (module notes); ``weight`` (G,)
+    S m g, N; ``inv_m`` (G,) Δt/(S m); writes ``force``, ``torque`` (G, 3); ``advance``: also
+    update V, X, L, q.
     """
     for g in numba.prange(X.shape[0]):
-        update_one(g, X, V, q, L, inertia, start, arm, force_s, torque_s, weight, inv_m, dt, force, torque, advance)
+        update_one(g, X, V, q, L, inertia, start, arm, force_s, torque_s, roll_s, weight, inv_m, dt, force, torque,
+                   advance)

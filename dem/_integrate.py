@@ -116,6 +116,7 @@ class Simulation:
         self._w = np.zeros((n, 3))
         self._force = np.zeros((n, 3))
         self._torque = np.zeros((n, 3))
+        self._roll = np.zeros(n)
         skin = skin_m if skin_m is not None else SKIN_FRACTION * float(radii.max())
         self.verlet = VerletList(skin)
         self._set_pairs(np.zeros((0, 4)))
@@ -238,11 +239,11 @@ class Simulation:
         pair_forces(self._x, self._v, self._w, self.radii, self._pi, self._pj, self._cn, self._ct, self.shear,
                     mat.kn_pp, mat.ks_pp, mat.friction, dt, self._f_pair, self._t_pair, self._fn_pair, self._touch)
         particle_update(self._x, self._v, self._w, self.radii, self._ms, self._gforce, vl.first_start,
-                        vl.second_start, vl.by_second, self._f_pair, self._t_pair, self._touch, self._wall_kind,
-                        self._wall_normal, self._wall_offsets(), self._wall_cyl, self._wall_moves,
+                        vl.second_start, vl.by_second, self._f_pair, self._t_pair, self._fn_pair, self._touch,
+                        self._wall_kind, self._wall_normal, self._wall_offsets(), self._wall_cyl, self._wall_moves,
                         self.wall_vz_m_s, self.wall_shear, self._wall_fn, self._wall_touch, mat.kn_pw, mat.ks_pw,
-                        mat.wall_beta, mat.wall_friction, dt, self._inv_m, self._inv_i, self._force,
-                        self._torque, advance)
+                        mat.wall_beta, mat.wall_friction, mat.rolling_friction, mat.wall_rolling_friction, dt,
+                        self._inv_m, self._inv_i, self._force, self._torque, self._roll, advance)
 
     def forces(self):
         """Net force and torque on every particle, both (3, N) component-first (scaled masses).

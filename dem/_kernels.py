@@ -9,8 +9,10 @@ One step is two passes over flat arrays, each a parallel loop:
    pair (history is zeroed for pairs that do not touch).
 2. :func:`particle_update`, one iteration per particle: the sum of its pair forces in a fixed
    order (the pairs where it is first, then those where it is second, each in pair order), its
-   wall contacts (same contact law, wall by wall), gravity, and, when asked, the semi-implicit
-   Euler update of velocity, spin and position.
+   wall contacts (same contact law, wall by wall), gravity, the sum M of its contacts' rolling
+   moments :math:`\mu_r F_n r` (:func:`dem._contacts.rolling_moment`; ``roll``), and, when
+   asked, the semi-implicit Euler update of velocity, spin and position, with the rolling torque
+   :func:`dem._contacts.rolling_torque` against the spin (a grain's is applied by the grain update).
 
 Every sum runs in that fixed order, so the result does not depend on the number of threads
 and equals, bit for bit, the numpy form this replaced (``np.bincount`` over the contacts; see
@@ -24,9 +26,9 @@ from __future__ import annotations
 import numba
 import numpy as np
 
-from ._contacts import contact_law
+from ._contacts import contact_law, rolling_moment, rolling_torque
 
-__all__ = ["pair_damping", "pair_forces", "particle_update", "wall_contacts"]
+__all__ = ["pair_damping", "pair_forces", "particle_update", "wall_contacts", "wall_rolling"]
 
 
 @numba.njit(parallel=True, cache=True, error_model="numpy")
@@ -145,22 +147,38 @@ def wall_contacts(p, x, v, w, r, ms, wall_kind, wall_normal, wall_offset, wall_c
     return wfx, wfy, wfz, wtx, wty, wtz, hits
 
 
+@numba.njit(inline="always", cache=True, error_model="numpy")
+def wall_rolling(p, wall_touch, wall_fn, mu_rw, rp):
+    """Sum of the rolling moments (:func:`dem._contacts.rolling_moment`) of the wall contacts of
+    particle ``p`` (radius ``rp``, m) at the last evaluation, N·m."""
+    m = 0.0
+    for k in range(wall_touch.shape[0]):
+        if wall_touch[k, p]:
+            m += rolling_moment(mu_rw, wall_fn[k, p], rp)
+    return m
+
+
 @numba.njit(parallel=True, cache=True, error_model="numpy")
-def particle_update(x, v, w, r, ms, gforce, first_start, second_start, by_second, f_pair, t_pair, touch,
+def particle_update(x, v, w, r, ms, gforce, first_start, second_start, by_second, f_pair, t_pair, fn_pair, touch,
                     wall_kind, wall_normal, wall_offset, wall_cyl, wall_moves, wall_vz, wall_shear, wall_fn,
-                    wall_touch, kn_w, ks_w, beta, mu_w, dt, inv_m, inv_i, force, torque, advance):
+                    wall_touch, kn_w, ks_w, beta, mu_w, mu_r, mu_rw, dt, inv_m, inv_i, force, torque, roll, advance):
     """Net force and torque on every particle (step 2 of the module notes), and the update.
 
     ``first_start`` (N+1,), ``second_start`` (N+1,), ``by_second`` (Np,): the particle's pairs
     (:class:`dem._neighbors.VerletList`); ``gforce`` (N,) weight with scaled mass; walls as in
     the module notes, ``wall_shear`` (Nw, N, 3) history, ``wall_fn``/``wall_touch`` (Nw, N)
-    written; ``inv_m``, ``inv_i`` (N,) Δt over scaled mass / moment of inertia; ``force``,
-    ``torque`` (N, 3) written; ``advance``: also update v, w, x.
+    written; ``mu_r``, ``mu_rw`` coefficients of rolling friction of pair and wall contacts;
+    ``inv_m``, ``inv_i`` (N,) Δt over scaled mass / moment of inertia; ``force``, ``torque``
+    (N, 3) and ``roll`` (N,) (the rolling moment M, N·m) written; ``advance``: also update v, w,
+    x, with the rolling torque in ``torque`` (against the spin ω* = ω + T ``inv_i`` the step gives
+    without it, limited to stop that spin, M_stop = |ω*|/``inv_i``).
     """
     n = x.shape[0]
+    rolling = mu_r > 0.0 or mu_rw > 0.0
     for p in numba.prange(n):
         fx = fy = fz = 0.0
         tx = ty = tz = 0.0
+        mr = 0.0
         rp = r[p]
         for k in range(first_start[p], first_start[p + 1]):
             if touch[k]:
@@ -170,6 +188,8 @@ def particle_update(x, v, w, r, ms, gforce, first_start, second_start, by_second
                 tx += t_pair[k, 0] * rp
                 ty += t_pair[k, 1] * rp
                 tz += t_pair[k, 2] * rp
+                if rolling:
+                    mr += rolling_moment(mu_r, fn_pair[k], rp)
         for s in range(second_start[p], second_start[p + 1]):
             k = by_second[s]
             if touch[k]:
@@ -179,6 +199,8 @@ def particle_update(x, v, w, r, ms, gforce, first_start, second_start, by_second
                 tx += t_pair[k, 0] * rp
                 ty += t_pair[k, 1] * rp
                 tz += t_pair[k, 2] * rp
+                if rolling:
+                    mr += rolling_moment(mu_r, fn_pair[k], rp)
         # walls: summed apart, wall by wall, then added (one fixed order: the same bits always)
         wfx, wfy, wfz, wtx, wty, wtz, hits = wall_contacts(p, x, v, w, r, ms, wall_kind, wall_normal, wall_offset,
                                                            wall_cyl, wall_moves, wall_vz, wall_shear, wall_fn,
@@ -191,6 +213,15 @@ def particle_update(x, v, w, r, ms, gforce, first_start, second_start, by_second
             ty += wty
             tz += wtz
         fz -= gforce[p]
+        if rolling:
+            mr += wall_rolling(p, wall_touch, wall_fn, mu_rw, rp)
+            if advance and mr > 0.0:        # against the spin the step gives without it
+                wx, wy, wz = w[p, 0] + tx * inv_i[p], w[p, 1] + ty * inv_i[p], w[p, 2] + tz * inv_i[p]
+                rx, ry, rz = rolling_torque(mr, wx, wy, wz, np.sqrt(wx * wx + wy * wy + wz * wz) / inv_i[p])
+                tx += rx
+                ty += ry
+                tz += rz
+        roll[p] = mr
         force[p, 0], force[p, 1], force[p, 2] = fx, fy, fz
         torque[p, 0], torque[p, 1], torque[p, 2] = tx, ty, tz
         if advance:

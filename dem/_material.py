@@ -19,6 +19,9 @@ class Material:
     Stiffnesses are per-entity values as in PFC3D; a contact uses the series
     combination (:func:`dem._contacts.series_stiffness`). ``damping_ratio`` is the critical-damping
     ratio of grain-grain dashpots; ``wall_damping_ratio`` that of grain-wall ones (None: the same).
+    ``rolling_friction`` and ``wall_rolling_friction`` are the coefficients of rolling friction
+    mu_r of grain-grain and grain-wall contacts (torque mu_r F_n R against the body's spin,
+    :func:`dem._contacts.rolling_torque`; 0, the default: none).
     """
 
     density_kg_m3: float = 1285.0
@@ -32,13 +35,15 @@ class Material:
     radius_min_m: float = 0.00275
     radius_max_m: float = 0.00375
     wall_damping_ratio: float | None = None
+    rolling_friction: float = 0.0
+    wall_rolling_friction: float = 0.0
 
     def __post_init__(self):
         for name in ("density_kg_m3", "kn_n_m", "ks_n_m", "wall_kn_n_m", "wall_ks_n_m"):
             v = getattr(self, name)
             if not (np.isfinite(v) and v > 0):
                 raise ValueError(f"{name} must be positive and finite, got {v}")
-        for name in ("friction", "wall_friction"):
+        for name in ("friction", "wall_friction", "rolling_friction", "wall_rolling_friction"):
             v = getattr(self, name)
             if not (np.isfinite(v) and v >= 0):
                 raise ValueError(f"{name} must be >= 0, got {v}")

@@ -40,7 +40,7 @@ def stress_outputs(args):
 
 _POUR_ONLY = (("--drop-height", "drop_height"), ("--rate", "rate"), ("--spout-diameter", "spout_diameter"),
               ("--depth", "depth"), ("--bin-diameter", "bin_diameter"), ("--bin-height", "bin_height"),
-              ("--stress", "stress"), ("--no-freeze", "no_freeze"))
+              ("--stress", "stress"), ("--no-freeze", "no_freeze"), ("--no-rolling", "no_rolling"))
 
 
 def fill_options(args):
@@ -148,6 +148,39 @@ def _pour_material(args, name):
     return mat, used, float(e_pp)
 
 
+#: the rolling-friction model of the poured fills, as the companion JSON names it
+ROLLING_MODEL = ("EDEM standard rolling friction (Ai et al. 2011 type A, directional constant torque): "
+                 "T = -mu_r F_n R omega/|omega| per contact, R the touching sphere's radius, omega the grain's "
+                 "spin; limited to the torque that stops the spin in a step (dem._contacts.rolling_torque)")
+
+
+def _rolling_friction(args, name, material):
+    """The material with the library's coefficients of rolling friction of grain ``name``
+    (grain-grain, grain-wall; 0 where the library has none, and with ``--no-rolling``) and the
+    companion JSON's record of them."""
+    try:
+        g = grain(name)
+    except ValueError:
+        g = None
+    rec = {"on": False, "model": ROLLING_MODEL}
+    vals = {}
+    for key, field, attr in (("particle", "rolling_friction_pp", "rolling_friction"),
+                             ("wall", "rolling_friction_pw", "wall_rolling_friction")):
+        v = getattr(g, field) if g is not None else None
+        if v is None:
+            rec[key] = {"value": 0.0, "source": "none: a template file, not a library grain"}
+        elif v.value is None:
+            rec[key] = {"value": 0.0, "source": "none: the library has no value", "note": v.note}
+        else:
+            rec[key] = {"value": 0.0 if args.no_rolling else float(v.value), "library_value": float(v.value),
+                        "source": v.source, "note": v.note}
+        vals[attr] = rec[key]["value"]
+    rec["on"] = any(x > 0 for x in vals.values())
+    if args.no_rolling:
+        rec["off_by"] = "--no-rolling"
+    return replace(material, **vals), rec
+
+
 def pour_and_load(args, fill, template, container) -> int:
     """--fill rain|spout, then the load of --depth or --stress (several stresses: each from a copy
     of the same poured state)."""
@@ -156,6 +189,7 @@ def pour_and_load(args, fill, template, container) -> int:
         check_fill_options(fill, container, template)
     janssen = _janssen_inputs(template.name) if args.depth is not None else None
     material, used, e_pp = _pour_material(args, template.name)
+    material, rolling = _rolling_friction(args, template.name, material)
     phi_count = grain_porosity(args, template.name)
     if janssen is not None:
         est = janssen_stress(args.depth, bulk_density_kg_m3=material.density_kg_m3 * (1 - phi_count),
@@ -179,12 +213,12 @@ def pour_and_load(args, fill, template, container) -> int:
         bed = sim if poured is None else (poured if k == len(outs) - 1 else copy.deepcopy(poured))
         rc = max(rc, _load_and_write(args, out, bed, stress, janssen=janssen, fill=fill, template=template,
                                      container=container, material=material, used=used, record=record, n=n,
-                                     max_steps=max_steps, pr=pr, t0=t0, c0=c0))
+                                     max_steps=max_steps, pr=pr, t0=t0, c0=c0, rolling=rolling))
     return rc
 
 
 def _load_and_write(args, out, sim, stress, *, janssen, fill, template, container, material, used, record, n,
-                    max_steps, pr, t0, c0) -> int:
+                    max_steps, pr, t0, c0, rolling) -> int:
     """Load one poured bed to ``stress`` (or Janssen's at --depth), write it to ``out``, print its
     lines; the exit status."""
     s = {"n_grains": n, "n_spheres": sim.n, "template": template.name, "template_source": template.source,
@@ -219,7 +253,7 @@ def _load_and_write(args, out, sim, stress, *, janssen, fill, template, containe
              material={k: getattr(material, k) for k in material.__dataclass_fields__},
              engine="dem.clumps (numba: the sphere step's kernels and a rigid-body update)",
              scene=args.scene, seed=args.seed, container=container.to_dict(), material_from_library=used,
-             converged=bool(converged))
+             rolling_friction=rolling, converged=bool(converged))
     if args.stress is not None and len(args.stress) > 1:
         s["bed_set"] = {"stresses_pa": [float(v) for v in args.stress],
                         "note": "one pour; each stress loaded from a copy of the same poured state; "

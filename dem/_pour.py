@@ -3,8 +3,8 @@ r"""Poured fills: grains rain over the whole cross-section or run from a centre 
 A bin is filled by pouring: from a spreader (a uniform rain over the cross-section) or a centre
 spout (a pile at its angle of repose whose grains slide down the slope). :func:`pour_grains`
 does the same with rigid multi-sphere grains (:class:`dem.clumps.ClumpSimulation`), their real
-masses (``FillOptions.mass_scale`` = 1) and the contact friction and restitution of the grain
-library.
+masses (``FillOptions.mass_scale`` = 1) and the contact friction, restitution and rolling
+friction (:func:`dem._contacts.rolling_torque`) of the grain library.
 
 **Entry.** The fall from the drop height H costs no steps: a grain enters just above the bed
 surface with the speed of that fall,

@@ -179,7 +179,8 @@ class ClumpSimulation(Simulation):
         """The sphere step's kernels without their update, then the grains' sums and update."""
         super()._step_kernels(False)
         grain_update(self.X, self.V, self.q, self.L, self._inertia_s, self._start, self._arm, self._force,
-                     self._torque, self._weight, self._inv_m_g, self._dt, self._force_g, self._torque_g, advance)
+                     self._torque, self._roll, self._weight, self._inv_m_g, self._dt, self._force_g, self._torque_g,
+                     advance)
 
     def attach_active(self, *, lo_m, hi_m, capacity=None, policy=None):
         """Step the active grains only, with per-sphere neighbour rows (:class:`dem._freeze.ActiveRegion`,

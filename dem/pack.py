@@ -16,7 +16,7 @@ With ``--grain`` (a library name or a template CSV x,y,z,r) the grains are rigid
 clumps (:mod:`dem.clumps`): the CSV gains ``grain_id`` and a second file ``<stem>.grains.csv`` has
 one row per grain; ``--scene box`` alone means 0.04 x 0.04 x 0.04 m. Grains are poured
 (``--fill rain``, the default, or ``spout``; :mod:`dem._pour`) with their real masses and the
-library's friction and restitution, or grown in place (``--fill grow``, :mod:`dem._clump_pack`; ``--porosity``: :mod:`dem._grain_search`).
+library's friction, restitution and rolling friction (``--no-rolling``: none), or grown in place (``--fill grow``, :mod:`dem._clump_pack`; ``--porosity``: :mod:`dem._grain_search`).
 ``--depth Z --bin-diameter D`` (or ``--stress PA``) then loads the poured bed through a lid
 servo-controlled to Janssen's vertical stress at that depth (:mod:`dem._load`). Several
 ``--stress`` values make a bed set: one pour, each stress loaded from a copy of the same poured
@@ -147,6 +147,10 @@ def _parser():
                    help="poured fill: step every grain to the end (default: grains settled more than four kernel "
                         "lengths below the surface are frozen while the pour goes on, and released before the "
                         "bed's rest is judged and before a load; docs/dem-fill.md, Speed)")
+    p.add_argument("--no-rolling", action="store_const", const=True, default=None,
+                   help="poured fill: no rolling friction (default: the grain library's coefficients of rolling "
+                        "friction, grain-grain and grain-wall, where it has them; 0 where not; docs/dem-fill.md, "
+                        "Rolling friction)")
     p.add_argument("--depth", type=float, default=None,
                    help="rain/spout: load the bed to Janssen's vertical stress at this depth of a bin, m, >= 0 "
                         "(needs --bin-diameter; default: no load)")
