@@ -26,7 +26,7 @@ section Speed):
   flag is set again.
 
 Rows are kept in ascending order. Each pair is listed in both rows and carries its contact
-history (shear spring, touching flag, normal force) in both slots; it is evaluated from one row
+history (shear spring, touching flag) in both slots; it is evaluated from one row
 only, the *evaluator*: min(p, q) when both grains are active, the active one's row when one is
 frozen, none when both are. Whenever the frozen set changes, each changed pair's history is
 copied from its old evaluator's slot to the other, so the new evaluator continues it. A row's
@@ -47,8 +47,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ._freeze_kernels import (active_forces, active_poses, contact_sums, in_contact, list_walls, load_history,
-                              relist, row_starts, sync_history)
+from ._freeze_kernels import (active_forces, active_poses, in_contact, list_walls, load_history, relist,
+                              row_starts, sync_history)
 from ._rigid import quat_to_matrix
 
 __all__ = ["ActiveRegion", "FreezePolicy", "FREEZE_DEPTH_LENGTHS"]
@@ -92,9 +92,7 @@ class ActiveRegion:
         self.below = np.zeros(cap_n, np.int64)
         self.shear = np.zeros((cap_n, width, 3))
         self.touch = np.zeros((cap_n, width), np.uint8)
-        self.fn = np.zeros((cap_n, width))
-        self.cn = np.zeros((cap_n, width))
-        self.ct = np.zeros((cap_n, width))
+        self.fn_sum = np.zeros(2)
         self.mark = np.zeros(cap_n, np.int64)
         self.moved = np.zeros(cap_n, np.int64)
         self.frozen_s = np.zeros(cap_n, np.bool_)
@@ -157,7 +155,7 @@ class ActiveRegion:
             return b
 
         n = max(n, old_n)
-        for name, fill in (("nbr", 0), ("touch", 0), ("fn", 0.0), ("cn", 0.0), ("ct", 0.0)):
+        for name, fill in (("nbr", 0), ("touch", 0)):
             setattr(self, name, grow(getattr(self, name), fill, (n, width)))
         self.shear = grow(self.shear, 0.0, (n, width, 3))
         for name, fill in (("nxt", -1), ("prv", -1), ("cellof", -1), ("cnt", 0), ("below", 0), ("mark", 0),
@@ -166,24 +164,18 @@ class ActiveRegion:
         self.ref = grow(self.ref, np.inf, (n, 3))
 
     def _relist(self, moved, n_moved):
-        sim, mat = self.sim, self.sim.material
-        width = self.nbr.shape[1]
-        buf = np.empty(2 * width, np.int64)
+        sim = self.sim
         k = 0
         while True:
-            tmp_j = np.empty(width, np.int64)
-            tmp_h = np.empty((width, 5))
-            tmp_c = np.empty((width, 2))
-            k = relist(moved, n_moved, k, sim._x, self.ref, sim.radii, sim.gid, sim._ms, self.skin, self.lo,
-                       self.cell, self.dims, self.head, self.nxt, self.prv, self.cellof, self.nbr, self.cnt,
-                       self.shear, self.touch, self.fn, self.cn, self.ct, mat.damping_ratio, mat.kn_pp, mat.ks_pp,
-                       self.mark, buf, tmp_j, tmp_h, tmp_c, sim._wall_kind, sim._wall_normal, self._walls_at,
+            width = self.nbr.shape[1]
+            buf, tmp_j, tmp_h = np.empty(2 * width, np.int64), np.empty(width, np.int64), np.empty((width, 4))
+            k = relist(moved, n_moved, k, sim._x, self.ref, sim.radii, sim.gid, self.skin, self.lo, self.cell,
+                       self.dims, self.head, self.nxt, self.prv, self.cellof, self.nbr, self.cnt, self.shear,
+                       self.touch, self.mark, buf, tmp_j, tmp_h, sim._wall_kind, sim._wall_normal, self._walls_at,
                        sim._wall_cyl, sim._wall_touch, sim.wall_shear, self.near, self.frozen_s, self.below)
             if k >= n_moved:
                 break
-            width = int(width * 1.5) + 1          # a row outgrew its width: widen, resume
-            self._resize(len(self.ref), width)
-            buf = np.empty(2 * width, np.int64)
+            self._resize(len(self.ref), int(width * 1.5) + 1)   # a row outgrew its width: widen, resume
         self.relists += 1
         self.relisted_spheres += n_moved
 
@@ -227,19 +219,20 @@ class ActiveRegion:
             self._relist(self.moved, n_moved)
         mat = sim.material
         active_forces(self.sidx, self.frozen_s, sim.gid, sim._x, sim._v, sim._w, sim.radii, sim._ms, self.nbr,
-                      self.cnt, self.below, self.shear, self.touch, self.fn, self.cn, self.ct, mat.kn_pp, mat.ks_pp,
+                      self.cnt, self.below, self.shear, self.touch, mat.damping_ratio, mat.kn_pp, mat.ks_pp,
                       mat.friction, sim._dt, self.near, sim._wall_kind, sim._wall_normal, offsets, sim._wall_cyl,
                       sim._wall_moves, sim.wall_vz_m_s, sim.wall_shear, sim._wall_fn, sim._wall_touch, mat.kn_pw,
                       mat.ks_pw, mat.wall_beta, mat.wall_friction, sim._force, sim._torque, self.push_n, sim.X,
                       sim.V, sim.q, sim.L, sim._inertia_s, sim._start, sim._arm, sim._weight, sim._inv_m_g,
-                      sim._force_g, sim._torque_g, True, mat.rolling_friction, mat.wall_rolling_friction, sim._roll)
+                      sim._force_g, sim._torque_g, True, mat.rolling_friction, mat.wall_rolling_friction, sim._roll,
+                      self.fn_sum)
         return sim._force_g
 
     def unbalanced_force_ratio(self):
         """Mean |net force| on the active grains over the mean normal force of their contacts
         (grain and wall); inf without contact."""
         sim = self.sim
-        total, n = contact_sums(self.sidx, self.frozen_s, self.nbr, self.cnt, self.touch, self.fn)
+        total, n = float(self.fn_sum[0]), int(self.fn_sum[1])
         wt = sim._wall_touch[:, self.sidx].view(bool)
         wf = sim._wall_fn[:, self.sidx][wt]
         n += len(wf)
@@ -272,7 +265,7 @@ class ActiveRegion:
         self.frozen_g = frozen_g.copy()
         self.frozen_s[:self.n] = frozen_g[sim.gid]
         changed_s = np.flatnonzero(before[:self.n] != self.frozen_s[:self.n]).astype(np.int64)
-        sync_history(changed_s, before, self.nbr, self.cnt, self.shear, self.touch, self.fn)
+        sync_history(changed_s, before, self.nbr, self.cnt, self.shear, self.touch)
         row_starts(self.n, self.frozen_s, self.nbr, self.cnt, self.below)
         newly = changed_g[frozen_g[changed_g]]
         sim.V[newly] = 0.0

@@ -17,7 +17,7 @@ from ._contacts import contact_law, rolling_moment
 from ._grain_kernels import advance_one, grain_rolling, pose_one
 from ._kernels import wall_contacts, wall_rolling
 
-__all__ = ["active_forces", "active_poses", "contact_sums", "in_contact", "list_walls", "load_history", "relist",
+__all__ = ["active_forces", "active_poses", "in_contact", "list_walls", "load_history", "relist",
            "row_starts", "sync_history"]
 
 
@@ -93,20 +93,18 @@ def _find(row, n, i):
 
 
 @numba.njit(inline="always", cache=True)
-def _row_insert(j, i, a, b, nbr, cnt, shear, touch, fn, cn, ct, frozen, below):
-    """Put partner i into row j at its place in ascending order, zero history, dashpots a, b
-    (``below[j]`` kept a count of leading slots that hold active partners below j)."""
+def _row_insert(j, i, nbr, cnt, shear, touch, frozen, below):
+    """Put partner i into row j at its place in ascending order, zero history (``below[j]`` kept
+    a count of leading slots that hold active partners below j)."""
     u = cnt[j]
     while u > 0 and nbr[j, u - 1] > i:
         nbr[j, u] = nbr[j, u - 1]
         shear[j, u, 0], shear[j, u, 1], shear[j, u, 2] = shear[j, u - 1, 0], shear[j, u - 1, 1], shear[j, u - 1, 2]
-        touch[j, u], fn[j, u], cn[j, u], ct[j, u] = touch[j, u - 1], fn[j, u - 1], cn[j, u - 1], ct[j, u - 1]
+        touch[j, u] = touch[j, u - 1]
         u -= 1
     nbr[j, u] = i
     shear[j, u, 0] = shear[j, u, 1] = shear[j, u, 2] = 0.0
     touch[j, u] = 0
-    fn[j, u] = 0.0
-    cn[j, u], ct[j, u] = a, b
     cnt[j] += 1
     if u <= below[j]:
         if i < j and not frozen[i]:
@@ -116,7 +114,7 @@ def _row_insert(j, i, a, b, nbr, cnt, shear, touch, fn, cn, ct, frozen, below):
 
 
 @numba.njit(inline="always", cache=True)
-def _row_delete(j, i, nbr, cnt, shear, touch, fn, cn, ct, below):
+def _row_delete(j, i, nbr, cnt, shear, touch, below):
     """Take partner i out of row j (the rest keep their order)."""
     n = cnt[j]
     u = _find(nbr[j], n, i)
@@ -125,7 +123,7 @@ def _row_delete(j, i, nbr, cnt, shear, touch, fn, cn, ct, below):
     for t in range(u, n - 1):
         nbr[j, t] = nbr[j, t + 1]
         shear[j, t, 0], shear[j, t, 1], shear[j, t, 2] = shear[j, t + 1, 0], shear[j, t + 1, 1], shear[j, t + 1, 2]
-        touch[j, t], fn[j, t], cn[j, t], ct[j, t] = touch[j, t + 1], fn[j, t + 1], cn[j, t + 1], ct[j, t + 1]
+        touch[j, t] = touch[j, t + 1]
     cnt[j] = n - 1
 
 
@@ -172,9 +170,8 @@ def list_walls(idx, ref, r, skin, wall_kind, wall_normal, wall_offset, wall_cyl,
 
 
 @numba.njit(cache=True)
-def relist(moved, n_moved, first, x, ref, r, gid, ms, skin, lo, cell, dims, head, nxt, prv, cellof,
-           nbr, cnt, shear, touch, fn, cn, ct, beta, kn, ks, mark, buf, tmp_j, tmp_h, tmp_c,
-           wall_kind, wall_normal, wall_offset, wall_cyl, wall_touch, wall_shear, near, frozen, below):
+def relist(moved, n_moved, first, x, ref, r, gid, skin, lo, cell, dims, head, nxt, prv, cellof,
+           nbr, cnt, shear, touch, mark, buf, tmp_j, tmp_h, wall_kind, wall_normal, wall_offset, wall_cyl, wall_touch, wall_shear, near, frozen, below):
     """New reference, row and wall flag (:func:`_list_walls`) for each sphere
     ``moved[first:n_moved]`` (module notes), in order.
 
@@ -214,27 +211,20 @@ def relist(moved, n_moved, first, x, ref, r, gid, ms, skin, lo, cell, dims, head
             s = mark[j] - 1
             if s >= 0:                      # kept: its history moves with it
                 tmp_h[t, 0], tmp_h[t, 1], tmp_h[t, 2] = shear[i, s, 0], shear[i, s, 1], shear[i, s, 2]
-                tmp_h[t, 3], tmp_h[t, 4] = touch[i, s], fn[i, s]
-                tmp_c[t, 0], tmp_c[t, 1] = cn[i, s], ct[i, s]
+                tmp_h[t, 3] = touch[i, s]
                 mark[j] = -1
             else:                           # new: zero history, in j's row too
-                meff = ms[i] * ms[j] / (ms[i] + ms[j])
-                a = 2.0 * beta * np.sqrt(meff * kn)
-                b = 2.0 * beta * np.sqrt(meff * ks)
-                tmp_h[t, 0] = tmp_h[t, 1] = tmp_h[t, 2] = tmp_h[t, 3] = tmp_h[t, 4] = 0.0
-                tmp_c[t, 0], tmp_c[t, 1] = a, b
-                _row_insert(j, i, a, b, nbr, cnt, shear, touch, fn, cn, ct, frozen, below)
+                tmp_h[t, 0] = tmp_h[t, 1] = tmp_h[t, 2] = tmp_h[t, 3] = 0.0
+                _row_insert(j, i, nbr, cnt, shear, touch, frozen, below)
         for s in range(cnt[i]):             # dropped: out of j's row
             j = nbr[i, s]
             if mark[j] > 0:
-                _row_delete(j, i, nbr, cnt, shear, touch, fn, cn, ct, below)
+                _row_delete(j, i, nbr, cnt, shear, touch, below)
             mark[j] = 0
         for t in range(m):
             nbr[i, t] = tmp_j[t]
             shear[i, t, 0], shear[i, t, 1], shear[i, t, 2] = tmp_h[t, 0], tmp_h[t, 1], tmp_h[t, 2]
             touch[i, t] = np.uint8(tmp_h[t, 3])
-            fn[i, t] = tmp_h[t, 4]
-            cn[i, t], ct[i, t] = tmp_c[t, 0], tmp_c[t, 1]
         cnt[i] = m
         below[i] = _below(i, frozen, nbr, m)
     return n_moved
@@ -278,15 +268,16 @@ def active_poses(gidx, X, V, q, L, inertia, start, body, x, v, w, arm, ref, half
 
 
 @numba.njit(cache=True, error_model="numpy")
-def active_forces(sidx, frozen, gid, x, v, w, r, ms, nbr, cnt, below, shear, touch, fn, cn, ct, kn, ks, mu, dt,
+def active_forces(sidx, frozen, gid, x, v, w, r, ms, nbr, cnt, below, shear, touch, beta, kn, ks, mu, dt,
                   near, wall_kind, wall_normal, wall_offset, wall_cyl, wall_moves, wall_vz, wall_shear, wall_fn,
                   wall_touch, kn_w, ks_w, beta_w, mu_w, force_s, torque_s, push, X, V, q, L, inertia, start, arm,
-                  weight, inv_m, force_g, torque_g, advance, mu_r, mu_rw, roll_s):
+                  weight, inv_m, force_g, torque_g, advance, mu_r, mu_rw, roll_s, fn_sum):
     """Contact forces of the active spheres ``sidx`` (ascending; each pair from its evaluator's
     row, the row's first ``below`` slots skipped), their walls (of the spheres ``near`` one), and
     the sums and update of their grains (module notes). ``push`` (G,) gets, for each frozen
-    grain, the largest normal force of an active neighbour, N. ``roll_s`` (N,) gets each active
-    sphere's summed rolling moment (pair contacts ``mu_r``, walls ``mu_rw``;
+    grain, the largest normal force of an active neighbour, N; ``fn_sum`` (2,) the sum of the
+    normal forces of the touching pairs evaluated, N, and their count. ``roll_s`` (N,) gets each
+    active sphere's summed rolling moment (pair contacts ``mu_r``, walls ``mu_rw``;
     :func:`dem._contacts.rolling_moment`), N·m, which the grain's sums turn into the torque
     against its spin (:func:`dem._grain_kernels.grain_rolling`).
 
@@ -301,6 +292,7 @@ def active_forces(sidx, frozen, gid, x, v, w, r, ms, nbr, cnt, below, shear, tou
         roll_s[p] = 0.0
     rolling = mu_r > 0.0 or mu_rw > 0.0
     gfx = gfy = gfz = gtx = gty = gtz = gmr = 0.0
+    total_fn, n_fn = 0.0, 0
     for a in range(sidx.shape[0]):
         i = sidx[a]
         ri = r[i]
@@ -324,7 +316,6 @@ def active_forces(sidx, frozen, gid, x, v, w, r, ms, nbr, cnt, below, shear, tou
                 if touch[i, s]:
                     touch[i, s] = 0
                     shear[i, s, 0] = shear[i, s, 1] = shear[i, s, 2] = 0.0
-                    fn[i, s] = 0.0
                 continue
             touch[i, s] = 1
             dist = np.sqrt(dist2)
@@ -337,9 +328,11 @@ def active_forces(sidx, frozen, gid, x, v, w, r, ms, nbr, cnt, below, shear, tou
             vx = vi0 - v[j, 0] + (ay * nz - az * ny)
             vy = vi1 - v[j, 1] + (az * nx - ax * nz)
             vz = vi2 - v[j, 2] + (ax * ny - ay * nx)
+            meff = ms[i] * ms[j] / (ms[i] + ms[j])       # the dashpots (dem._kernels.pair_damping)
             out = contact_law(rsum - dist, nx, ny, nz, vx, vy, vz, shear[i, s, 0], shear[i, s, 1], shear[i, s, 2],
-                              kn, ks, cn[i, s], ct[i, s], mu, dt)
-            fn[i, s] = out[3]
+                              kn, ks, 2.0 * beta * np.sqrt(meff * kn), 2.0 * beta * np.sqrt(meff * ks), mu, dt)
+            total_fn += out[3]
+            n_fn += 1
             ftx, fty, ftz = out[4], out[5], out[6]
             shear[i, s, 0], shear[i, s, 1], shear[i, s, 2] = out[7], out[8], out[9]
             tx = ny * ftz - nz * fty
@@ -404,6 +397,7 @@ def active_forces(sidx, frozen, gid, x, v, w, r, ms, nbr, cnt, below, shear, tou
             torque_g[g, 0], torque_g[g, 1], torque_g[g, 2] = gtx, gty, gtz
             if advance:
                 advance_one(g, gfx, gfy, gfz, gtx, gty, gtz, X, V, q, L, inertia, inv_m, dt)
+    fn_sum[0], fn_sum[1] = total_fn, n_fn
 
 
 @numba.njit(inline="always", cache=True)
@@ -416,7 +410,7 @@ def _evaluator(i, j, frozen):
 
 
 @numba.njit(cache=True)
-def sync_history(changed, frozen_before, nbr, cnt, shear, touch, fn):
+def sync_history(changed, frozen_before, nbr, cnt, shear, touch):
     """Copy each pair of the spheres ``changed`` from its evaluator's slot under ``frozen_before``
     to the other slot (module notes)."""
     for a in range(changed.shape[0]):
@@ -429,10 +423,10 @@ def sync_history(changed, frozen_before, nbr, cnt, shear, touch, fn):
             u = _find(nbr[j], cnt[j], i)
             if e == i:
                 shear[j, u, 0], shear[j, u, 1], shear[j, u, 2] = shear[i, s, 0], shear[i, s, 1], shear[i, s, 2]
-                touch[j, u], fn[j, u] = touch[i, s], fn[i, s]
+                touch[j, u] = touch[i, s]
             else:
                 shear[i, s, 0], shear[i, s, 1], shear[i, s, 2] = shear[j, u, 0], shear[j, u, 1], shear[j, u, 2]
-                touch[i, s], fn[i, s] = touch[j, u], fn[j, u]
+                touch[i, s] = touch[j, u]
 
 
 @numba.njit(cache=True)
@@ -463,17 +457,3 @@ def in_contact(sidx, frozen, nbr, cnt, touch, out):
             if (j > i or frozen[j]) and touch[i, s]:
                 out[i] = True
                 out[j] = True
-
-
-@numba.njit(cache=True)
-def contact_sums(sidx, frozen, nbr, cnt, touch, fn):
-    """(sum, count) of the normal forces of the touching pairs evaluated from the rows ``sidx``."""
-    total, n = 0.0, 0
-    for a in range(sidx.shape[0]):
-        i = sidx[a]
-        for s in range(cnt[i]):
-            j = nbr[i, s]
-            if (j > i or frozen[j]) and touch[i, s]:
-                total += fn[i, s]
-                n += 1
-    return total, n
