@@ -17,16 +17,18 @@ from dem.pack import main
 from dem.templates import library_template
 
 
-def _bed(seed=0, jitter=0.0, settle=300):
-    """36 soybean grains stacked on a lattice in a box their size, settled ``settle`` steps
-    into contact, then given random velocities (normal, ``jitter`` m/s)."""
+def _bed(seed=0, jitter=0.0, settle=300, kind="box"):
+    """36 soybean grains stacked on a lattice in a box their size (or the cylinder around that
+    box), settled ``settle`` steps into contact, then given random velocities (normal,
+    ``jitter`` m/s)."""
     t = library_template("soybean")
     ex = t.extent_m
     nx, ny, layers = 3, 4, 3
     g = np.stack(np.meshgrid(np.arange(nx), np.arange(ny), np.arange(layers), indexing="ij"), -1).reshape(-1, 3)
     x = (g + 0.5) * ex - np.array([nx * ex[0] / 2, ny * ex[1] / 2, 0.0])
     q = np.tile([1.0, 0, 0, 0], (len(x), 1))
-    box = Container("box", (nx * ex[0] + 1e-4, ny * ex[1] + 1e-4), 0.03)
+    side = (nx * ex[0] + 1e-4, ny * ex[1] + 1e-4)
+    box = Container("box", side, 0.03) if kind == "box" else Container("cylinder", (float(np.hypot(*side)),), 0.03)
     sim = ClumpSimulation([t], np.zeros(len(x), int), x, q, np.ones(len(x)), box.walls(lid=False), Material(),
                           mass_scale=100.0, threads=1)
     for _ in range(settle):
@@ -79,15 +81,20 @@ def test_rows_after_partial_relists_are_the_full_rebuild_and_its_contacts():
 
 
 def _wall_touching(sim):
-    """(walls, spheres) bool: sphere centre closer to the plane than its radius, by brute force."""
+    """(walls, spheres) bool: sphere centre closer to the wall (plane or cylinder) than its
+    radius, by brute force."""
     d = sim._wall_offsets()[:, None] + sim._wall_normal @ sim._x.T
+    cyl = sim._wall_kind == 1
+    c = sim._wall_cyl[cyl]
+    d[cyl] = c[:, 2:3] - np.hypot(sim._x[:, 0][None] - c[:, 0:1], sim._x[:, 1][None] - c[:, 1:2])
     return d < sim.radii[None]
 
 
-def test_wall_contacts_are_evaluated_for_every_sphere_that_touches_a_wall():
+@pytest.mark.parametrize("kind", ["box", "cylinder"])
+def test_wall_contacts_are_evaluated_for_every_sphere_that_touches_a_wall(kind):
     """The wall flags (a wall within r + skin of the reference) miss no wall contact, skip the
     spheres far from every wall, and follow the walls when the container moves."""
-    sim, _, lo, hi = _bed(jitter=0.3)
+    sim, _, lo, hi = _bed(jitter=0.3, kind=kind)
     reg = sim.attach_active(lo_m=lo, hi_m=hi)
     for _ in range(300):
         sim.step()
@@ -99,7 +106,8 @@ def test_wall_contacts_are_evaluated_for_every_sphere_that_touches_a_wall():
     sim.z_offset_m = 8e-3                       # the floor rises through the bottom layer
     sim.step()
     truth = _wall_touching(sim)
-    assert np.any(truth[4] & ~near)             # spheres far from every wall before now touch the floor
+    floor = sim._wall_normal[:, 2] == 1.0
+    assert np.any(truth[floor] & ~near)         # spheres far from every wall before now touch the floor
     assert np.array_equal(sim._wall_touch.view(bool), truth)
 
 
