@@ -47,8 +47,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ._freeze_kernels import (active_forces, active_poses, in_contact, list_walls, load_history, relist,
-                              row_starts, sync_history)
+from ._freeze_kernels import (active_forces, active_poses, in_contact, list_walls, load_history, pair_dashpots,
+                              relist, row_starts, sync_history)
 from ._rigid import quat_to_matrix
 
 __all__ = ["ActiveRegion", "FreezePolicy", "FREEZE_DEPTH_LENGTHS"]
@@ -93,6 +93,8 @@ class ActiveRegion:
         self.shear = np.zeros((cap_n, width, 3))
         self.touch = np.zeros((cap_n, width), np.uint8)
         self.fn_sum = np.zeros(2)
+        self._dash = np.full(2, -1.0)
+        self._dash_for = (None, None)
         self.mark = np.zeros(cap_n, np.int64)
         self.moved = np.zeros(cap_n, np.int64)
         self.frozen_s = np.zeros(cap_n, np.bool_)
@@ -205,6 +207,16 @@ class ActiveRegion:
                    sim._wall_normal, offsets, sim._wall_cyl, sim._wall_touch, sim.wall_shear, self.near)
         self._walls_at = offsets
 
+    def _set_dashpots(self):
+        """The pair dashpots when every sphere has the same mass (one value for every pair), else
+        none (each pair's from its masses)."""
+        sim, mat = self.sim, self.sim.material
+        ms = sim._ms
+        self._dash[:] = -1.0
+        if len(ms) and np.all(ms == ms[0]):
+            self._dash[:] = pair_dashpots(float(ms[0]), float(ms[0]), mat.damping_ratio, mat.kn_pp, mat.ks_pp)
+        self._dash_for = (mat, ms)
+
     # -- the step
     def step(self):
         """One step of the active grains (module notes); returns the net force on every grain (G, 3)."""
@@ -218,8 +230,10 @@ class ActiveRegion:
         if n_moved:
             self._relist(self.moved, n_moved)
         mat = sim.material
+        if self._dash_for[0] is not mat or self._dash_for[1] is not sim._ms:
+            self._set_dashpots()
         active_forces(self.sidx, self.frozen_s, sim.gid, sim._x, sim._v, sim._w, sim.radii, sim._ms, self.nbr,
-                      self.cnt, self.below, self.shear, self.touch, mat.damping_ratio, mat.kn_pp, mat.ks_pp,
+                      self.cnt, self.below, self.shear, self.touch, mat.damping_ratio, self._dash, mat.kn_pp, mat.ks_pp,
                       mat.friction, sim._dt, self.near, sim._wall_kind, sim._wall_normal, offsets, sim._wall_cyl,
                       sim._wall_moves, sim.wall_vz_m_s, sim.wall_shear, sim._wall_fn, sim._wall_touch, mat.kn_pw,
                       mat.ks_pw, mat.wall_beta, mat.wall_friction, sim._force, sim._torque, self.push_n, sim.X,

@@ -17,7 +17,7 @@ from ._contacts import contact_law, rolling_moment
 from ._grain_kernels import advance_one, grain_rolling, pose_one
 from ._kernels import wall_contacts, wall_rolling
 
-__all__ = ["active_forces", "active_poses", "in_contact", "list_walls", "load_history", "relist",
+__all__ = ["active_forces", "active_poses", "in_contact", "list_walls", "load_history", "pair_dashpots", "relist",
            "row_starts", "sync_history"]
 
 
@@ -247,6 +247,16 @@ def row_starts(n, frozen, nbr, cnt, below):
 
 
 # ---------------------------------------------------------------------------- the step
+@numba.njit(inline="always", cache=True, error_model="numpy")
+def pair_dashpots(mi, mj, beta, kn, ks):
+    r"""Normal and shear dashpots of a pair of masses ``mi``, ``mj`` (kg), N·s/m:
+    :math:`c = 2\beta\sqrt{m^* k}`, :math:`m^* = m_i m_j/(m_i + m_j)` (the operations of
+    :func:`dem._kernels.pair_damping`, so the same bits)."""
+    meff = mi * mj / (mi + mj)
+    return 2.0 * beta * np.sqrt(meff * kn), 2.0 * beta * np.sqrt(meff * ks)
+
+
+
 @numba.njit(cache=True, error_model="numpy")
 def active_poses(gidx, X, V, q, L, inertia, start, body, x, v, w, arm, ref, half_skin, moved):
     """Sphere state of the active grains ``gidx`` (:func:`dem._grain_kernels.pose_one`); the
@@ -268,7 +278,7 @@ def active_poses(gidx, X, V, q, L, inertia, start, body, x, v, w, arm, ref, half
 
 
 @numba.njit(cache=True, error_model="numpy")
-def active_forces(sidx, frozen, gid, x, v, w, r, ms, nbr, cnt, below, shear, touch, beta, kn, ks, mu, dt,
+def active_forces(sidx, frozen, gid, x, v, w, r, ms, nbr, cnt, below, shear, touch, beta, dash, kn, ks, mu, dt,
                   near, wall_kind, wall_normal, wall_offset, wall_cyl, wall_moves, wall_vz, wall_shear, wall_fn,
                   wall_touch, kn_w, ks_w, beta_w, mu_w, force_s, torque_s, push, X, V, q, L, inertia, start, arm,
                   weight, inv_m, force_g, torque_g, advance, mu_r, mu_rw, roll_s, fn_sum):
@@ -276,7 +286,9 @@ def active_forces(sidx, frozen, gid, x, v, w, r, ms, nbr, cnt, below, shear, tou
     row, the row's first ``below`` slots skipped), their walls (of the spheres ``near`` one), and
     the sums and update of their grains (module notes). ``push`` (G,) gets, for each frozen
     grain, the largest normal force of an active neighbour, N; ``fn_sum`` (2,) the sum of the
-    normal forces of the touching pairs evaluated, N, and their count. ``roll_s`` (N,) gets each
+    normal forces of the touching pairs evaluated, N, and their count. The dashpots of a pair
+    are :func:`pair_dashpots` of its masses, or ``dash`` (2,) when every sphere has the same
+    mass (``dash[0]`` < 0 otherwise). ``roll_s`` (N,) gets each
     active sphere's summed rolling moment (pair contacts ``mu_r``, walls ``mu_rw``;
     :func:`dem._contacts.rolling_moment`), N·m, which the grain's sums turn into the torque
     against its spin (:func:`dem._grain_kernels.grain_rolling`).
@@ -328,9 +340,12 @@ def active_forces(sidx, frozen, gid, x, v, w, r, ms, nbr, cnt, below, shear, tou
             vx = vi0 - v[j, 0] + (ay * nz - az * ny)
             vy = vi1 - v[j, 1] + (az * nx - ax * nz)
             vz = vi2 - v[j, 2] + (ax * ny - ay * nx)
-            meff = ms[i] * ms[j] / (ms[i] + ms[j])       # the dashpots (dem._kernels.pair_damping)
+            if dash[0] >= 0.0:
+                c_n, c_t = dash[0], dash[1]
+            else:
+                c_n, c_t = pair_dashpots(ms[i], ms[j], beta, kn, ks)
             out = contact_law(rsum - dist, nx, ny, nz, vx, vy, vz, shear[i, s, 0], shear[i, s, 1], shear[i, s, 2],
-                              kn, ks, 2.0 * beta * np.sqrt(meff * kn), 2.0 * beta * np.sqrt(meff * ks), mu, dt)
+                              kn, ks, c_n, c_t, mu, dt)
             total_fn += out[3]
             n_fn += 1
             ftx, fty, ftz = out[4], out[5], out[6]
