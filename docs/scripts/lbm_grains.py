@@ -43,6 +43,7 @@ from pathlib import Path
 import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
+sys.path.insert(1, str(Path(__file__).resolve().parents[2]))     # the repository's packages
 from lbm_periodic import C, CudaLattice, Lattice, plan   # noqa: E402  (beside this script)
 
 OPP = np.r_[0, np.arange(10, 19), np.arange(1, 10)]

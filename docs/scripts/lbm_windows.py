@@ -45,6 +45,7 @@ from pathlib import Path
 import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
+sys.path.insert(1, str(Path(__file__).resolve().parents[2]))     # the repository's packages
 from lbm_grains import BoxLattice, mirrored_index, sample_box, voxelise_box  # noqa: E402
 from lbm_periodic import C  # noqa: E402
 
@@ -402,6 +403,174 @@ def mates_bins(bed, ref=None, log=print):
     return out
 
 
+def _window_network(bed, grain_mates="window"):
+    """Tessellation and the network's Stokes solution in the sample box with the default
+    conduit model (table-only, grain mates out of the windows unless told otherwise)."""
+    from network import tessellate
+    from network.flow import ConductanceOptions, SampleOptions, solve_network
+    from network.packing import read_container, read_packing
+
+    pk = read_packing(bed)
+    tess = tessellate(pk)
+    cond = ConductanceOptions(policy="table-only", model_options={"grain_mates": grain_mates})
+    res = solve_network(pk, axis="z", sample=SampleOptions(container=read_container(bed)),
+                        conductance=cond, tessellation=tess)
+    return pk, tess, res
+
+
+def mate_classes(tess, th):
+    """Each conduit's grain-mate class and its g in the three modes: 'untouched' (no grain
+    mate cuts the window or any section), 'sections cut' (the window is not cut, some
+    section is: 'all' lowers g by 3 % or more), 'window cut' (a mate takes flow rate from the
+    window); returns (codes 0 / 1 / 2, window factors, {mode: g})."""
+    from network.conductance import conduit_conductance
+    from network.conductance._mates import window_factors_compiled
+
+    wf = window_factors_compiled(tess.packing, tess.throat_vertices[th])
+    gs = {m: np.asarray(conduit_conductance(tess, th, policy="table-only", grain_mates=m).g)
+          for m in ("off", "window", "all")}
+    ok = gs["window"] > 0
+    ra = np.where(ok, gs["all"] / np.where(ok, gs["window"], 1.0), 1.0)
+    code = np.where(wf < 1.0, 2, np.where(ra < 0.97, 1, 0))
+    return code, wf, gs
+
+
+MATE_CLASSES = ("untouched", "sections cut", "window cut")
+
+
+def classes_report(bed, log=print):
+    """Where a bed's dissipation goes in the network (the default model): each conduit's
+    share q^2/g of the Stokes dissipation (its d ln k / d ln g) by window class (a deep pair
+    of one grain or three grains), grain-mate class (:func:`mate_classes`), the smallest over
+    the largest of the window's three radii, and the windows the mates nearly close
+    (:func:`throats.section_ratio`'s shape-factor branch); and the first-order change of k
+    from 'window' to 'off' and to 'all' per class."""
+    from throats import deep_overlap, sub_triangle_centroids, triangle_vertices
+
+    pk, tess, res = _window_network(bed)
+    th = np.asarray(res.throat_ids)
+    q, g = np.asarray(res.throat_flow_m3_s), np.asarray(res.throat_conductance)
+    ok = np.isfinite(q) & np.isfinite(g) & (g > 0)
+    power = np.where(ok, q**2 / np.where(ok, g, 1.0), 0.0)
+    share = power / power.sum()
+    deep = deep_overlap(tess.throat_radii[th], tess.throat_sides[th])
+    code, wf, gs = mate_classes(tess, th)
+    r = tess.throat_radii[th]
+    ratio = r.min(axis=1) / r.max(axis=1)
+    # three-disk open fraction on the 16^2 sub-triangle centroids (section_ratio's rule)
+    s = tess.throat_sides[th]
+    V = triangle_vertices(s)
+    b1, b2 = sub_triangle_centroids(16)
+    px, py = V[:, None, 1, 0] * b1 + V[:, None, 2, 0] * b2, V[:, None, 2, 1] * b2
+    d3 = np.hypot(px, py) - r[:, None, 0]
+    for k in (1, 2):
+        d3 = np.minimum(d3, np.hypot(px - V[:, None, k, 0], py - V[:, None, k, 1])
+                        - r[:, None, k])
+    narrow = (wf < 1.0) & ((d3 > 0).mean(axis=1) < 0.1)
+    gw = np.where(gs["window"] > 0, gs["window"], 1.0)
+    out = {"bed": str(bed), "k_m2": res.permeability_m2, "n_conduits": int(th.size),
+           "narrow_cut_windows": {"n": int(narrow.sum()), "share": float(share[narrow].sum())},
+           "rows": []}
+    groups = [("all", np.ones(th.size, bool))]
+    groups += [(f"{w} / {MATE_CLASSES[c]}", (deep == d) & (code == c))
+               for d, w in ((False, "three grains"), (True, "deep pair")) for c in range(3)]
+    groups += [(f"radius ratio {lo}-{hi}", (ratio >= lo) & (ratio < hi))
+               for lo, hi in ((0.0, 0.6), (0.6, 0.8), (0.8, 0.95), (0.95, 1.01))]
+    for name, m in groups:
+        row = {"class": name, "n": int(m.sum()), "share": float(share[m].sum())}
+        for mode in ("off", "all"):
+            rr = np.where(gs["window"][m] > 0, gs[mode][m] / gw[m], 1.0)
+            row[f"dlnk_{mode}_minus_window"] = float(np.sum(share[m]
+                                                            * np.log(np.maximum(rr, 1e-3))))
+        out["rows"].append(row)
+        log(json.dumps(row))
+    return out
+
+
+def fe_check(bed, log=print):
+    """The network's k on a bed with FE in place of its two estimates: every cut window's
+    factor by :func:`throats.section_fem` (the section with its live grain mates over the
+    three-disk section) against :func:`throats.section_ratio`, and every window and section
+    the Q* table cannot answer by :func:`throats.solve_fem` (table-only gives such a window
+    the shape-factor estimate and continues such a section by cell-model ratios)."""
+    import throats
+    from network.conductance import _conduit
+    from network.conductance._mates import _live, grain_mates, mate_radii
+    from network.conductance._qstar import QstarResult
+    from network.flow import ConductanceOptions, SampleOptions, solve_network
+    from network.packing import read_container
+
+    pk, tess, res = _window_network(bed)
+    th = np.asarray(res.throat_ids)
+    solve = lambda: solve_network(pk, axis="z",                           # noqa: E731
+                                  sample=SampleOptions(container=read_container(bed)),
+                                  conductance=ConductanceOptions(policy="table-only"),
+                                  tessellation=tess).permeability_m2
+    k0 = res.permeability_m2
+    wf = _conduit.window_factors_compiled(pk, tess.throat_vertices[th])
+    cut = np.flatnonzero(wf < 1.0)
+    vt = tess.throat_vertices[th[cut]]
+    sides, radii = tess.throat_sides[th[cut]], tess.throat_radii[th[cut]]
+    mates = grain_mates(pk, vt, np.zeros((cut.size, 2)), np.ones((cut.size, 2)))
+    rho = mate_radii(mates, np.zeros(mates.rows.size))
+    live = _live(mates, rho, throats.triangle_vertices(sides[mates.rows]), radii[mates.rows])
+    fe = np.full(cut.size, np.nan)
+    for j, i in enumerate(mates.rows):
+        e = live[j]
+        V = throats.triangle_vertices(sides[i:i + 1])
+        qa, sa = throats.section_fem(sides[i:i + 1],
+                                     np.concatenate([V[0], mates.center[j][e]])[None],
+                                     np.concatenate([radii[i], rho[j][e]])[None])
+        q3, s3 = throats.section_fem(sides[i:i + 1], V, radii[i:i + 1])
+        if s3[0] == "ok" and sa[0] in ("ok", "closed"):
+            fe[i] = qa[0] / q3[0]
+    good = np.isfinite(fe) & (fe > 0)
+    err = wf[cut][good] / fe[good] - 1.0
+    out = {"bed": str(bed), "k_m2": k0, "n_cut_windows": int(cut.size),
+           "n_fe": int(good.sum()), "ratio_error_median_abs": float(np.median(np.abs(err))),
+           "ratio_error_p95_abs": float(np.percentile(np.abs(err), 95)),
+           "ratio_error_max_abs": float(np.abs(err).max()),
+           "ratio_error_signed_median": float(np.median(err))}
+    key = {tuple(v): f for v, f in zip(map(tuple, vt[np.isfinite(fe)]), fe[np.isfinite(fe)])}
+    orig_wf, orig_q = _conduit.window_factors_compiled, _conduit.policy_qstar
+
+    def fe_factors(packing, vertices, **kw):
+        f = orig_wf(packing, vertices, **kw)
+        for a, v in enumerate(map(tuple, np.asarray(vertices))):
+            f[a] = key.get(v, f[a])
+        return f
+
+    count = {"n": 0}
+
+    def fe_outside(r, s, **kw):
+        q = orig_q(r, s, **kw)
+        src = np.asarray(q.source)
+        bad = np.flatnonzero(src == "shape-factor")
+        if bad.size == 0:
+            return q
+        qf = np.asarray(throats.solve_fem(np.asarray(r)[bad], np.asarray(s)[bad],
+                                          rtol=1e-2).qstar, float)
+        fine = np.isfinite(qf) & (qf >= 0)
+        qq, ss = np.asarray(q.qstar, float).copy(), src.astype("<U24")
+        qq[bad[fine]], ss[bad[fine]] = qf[fine], "fe"
+        count["n"] += int(fine.sum())
+        return QstarResult(qq, ss, q.error_estimate, q.stats)
+
+    try:
+        _conduit.window_factors_compiled = fe_factors
+        out["k_fe_window_factors_m2"] = solve()
+        _conduit.window_factors_compiled = orig_wf
+        _conduit.policy_qstar = fe_outside
+        out["k_fe_outside_table_m2"] = solve()
+    finally:
+        _conduit.window_factors_compiled, _conduit.policy_qstar = orig_wf, orig_q
+    out["n_fe_outside_table"] = count["n"]
+    out["change_fe_window_factors"] = out["k_fe_window_factors_m2"] / k0 - 1.0
+    out["change_fe_outside_table"] = out["k_fe_outside_table_m2"] / k0 - 1.0
+    log(json.dumps(out, indent=1))
+    return out
+
+
 def compare(field_npz, log=print):
     """Per-conduit resolved flux and conductance against the network's (module docstring)."""
     z = np.load(field_npz)
@@ -548,6 +717,42 @@ def compare(field_npz, log=print):
             "g_ratio_power_weighted_log_mean": float(np.exp(
                 np.sum(power_net[m][fin] * np.log(np.clip(r[fin], 0.1, 10)))
                 / power_net[m][fin].sum())) if fin.any() else None})
+    # the same conduits' g with the grain mates out of the windows and out of every section,
+    # each mode's g over the resolved g, by grain-mate class (:func:`mate_classes`) and by the
+    # window's intrusion; weights: the dissipation with the mates left in, as above
+    mcode, _, gs = mate_classes(tess, th)
+    off = np.where(gs["off"] > 0, gs["off"], np.nan)
+    g_mode = {m: g_net * gs[m] / off for m in ("off", "window", "all")}
+
+    def mode_ratios(m):
+        row = {}
+        for mode, gm in g_mode.items():
+            r = gm[m] / g_lbm[m]
+            fin = np.isfinite(r) & (r > 0)
+            row[f"g_{mode}_over_lbm"] = float(np.exp(
+                np.sum(power_net[m][fin] * np.log(np.clip(r[fin], 0.1, 10)))
+                / power_net[m][fin].sum())) if fin.any() else None
+        return row
+
+    out["mate_class_bins"] = []
+    deep = cls == 2
+    r3 = tess.throat_radii[th]
+    ratio = r3.min(axis=1) / r3.max(axis=1)          # the window's smallest radius / largest
+    for name, m in ([(MATE_CLASSES[c], mcode == c) for c in range(3)]
+                    + [(f"{w} / {MATE_CLASSES[c]}", (deep == d) & (mcode == c))
+                       for d, w in ((False, "three grains"), (True, "deep pair"))
+                       for c in range(3)]
+                    + [(f"intrusion {lo_}-{min(hi_, 1.0)}", (intr >= lo_) & (intr < hi_))
+                       for lo_, hi_ in ((0.0, 0.02), (0.02, 0.1), (0.1, 0.25), (0.25, 1.01))]
+                    + [(f"radius ratio {op} 0.6{c}", ((ratio < 0.6) == small) & m_c)
+                       for op, small in (("<", True), (">=", False))
+                       for c, m_c in (("", True), (" / untouched", mcode == 0))]
+                    + [("all", np.ones(th.size, bool))]):
+        m = m & ~closed
+        out["mate_class_bins"].append({"class": name, "n": int(m.sum()),
+                                       "power_share_net": float(power_net[m].sum()
+                                                                / power_net.sum()),
+                                       **mode_ratios(m)})
     out["per_conduit"] = {"intrusion": np.nan_to_num(intr, nan=-1.0).tolist(),"throat": th.tolist(), "class": cls.tolist(), "q_lbm_m4": ql.tolist(),
                           "q_net_m4": qn.tolist(), "mu_g_net_m3": g_net.tolist(),
                           "mu_g_lbm_m3": np.nan_to_num(g_lbm, nan=-1.0).tolist()}
@@ -561,6 +766,9 @@ def main(argv=None):
     r.add_argument("bed")
     r.add_argument("--resolution", type=float, default=16.0, help="lattice units per d32")
     r.add_argument("--max-steps", type=int, default=12000)
+    r.add_argument("--tau", type=float, default=1.5,
+                   help="relaxation time (TRT with Lambda 3/16: the steady field does not "
+                        "depend on it; a smaller one relaxes the density faster)")
     r.add_argument("--tol", type=float, default=1e-5)
     r.add_argument("--out", required=True, help="NPZ of the field")
     c = sub.add_parser("compare", help="per-conduit comparison with the network")
@@ -569,6 +777,13 @@ def main(argv=None):
     g = sub.add_parser("mates", help="the conduits' g with grain mates out, by intrusion")
     g.add_argument("bed")
     g.add_argument("--ref", default=None, help="a compare JSON of the same bed")
+    k = sub.add_parser("classes", help="the network's dissipation by window and mate class")
+    k.add_argument("beds", nargs="+")
+    k.add_argument("--json", default=None)
+    f = sub.add_parser("fe-check", help="k with FE for the window factors and the sections "
+                       "outside the table")
+    f.add_argument("beds", nargs="+")
+    f.add_argument("--json", default=None)
     i = sub.add_parser("intrusion", help="window area inside spheres off the face")
     i.add_argument("beds", nargs="+")
     i.add_argument("--json", default=None)
@@ -576,13 +791,19 @@ def main(argv=None):
     if a.cmd == "mates":
         mates_bins(a.bed, a.ref)
         return 0
+    if a.cmd in ("classes", "fe-check"):
+        fn = classes_report if a.cmd == "classes" else fe_check
+        rows = [fn(b) for b in a.beds]
+        if a.json:
+            Path(a.json).write_text(json.dumps(rows, indent=1) + "\n")
+        return 0
     if a.cmd == "intrusion":
         rows = [intrusion_report(b) for b in a.beds]
         if a.json:
             Path(a.json).write_text(json.dumps(rows, indent=1) + "\n")
         return 0
     if a.cmd == "run":
-        res = run_field(a.bed, a.resolution, max_steps=a.max_steps, tol=a.tol)
+        res = run_field(a.bed, a.resolution, tau=a.tau, max_steps=a.max_steps, tol=a.tol)
         solid = res.pop("solid")
         np.savez_compressed(a.out, bits=np.packbits(solid.ravel()), shape=solid.shape,
                             **{k: np.asarray(v) for k, v in res.items()})
@@ -590,7 +811,7 @@ def main(argv=None):
         return 0
     res = compare(a.field)
     print(json.dumps({k: res[k] for k in ("k_net_over_lbm", "body_imbalance_median", "classes",
-                                          "intrusion_bins")}, indent=1))
+                                          "intrusion_bins", "mate_class_bins")}, indent=1))
     if a.json:
         Path(a.json).write_text(json.dumps(res, indent=1) + "\n")
     return 0
