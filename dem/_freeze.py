@@ -25,20 +25,17 @@ section Speed):
   step would clear them. When the walls move (the container's ``z_offset_m``, new walls) every
   flag is set again.
 
-Rows are kept in ascending order. Each pair is listed in both rows and carries its contact
-history (shear spring, touching flag) in both slots; it is evaluated from one row
-only, the *evaluator*: min(p, q) when both grains are active, the active one's row when one is
-frozen, none when both are. Whenever the frozen set changes, each changed pair's history is
-copied from its old evaluator's slot to the other, so the new evaluator continues it. A row's
-leading slots that hold active partners below its sphere (``below``, kept with each insert,
-delete and change of the frozen set) are not read: their pairs belong to the partner's row.
-The step is the engine's own: the contact law of :func:`dem._contacts.contact_law`, the walls
-of :func:`dem._kernels.wall_contacts`, the rigid update of :func:`dem._grain_kernels.update_one`
-(its sums and :func:`dem._grain_kernels.advance_one`), one thread, each sphere's forces summed
-in row order. The rows run in ascending order, so a sphere's force is complete when its own row
-is done (later rows add only to partners above them): each grain is summed and advanced right
-after its last sphere, in the operations and order of :func:`dem._grain_kernels.update_one`,
-and the step's trajectories are those of separate force and update passes bit for bit.
+Rows are kept in ascending order. A pair's history (shear spring, touching flag) sits in both
+its slots; it is evaluated from one row, the *evaluator*: min(p, q) when both grains are active,
+the active one's row when one is frozen, none when both are (a change of the frozen set copies
+each changed pair's history to its new evaluator's slot). A row's leading slots of active
+partners below its sphere (``below``, kept with each insert, delete and frozen-set change) are
+not read. The step is the engine's own (contact law :func:`dem._contacts.contact_law`, walls
+:func:`dem._kernels.wall_contacts`, rigid update :func:`dem._grain_kernels.update_one`: its sums,
+then :func:`dem._grain_kernels.advance_one`), one thread. The rows run in ascending order, so a
+sphere's force is complete when its row is done (later rows add only to partners above them):
+each grain is summed and advanced right after its last sphere, in update_one's operations and
+order, bit for bit the trajectories of separate force and update passes.
 """
 
 from __future__ import annotations
@@ -47,8 +44,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ._freeze_kernels import (active_forces, active_poses, in_contact, list_walls, load_history, pair_dashpots,
-                              relist, row_starts, sync_history)
+from ._freeze_kernels import (active_forces, active_poses, in_contact, load_history, pair_dashpots, relist,
+                              row_starts, sync_history)
+from ._kernels import list_walls
 from ._rigid import quat_to_matrix
 
 __all__ = ["ActiveRegion", "FreezePolicy", "FREEZE_DEPTH_LENGTHS"]

@@ -15,10 +15,10 @@ import numpy as np
 
 from ._contacts import contact_law, rolling_moment
 from ._grain_kernels import advance_one, grain_rolling, pose_one
-from ._kernels import wall_contacts, wall_rolling
+from ._kernels import flag_walls, wall_contacts, wall_rolling
 
-__all__ = ["active_forces", "active_poses", "in_contact", "list_walls", "load_history", "pair_dashpots", "relist",
-           "row_starts", "sync_history"]
+__all__ = ["active_forces", "active_poses", "in_contact", "load_history", "pair_dashpots", "relist", "row_starts",
+           "sync_history"]
 
 
 # ---------------------------------------------------------------------------- the cell grid
@@ -127,52 +127,10 @@ def _row_delete(j, i, nbr, cnt, shear, touch, below):
     cnt[j] = n - 1
 
 
-@numba.njit(inline="always", cache=True)
-def _near_wall(x0, x1, x2, reach, wall_kind, wall_normal, wall_offset, wall_cyl):
-    """Whether a wall lies closer than ``reach`` (m) to the point (x0, x1, x2) (distances as in
-    :func:`dem._kernels.wall_contacts`)."""
-    for m in range(wall_kind.shape[0]):
-        if wall_kind[m] == 0:
-            d = wall_offset[m]
-            if wall_normal[m, 0] != 0.0:
-                d = d + wall_normal[m, 0] * x0
-            if wall_normal[m, 1] != 0.0:
-                d = d + wall_normal[m, 1] * x1
-            if wall_normal[m, 2] != 0.0:
-                d = d + wall_normal[m, 2] * x2
-        else:
-            ddx = x0 - wall_cyl[m, 0]
-            ddy = x1 - wall_cyl[m, 1]
-            d = wall_cyl[m, 2] - np.sqrt(ddx * ddx + ddy * ddy)
-        if not d >= reach:
-            return True
-    return False
-
-
-@numba.njit(inline="always", cache=True)
-def _list_walls(p, ref, r, skin, wall_kind, wall_normal, wall_offset, wall_cyl, wall_touch, wall_shear, near):
-    """``near[p]``: a wall within r_p + skin of sphere p's reference; without one its wall
-    springs and touching flags are cleared (no wall touches it: the step would clear them)."""
-    hit = _near_wall(ref[p, 0], ref[p, 1], ref[p, 2], r[p] + skin, wall_kind, wall_normal, wall_offset, wall_cyl)
-    near[p] = hit
-    if not hit:
-        for m in range(wall_kind.shape[0]):
-            wall_touch[m, p] = 0
-            wall_shear[m, p, 0] = wall_shear[m, p, 1] = wall_shear[m, p, 2] = 0.0
-
-
-@numba.njit(cache=True)
-def list_walls(idx, ref, r, skin, wall_kind, wall_normal, wall_offset, wall_cyl, wall_touch, wall_shear, near):
-    """:func:`_list_walls` for the spheres ``idx`` (all of them after the walls moved)."""
-    for a in range(idx.shape[0]):
-        _list_walls(idx[a], ref, r, skin, wall_kind, wall_normal, wall_offset, wall_cyl, wall_touch, wall_shear,
-                    near)
-
-
 @numba.njit(cache=True)
 def relist(moved, n_moved, first, x, ref, r, gid, skin, lo, cell, dims, head, nxt, prv, cellof,
            nbr, cnt, shear, touch, mark, buf, tmp_j, tmp_h, wall_kind, wall_normal, wall_offset, wall_cyl, wall_touch, wall_shear, near, frozen, below):
-    """New reference, row and wall flag (:func:`_list_walls`) for each sphere
+    """New reference, row and wall flag (:func:`dem._kernels.flag_walls`) for each sphere
     ``moved[first:n_moved]`` (module notes), in order.
 
     Pairs kept keep their slots' history; new pairs start from zero (they did not touch: their
@@ -191,7 +149,7 @@ def relist(moved, n_moved, first, x, ref, r, gid, skin, lo, cell, dims, head, nx
                 return k
         # reference and cell
         ref[i, 0], ref[i, 1], ref[i, 2] = x[i, 0], x[i, 1], x[i, 2]
-        _list_walls(i, ref, r, skin, wall_kind, wall_normal, wall_offset, wall_cyl, wall_touch, wall_shear, near)
+        flag_walls(i, ref, r, skin, wall_kind, wall_normal, wall_offset, wall_cyl, wall_touch, wall_shear, near)
         c = _cell(x[i, 0], x[i, 1], x[i, 2], lo, cell, dims)
         if cellof[i] != c:
             _grid_remove(i, head, nxt, prv, cellof)

@@ -28,7 +28,8 @@ import numpy as np
 
 from ._contacts import contact_law, rolling_moment, rolling_torque
 
-__all__ = ["pair_damping", "pair_forces", "particle_update", "wall_contacts", "wall_rolling"]
+__all__ = ["flag_walls", "list_walls", "near_wall", "pair_damping", "pair_forces", "particle_update", "wall_contacts",
+           "wall_rolling"]
 
 
 @numba.njit(parallel=True, cache=True, error_model="numpy")
@@ -156,6 +157,48 @@ def wall_rolling(p, wall_touch, wall_fn, mu_rw, rp):
         if wall_touch[k, p]:
             m += rolling_moment(mu_rw, wall_fn[k, p], rp)
     return m
+
+
+@numba.njit(inline="always", cache=True)
+def near_wall(x0, x1, x2, reach, wall_kind, wall_normal, wall_offset, wall_cyl):
+    """Whether a wall lies closer than ``reach`` (m) to the point (x0, x1, x2) (distances as in
+    :func:`wall_contacts`)."""
+    for m in range(wall_kind.shape[0]):
+        if wall_kind[m] == 0:
+            d = wall_offset[m]
+            if wall_normal[m, 0] != 0.0:
+                d = d + wall_normal[m, 0] * x0
+            if wall_normal[m, 1] != 0.0:
+                d = d + wall_normal[m, 1] * x1
+            if wall_normal[m, 2] != 0.0:
+                d = d + wall_normal[m, 2] * x2
+        else:
+            ddx = x0 - wall_cyl[m, 0]
+            ddy = x1 - wall_cyl[m, 1]
+            d = wall_cyl[m, 2] - np.sqrt(ddx * ddx + ddy * ddy)
+        if not d >= reach:
+            return True
+    return False
+
+
+@numba.njit(inline="always", cache=True)
+def flag_walls(p, ref, r, skin, wall_kind, wall_normal, wall_offset, wall_cyl, wall_touch, wall_shear, near):
+    """``near[p]``: a wall within r_p + skin of sphere p's reference; without one its wall
+    springs and touching flags are cleared (no wall touches it: the step would clear them)."""
+    hit = near_wall(ref[p, 0], ref[p, 1], ref[p, 2], r[p] + skin, wall_kind, wall_normal, wall_offset, wall_cyl)
+    near[p] = hit
+    if not hit:
+        for m in range(wall_kind.shape[0]):
+            wall_touch[m, p] = 0
+            wall_shear[m, p, 0] = wall_shear[m, p, 1] = wall_shear[m, p, 2] = 0.0
+
+
+@numba.njit(cache=True)
+def list_walls(idx, ref, r, skin, wall_kind, wall_normal, wall_offset, wall_cyl, wall_touch, wall_shear, near):
+    """:func:`flag_walls` for the spheres ``idx`` (all of them after the walls moved)."""
+    for a in range(idx.shape[0]):
+        flag_walls(idx[a], ref, r, skin, wall_kind, wall_normal, wall_offset, wall_cyl, wall_touch, wall_shear,
+                   near)
 
 
 @numba.njit(parallel=True, cache=True, error_model="numpy")
