@@ -28,6 +28,14 @@ windows and out of every section (``network.conductance.conduit_conductance``'s
 
     python docs/scripts/lbm_windows.py mates network/data/wheat_grains.csv --ref docs/data/lbm_windows_wheat.json
 
+``classes`` needs no lattice: where a bed's Stokes dissipation goes in the network (the default
+model), by window class, grain-mate class (untouched, sections cut, window cut) and radius
+ratio; ``fe-check`` the network's k with FE in place of the window factors' distance-squared
+estimate and of the Q* table's misses:
+
+    python docs/scripts/lbm_windows.py classes network/data/wheat_grains.csv
+    python docs/scripts/lbm_windows.py fe-check shelled_corn.csv
+
 ``intrusion`` needs no lattice: the share of each window's three-disk open area that lies inside
 other spheres, the Stokes flow of those sections with every sphere cutting the face plane
 against the three-disk section, and the network's k with that ratio on each conduit:
