@@ -14,7 +14,7 @@ import numba
 import numpy as np
 
 from ._contacts import contact_law, rolling_moment
-from ._grain_kernels import advance_one, grain_rolling, pose_one
+from ._grain_kernels import finish_grain, pose_one
 from ._kernels import flag_walls, wall_contacts, wall_rolling
 
 __all__ = ["active_forces", "active_poses", "in_contact", "load_history", "pair_dashpots", "relist", "row_starts",
@@ -253,7 +253,7 @@ def active_forces(sidx, frozen, gid, x, v, w, r, ms, nbr, cnt, below, shear, tou
 
     A sphere's force is complete when its row is done (the rows after it add only to partners
     above them), so each grain is summed (:func:`dem._grain_kernels.update_one`'s sums, in
-    sphere order) and advanced (:func:`dem._grain_kernels.advance_one`) after its last sphere.
+    sphere order) and advanced (:func:`dem._grain_kernels.finish_grain`) after its last sphere.
     """
     for a in range(sidx.shape[0]):
         p = sidx[a]
@@ -360,16 +360,8 @@ def active_forces(sidx, frozen, gid, x, v, w, r, ms, nbr, cnt, below, shear, tou
         gtz += (arm[i, 0] * fy - arm[i, 1] * fx) + tqz
         gmr += roll_s[i]
         if i == start[g + 1] - 1:
-            if gmr > 0.0:
-                rx, ry, rz = grain_rolling(g, q, L, inertia, gmr, dt, gtx, gty, gtz)
-                gtx += rx
-                gty += ry
-                gtz += rz
-            gfz -= weight[g]
-            force_g[g, 0], force_g[g, 1], force_g[g, 2] = gfx, gfy, gfz
-            torque_g[g, 0], torque_g[g, 1], torque_g[g, 2] = gtx, gty, gtz
-            if advance:
-                advance_one(g, gfx, gfy, gfz, gtx, gty, gtz, X, V, q, L, inertia, inv_m, dt)
+            finish_grain(g, gfx, gfy, gfz, gtx, gty, gtz, gmr, X, V, q, L, inertia, weight, inv_m, dt, force_g,
+                         torque_g, advance)
     fn_sum[0], fn_sum[1] = total_fn, n_fn
 
 

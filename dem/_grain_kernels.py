@@ -46,7 +46,7 @@ import numpy as np
 
 from ._contacts import rolling_torque
 
-__all__ = ["advance_one", "grain_poses", "grain_rolling", "grain_update", "pose_one", "update_one"]
+__all__ = ["advance_one", "finish_grain", "grain_poses", "grain_rolling", "grain_update", "pose_one", "update_one"]
 
 
 @numba.njit(inline="always", cache=True, error_model="numpy")
@@ -127,6 +127,23 @@ def grain_rolling(g, q, L, inertia, mr, dt, tx, ty, tz):
 
 
 @numba.njit(inline="always", cache=True, error_model="numpy")
+def finish_grain(g, fx, fy, fz, tx, ty, tz, mr, X, V, q, L, inertia, weight, inv_m, dt, force, torque, advance):
+    """Grain ``g``'s step from its summed sphere forces (fx, fy, fz) N, torques (tx, ty, tz) N·m and
+    rolling moment ``mr`` N·m: the rolling torque (:func:`grain_rolling`), its weight, the sums
+    written to ``force``/``torque`` and, when ``advance``, the update (:func:`advance_one`)."""
+    if mr > 0.0:
+        rx, ry, rz = grain_rolling(g, q, L, inertia, mr, dt, tx, ty, tz)
+        tx += rx
+        ty += ry
+        tz += rz
+    fz -= weight[g]
+    force[g, 0], force[g, 1], force[g, 2] = fx, fy, fz
+    torque[g, 0], torque[g, 1], torque[g, 2] = tx, ty, tz
+    if advance:
+        advance_one(g, fx, fy, fz, tx, ty, tz, X, V, q, L, inertia, inv_m, dt)
+
+
+@numba.njit(inline="always", cache=True, error_model="numpy")
 def update_one(g, X, V, q, L, inertia, start, arm, force_s, torque_s, roll_s, weight, inv_m, dt, force, torque,
                advance):
     """:func:`grain_update` for grain ``g`` alone (the body of its loop)."""
@@ -142,16 +159,7 @@ def update_one(g, X, V, q, L, inertia, start, arm, force_s, torque_s, roll_s, we
         ty += (arm[s, 2] * f0 - arm[s, 0] * f2) + torque_s[s, 1]
         tz += (arm[s, 0] * f1 - arm[s, 1] * f0) + torque_s[s, 2]
         mr += roll_s[s]
-    if mr > 0.0:
-        rx, ry, rz = grain_rolling(g, q, L, inertia, mr, dt, tx, ty, tz)
-        tx += rx
-        ty += ry
-        tz += rz
-    fz -= weight[g]
-    force[g, 0], force[g, 1], force[g, 2] = fx, fy, fz
-    torque[g, 0], torque[g, 1], torque[g, 2] = tx, ty, tz
-    if advance:
-        advance_one(g, fx, fy, fz, tx, ty, tz, X, V, q, L, inertia, inv_m, dt)
+    finish_grain(g, fx, fy, fz, tx, ty, tz, mr, X, V, q, L, inertia, weight, inv_m, dt, force, torque, advance)
 
 
 @numba.njit(inline="always", cache=True, error_model="numpy")
