@@ -34,10 +34,11 @@ from cache import table_coverage
 
 from .._air import MU_AIR_PA_S, check_viscosity
 from .._json import jsonable
-from ..pores import PoreMerge, column_norm, cross_components, merge_pores
+from ..pores import PoreMerge, merge_pores
 from ._qstar import SOURCES, qstar_from_function, throat_qstar as policy_qstar
 from ._result import ConductanceResult
 from ._conduit_kernel import compiled_conduit_rows
+from ._heights import conduit_heights
 from ._mates import grain_mates as grain_mates_of, section_factors, window_factors_compiled
 from ._sections import colmax, side_resistance
 from ._table import grid_alone
@@ -285,34 +286,6 @@ def conduit_conductance(tessellation, throats_idx=None, *, viscosity_pa_s: float
                        "0.4 %% of its windows, k +2.9 %%); --policy table+fe solves them by FE "
                        "(docs/cache-table.md)", loose, qstats["n"], table_coverage())
     return ConductanceResult(g, "conduit", qstar, stats, h_m=h, internal=internal)
-
-
-def conduit_heights(tessellation, idx, pm):
-    """Conduit heights (M, 2), m: the normal distance from each throat's face plane to the
-    centres of its two pore bodies (``pm``, :class:`network.pores.PoreMerge`), and the side
-    (M, 2) of the plane each lies on, +1 / -1 along n = (x2 - x1) x (x3 - x1) / |...|
-    (+1 where the height is 0). A hull face's one side counts twice."""
-    t = tessellation
-    tp = t.throat_pores[idx]
-    # (component-major: each component a contiguous row, the gathers and products run over it)
-    x = np.ascontiguousarray(t.packing.centers.T)[:, t.throat_vertices[idx].T]   # (3, 3, M)
-    nrm = np.stack(cross_components(x[:, 1] - x[:, 0], x[:, 2] - x[:, 0]))  # face normal
-    nrm /= np.maximum(column_norm(nrm), 1e-300)
-    centre = np.ascontiguousarray(pm.center.T)
-    h = np.zeros((idx.size, 2))
-    sign = np.ones((idx.size, 2))
-    for side in (0, 1):
-        pore = tp[:, side]
-        ok = pore >= 0
-        d = centre[:, pm.labels[pore[ok]]] - x[:, 0][:, ok]
-        n = nrm[:, ok]
-        dn = d[0] * n[0] + d[1] * n[1] + d[2] * n[2]
-        h[ok, side] = np.abs(dn)
-        sign[ok, side] = np.where(dn < 0, -1.0, 1.0)
-    hull = tp[:, 1] < 0
-    h[hull, 1] = h[hull, 0]
-    sign[hull, 1] = sign[hull, 0]
-    return h, sign
 
 
 #: Fewest throats for which :func:`conduit_conductance` runs the compiled loop

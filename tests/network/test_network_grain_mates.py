@@ -10,7 +10,7 @@ from network.conductance import conduit_conductance
 from network.conductance._mates import (grain_mates, mate_radii, window_factors,
                                         window_factors_compiled)
 from network.pores import merge_pores
-from network.conductance._conduit import conduit_heights
+from network.conductance._heights import conduit_heights
 from network.packing import read_packing
 
 
