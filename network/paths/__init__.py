@@ -23,7 +23,8 @@ Modules: ``_geometry`` (angles, lengths, smoothing, face areas), ``_faces`` (the
 slivers, entry points), ``_record`` (:class:`AirflowPath`), ``_build`` (the thesis's
 construction), ``_walks`` (walks and graph paths, :func:`trace_paths`), ``_branched`` (the
 branched-path model, docs/airpaths-branched.md), ``_along`` (models along a path), ``_plots``;
-``__main__`` is the command ``python -m network.paths``.
+``__main__`` is the command ``python -m network.paths``, with ``_standin`` (its ``--standin``
+packing) and ``_reference`` (the thesis's values it prints beside its own).
 """
 
 from ._along import (branched_path_pressure_drop, branched_table, pore_pressure_array,

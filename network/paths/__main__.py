@@ -45,38 +45,18 @@ from .._cli import (CliParser, add_air, add_packing, bad_input, check_common, ch
 from .._grains import D272, d272_line, grain_key, packing_grain
 from . import (bed_depth, branched_table, face_graph, plot_paths, pore_pressure_array,
                pressure_along_path, random_entry_points, trace_paths)
+from ._reference import CONVENTIONS, THESIS, THESIS_DEPTH_M
+from ._standin import STANDIN_MAX_SPHERES, STANDIN_MIN_SIDE_M, standin_packing, standin_size
 from ..conductance import POLICIES
 from ..flow import (DEFAULT_DEPTH_M, ConductanceOptions, FlowOptions, SampleOptions,
                     asabe_d272_gradient, ergun_gradient, inset_window, solve_network)
-from ..packing import UNITS, Packing, random_packing
+from ..packing import UNITS, Packing
 from ..pores import (NoInteriorError, Region, axis_index, default_region, region_porosity,
                      tessellate)
 
 _ALL = ("widest", "narrowest", "maximin", "shortest")
-#: Thesis values (Tables 4.1-4.5) printed beside ours on a soybean bed (pressures: over 0.25 m).
-THESIS = {
-    "tortuosity": {"widest": 1.39, "narrowest": 1.40},
-    "mean_width_mm": {"widest": (2.73, 2.91), "narrowest": (1.85, 2.00)},
-    "tetrahedra": {"widest": (152, 162), "narrowest": (142, 154)},
-    "branched_mfx3_average_pa": {"0.013": 2.74, "0.027": 5.65},
-    "measured_pa": {"0.013": 2.44, "0.027": 6.80},
-}
 #: Most entry points (each traces up to four paths; 1e8 ran out of memory, 1e6 took minutes)
 MAX_ENTRIES = 10_000
-#: Bed depth of the thesis's measured and modelled pressure drops (Table 4.5), m.
-THESIS_DEPTH_M = 0.25
-CONVENTIONS = {
-    "tortuosity": "Eq. 3.27 smoothed length over L0, the straight length along the flow axis "
-                  "(thesis 3.4.2): the bed depth (centre span + mean diameter, Appendix D) for "
-                  "built paths, which run floor to top; the path's own axial span for paths on "
-                  "the tessellation, which start and end inside the bed",
-    "depth": "pressure drops in the Table 4.5 layout are over --depth (default 0.25 m, as "
-             "network.solve): ASABE D272 and Ergun as gradient x depth, the branched model as "
-             "its drop along each path / the path's L0 x depth; the thesis's values are printed "
-             "beside them only at 0.25 m and its velocities",
-    "duplicates": "a path traced again from another entry (same kind, same tetrahedra) is "
-                  "listed but counted once in the means and the branched model",
-}
 
 
 def _parser():
@@ -133,49 +113,6 @@ def _parser():
                         "spheres): diameters 5.5-7.5 mm, porosity 0.408, by "
                         "network.packing.random_packing (--seed)")
     return p
-
-
-#: Stand-in packing (``--standin``): soybean diameters (thesis Table 3.1) and the thesis's bin
-#: porosity.
-STANDIN_DIAMETERS_M = (5.5e-3, 7.5e-3)
-STANDIN_POROSITY = 0.408
-#: Most spheres a stand-in may have (about a 0.29 m cube; the thesis's bin holds 18 000).
-STANDIN_MAX_SPHERES = 100_000
-#: Shortest stand-in side, m: 6 mean diameters, the default sample's 1.5-diameter margins on
-#: both sides and its 2-diameter interior (``network.pores.default_region``) with room to spare.
-STANDIN_MIN_SIDE_M = 0.04
-
-
-def standin_packing(box_m, *, rng=None):
-    """Geometric stand-in packing of about the box ``box_m`` (m): (centers, radii).
-
-    As many spheres (diameters uniform in :data:`STANDIN_DIAMETERS_M`) as give porosity
-    :data:`STANDIN_POROSITY` in the box, packed by ``network.packing.random_packing`` with the
-    box's aspect ratio; its box has the volume of the drawn spheres at that porosity, so it
-    differs from ``box_m`` by the sampling error of the mean sphere volume.
-    """
-    n = standin_size(box_m)
-    pk = random_packing(n, diameter_range_m=STANDIN_DIAMETERS_M,
-                        solid_fraction=1.0 - STANDIN_POROSITY,
-                        aspect=np.asarray(box_m, dtype=float), rng=rng)
-    return np.asarray(pk.centers), np.asarray(pk.radii)
-
-
-def standin_size(box_m) -> int:
-    """Spheres of the stand-in in the box ``box_m`` (3,) m; ValueError naming ``--standin``
-    and the box when a side is not > 0 or the count is over :data:`STANDIN_MAX_SPHERES`."""
-    box = np.asarray(box_m, dtype=float)
-    if box.shape != (3,) or not np.all(np.isfinite(box) & (box > 0)):
-        raise ValueError(f"--standin needs three box sides > 0 (m), got {box_m}")
-    d0, d1 = STANDIN_DIAMETERS_M
-    mean_vol = np.pi / 6.0 * (d1**4 - d0**4) / (4.0 * (d1 - d0))  # E[pi d^3 / 6], d uniform
-    n = (1.0 - STANDIN_POROSITY) * float(box.prod()) / mean_vol
-    if n > STANDIN_MAX_SPHERES:
-        side = (STANDIN_MAX_SPHERES * mean_vol / (1.0 - STANDIN_POROSITY)) ** (1 / 3)
-        raise ValueError(f"--standin {' '.join(f'{v:g}' for v in box)}: the box holds about "
-                         f"{n:.3g} spheres, more than the {STANDIN_MAX_SPHERES} a stand-in may "
-                         f"have (a cube of {side:.2g} m); give a smaller box")
-    return int(round(n))
 
 
 def main(argv=None) -> int:

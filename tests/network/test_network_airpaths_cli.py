@@ -7,7 +7,8 @@ import sys
 import numpy as np
 import pytest
 
-from network.paths.__main__ import STANDIN_POROSITY, main, standin_packing
+from network.paths.__main__ import main
+from network.paths._standin import STANDIN_POROSITY, standin_packing
 
 SCENE = "network/data/soybean_default.csv"
 
