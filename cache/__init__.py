@@ -10,9 +10,8 @@ Public functions
 signature(radii, sides)
     (N, 5) scale/permutation-invariant key parameters ``[r1*, r2*, l12*, l13*, l23*]``.
 lookup_qstar(radii, sides, *, db=None, policy='table+fe', rtol=1e-3, workers=1, progress=False)
-    :class:`Lookup` of (N,) ``qstar``, ``error_estimate``, ``source`` plus ``stats``.
-    Policies: ``'table-only'``, ``'table+fe'``, ``'fe-only'``, ``'shape-factor'``; sources
-    of a row: ``SOURCES``.
+    :class:`Lookup` of (N,) ``qstar``, ``error_estimate``, ``source`` (one of ``SOURCES``) plus
+    ``stats``; policies: ``'table-only'``, ``'table+fe'``, ``'fe-only'``, ``'shape-factor'``.
 precompute_throats(store, radii, sides, *, rtol, workers, retry_failed, ...)
     Solve and store what a table lacks, one transaction per batch.
 precompute_grid(store, spec, *, rtol, ...)
@@ -34,18 +33,20 @@ Command lines: ``python -m cache.precompute``, ``python -m cache.lookup``, ``pyt
 The shipped table ``cache/data/grid_g1.npz`` (Q* at the 390 625 nodes of grid ``g1``, solved
 by ``throats.solve_fem`` at rtol 1e-3) and, for rows it cannot serve, ``EXTENSION_GRIDS``
 (radius deviations to ±0.5, gaps -2.2 to 4.6 r̄; the deep pairs of grain beds, :mod:`cache._pair`)
-are served only while ``throats.SOLVER_VERSION``
-equals the version they were built with; how to rebuild them: ``docs/cache-table.md``.  Accuracy and speed: ``python -m cache.bench``.  ``cache`` never
-imports ``network`` (data flows network → cache through arrays and CSV files) and never
-meshes or solves itself: it calls ``throats``.
+are served only while ``throats.SOLVER_VERSION`` equals the version they were built with; how to
+rebuild them: ``docs/cache-table.md``.  Accuracy and speed: ``python -m cache.bench``.
+``cache`` never imports ``network`` (data flows network → cache through arrays and CSV files)
+and never meshes or solves itself: it calls ``throats``.
 """
 
 from ._build import PrecomputeSummary, precompute_grid, precompute_throats
 from ._dask import DaskConnectError, dask_executor
 from ._kernel import point_kernel
-from ._interp import CALIBRATED_SAFETY, ERROR_SAFETY, GRIDS, GridSpec, GridTable, grid_coordinates
-from ._lookup import (POLICIES, SOURCES, Lookup, cold_tables, default_db_path, export_grid,
-                      load_grid_table, lookup_qstar, read_grid_file, shipped_grid_path)
+from ._grids import GRIDS, GridSpec
+from ._interp import CALIBRATED_SAFETY, ERROR_SAFETY, GridTable, grid_coordinates
+from ._gridio import export_grid, read_grid_file
+from ._lookup import (POLICIES, SOURCES, Lookup, cold_tables, default_db_path, load_grid_table,
+                      lookup_qstar, shipped_grid_path)
 from ._orbits import EXTENSION_GRIDS, table_coverage
 from ._routes import table_routes
 from ._signature import QUANTUM, shape_keys, signature

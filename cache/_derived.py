@@ -3,8 +3,9 @@
 :class:`cache.GridTable` fills the invalid nodes, takes second differences and finds the served
 cells in whole-grid passes (0.1-0.2 s for g1 on this 2-core machine, the largest part of a
 first lookup). Their result depends only on the table file and on the code that derives it
-(``_interp.py``, ``_cells.py``, ``_orbits.py``, ``_pair.py``), so it is saved beside the user's Q* table under a name hashed
-from both and read back as a memory map (a few ms); a changed table or code gets a new name.
+(``_interp.py``, ``_grids.py``, ``_cells.py``, ``_orbits.py``, ``_pair.py``), so it is saved
+beside the user's Q* table under a name hashed from both and read back as a memory map (a few
+ms); a changed table or code gets a new name.
 The name holds the table file's path too (a clone's files have their own times), so each
 checkout has its copy; :data:`KEEP` copies per table, the most recently used, are kept (x1's
 are 121 MB each: without the bound every clone added 0.2 GB for good).
@@ -40,7 +41,7 @@ def derived_path(path, directory):
         where = hashlib.blake2b(str(Path(path).resolve()).encode(), digest_size=6)
         st = Path(path).stat()
         what = hashlib.blake2b(f"{st.st_size}:{st.st_mtime_ns}".encode(), digest_size=8)
-        for mod in ("_interp.py", "_cells.py", "_orbits.py", "_pair.py"):
+        for mod in ("_interp.py", "_grids.py", "_cells.py", "_orbits.py", "_pair.py"):
             what.update(Path(__file__).with_name(mod).read_bytes())
         return (Path(directory)
                 / f"{Path(path).stem}.derived-{where.hexdigest()}-{what.hexdigest()}.npy")

@@ -19,7 +19,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from ._interp import GRIDS
+from ._grids import GRIDS
 
 __all__ = ["DEFAULT_GRID", "EXTENSION_GRIDS", "compact", "expand", "orbit_representatives",
            "table_coverage"]

@@ -29,7 +29,8 @@ from throats import validate_throats
 from throats._area import open_area_perimeter
 
 from ._cells import cell_all
-from ._interp import GRIDS, GridTable, RadiusLattice
+from ._grids import GRIDS, RadiusLattice
+from ._interp import GridTable
 
 __all__ = ["PairSpec", "PairTable", "pair_coordinates", "geometric_factor", "DEEP_GAP"]
 

@@ -42,9 +42,9 @@ import numpy as np
 import network
 import throats
 
+from ._gridio import grid_from_store, read_grid_file
 from ._interp import GridTable, grid_coordinates
-from ._lookup import (default_db_path, grid_from_store, load_grid_table, lookup_qstar,
-                      read_grid_file, shipped_grid_path)
+from ._lookup import default_db_path, load_grid_table, lookup_qstar, shipped_grid_path
 from ._orbits import EXTENSION_GRIDS
 from ._routes import table_routes
 from ._signature import shape_keys, signature

@@ -35,7 +35,7 @@ from network.core import MAX_WORKERS, check_count
 from throats.solve import OneLineParser, check_output, run_interruptible
 
 from ._csvio import read_throat_csv, row_problems, write_csv
-from ._interp import GRIDS
+from ._grids import GRIDS
 from ._lookup import POLICIES, default_db_path, lookup_qstar
 from ._store import CacheFileError
 

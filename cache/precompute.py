@@ -40,8 +40,8 @@ from throats.solve import OneLineParser, check_output, run_interruptible
 from ._build import precompute_grid, precompute_throats, resolve_solver
 from ._csvio import read_throat_csv, row_problems
 from ._dask import DaskConnectError, dask_executor
-from ._interp import GRIDS
-from ._lookup import export_grid
+from ._grids import GRIDS
+from ._gridio import export_grid
 from ._store import CacheFileError, open_store
 
 

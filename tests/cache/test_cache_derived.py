@@ -84,7 +84,7 @@ def test_the_pair_tables_geometric_part_is_kept_with_its_derived_arrays(tmp_path
     """The deep-pair table keeps its nodes' geometric part (a whole-grid pass of exact open
     areas) with the derived arrays: a table rebuilt from them equals the one computed."""
     from cache._derived import load_derived, save_derived
-    from cache._lookup import grid_table
+    from cache._gridio import grid_table
     from cache import read_grid_file
 
     spec, _, values = read_grid_file(shipped_grid_path("p1"))
