@@ -35,8 +35,8 @@ by ``throats.solve_fem`` at rtol 1e-3) and, for rows it cannot serve, ``EXTENSIO
 (radius deviations to ±0.5, gaps -2.2 to 4.6 r̄; the deep pairs of grain beds, :mod:`cache._pair`)
 are served only while ``throats.SOLVER_VERSION`` equals the version they were built with; how to
 rebuild them: ``docs/cache-table.md``.  Accuracy and speed: ``python -m cache.bench``.
-``cache`` never imports ``network`` (data flows network → cache through arrays and CSV files)
-and never meshes or solves itself: it calls ``throats``.
+Of ``network`` ``cache`` imports only ``network.core`` (its benchmark: ``network``); data flows
+network → cache through arrays and CSV files. It never meshes or solves itself: it calls ``throats``.
 """
 
 from ._build import PrecomputeSummary, precompute_grid, precompute_throats
