@@ -16,7 +16,10 @@ velocity components of every node of the box. Then for every conduit of the netw
 
 Conduits are grouped by their window: *deep pair* (two spheres of one grain overlapping so much
 that the tables' deep-overlap family serves the window, :func:`throats.deep_overlap`), *same
-grain* (two vertices of one grain, not deep), *ordinary* (three grains).
+grain* (two vertices of one grain, not deep), *ordinary* (three grains); and by the grains
+their two side tetrahedra span (four, or three or fewer where two of a tetrahedron's spheres
+belong to one grain: a piece of a void the grain's spheres split, :func:`side_grains`; on
+sphere packings every tetrahedron spans four).
 
     python docs/scripts/lbm_windows.py run network/data/wheat_grains.csv --resolution 16 --out .lbm/wheat_w16.npz
     python docs/scripts/lbm_windows.py compare .lbm/wheat_w16.npz --json wheat_windows.json
@@ -121,11 +124,17 @@ def _voxel_tets(tess, pts):
     return np.where(s >= 0, m[np.maximum(s, 0)], -1), float(np.mean(m >= 0))
 
 
+def grain_ids(packing):
+    """Each sphere's grain (a sphere packing's spheres: each its own grain)."""
+    g = packing.grain_id
+    return np.arange(packing.n) if g is None else np.asarray(g)
+
+
 def window_class(tess, throats):
     """'deep' / 'same' / 'ordinary' code (2, 1, 0) of throats' windows."""
     from throats import deep_overlap
 
-    gid = tess.packing.grain_id[tess.throat_vertices[throats]]
+    gid = grain_ids(tess.packing)[tess.throat_vertices[throats]]
     same = (gid[:, 0] == gid[:, 1]) | (gid[:, 0] == gid[:, 2]) | (gid[:, 1] == gid[:, 2])
     deep = deep_overlap(tess.throat_radii[throats], tess.throat_sides[throats])
     return np.where(deep, 2, np.where(same, 1, 0))
@@ -434,7 +443,8 @@ def mate_classes(tess, th):
     from network.conductance import conduit_conductance
     from network.conductance._mates import window_factors_compiled
 
-    wf = window_factors_compiled(tess.packing, tess.throat_vertices[th])
+    wf = (np.ones(len(th)) if tess.packing.grain_id is None       # spheres: no grain mates
+          else window_factors_compiled(tess.packing, tess.throat_vertices[th]))
     gs = {m: np.asarray(conduit_conductance(tess, th, policy="table-only", grain_mates=m).g)
           for m in ("off", "window", "all")}
     ok = gs["window"] > 0
@@ -444,6 +454,26 @@ def mate_classes(tess, th):
 
 
 MATE_CLASSES = ("untouched", "sections cut", "window cut")
+
+
+def side_grains(tess, th):
+    """(M, 2) grains spanned by the tetrahedra on the two sides of each conduit, the smaller
+    first (a hull face's one side counted twice; 4 on sphere packings, whose every sphere is
+    its own grain). A tetrahedron with two spheres of one grain (3 or fewer) is a piece of
+    a void that the grain's spheres split."""
+    pv = tess.pore_vertices
+    gid = grain_ids(tess.packing)
+    n = 1 + (np.diff(np.sort(gid[pv], axis=1), axis=1) != 0).sum(axis=1)
+    tp = tess.throat_pores[np.asarray(th, dtype=np.int64)].copy()
+    tp[tp[:, 1] < 0, 1] = tp[tp[:, 1] < 0, 0]
+    return np.sort(n[tp], axis=1)
+
+
+#: :func:`side_grains` classes of ``compare``'s ``mate_class_bins``: (label, test on (M, 2))
+SIDE_CLASSES = (("side tetrahedra: four grains both", lambda s: s[:, 0] == 4),
+                ("side tetrahedra: three and four grains", lambda s: (s[:, 0] == 3) & (s[:, 1] == 4)),
+                ("side tetrahedra: three grains both", lambda s: (s[:, 0] == 3) & (s[:, 1] == 3)),
+                ("side tetrahedra: two grains on a side", lambda s: s[:, 0] <= 2))
 
 
 def classes_report(bed, log=print):
@@ -669,7 +699,7 @@ def compare(field_npz, log=print):
     log(f"# body flux imbalance |sum q| / sum |q|: median {imbalance:.3f}")
     cls = window_class(tess, th)
     # pore bodies holding a tetrahedron with two spheres of one grain (a neck inside the body)
-    gv = tess.packing.grain_id[tess.pore_vertices]
+    gv = grain_ids(tess.packing)[tess.pore_vertices]
     neck_t = np.zeros(n_t, dtype=bool)
     for i_ in range(4):
         for j_ in range(i_ + 1, 4):
@@ -744,6 +774,7 @@ def compare(field_npz, log=print):
 
     out["mate_class_bins"] = []
     deep = cls == 2
+    sides = side_grains(tess, th)
     r3 = tess.throat_radii[th]
     ratio = r3.min(axis=1) / r3.max(axis=1)          # the window's smallest radius / largest
     for name, m in ([(MATE_CLASSES[c], mcode == c) for c in range(3)]
@@ -755,6 +786,7 @@ def compare(field_npz, log=print):
                     + [(f"radius ratio {op} 0.6{c}", ((ratio < 0.6) == small) & m_c)
                        for op, small in (("<", True), (">=", False))
                        for c, m_c in (("", True), (" / untouched", mcode == 0))]
+                    + [(label, test(sides)) for label, test in SIDE_CLASSES]
                     + [("all", np.ones(th.size, bool))]):
         m = m & ~closed
         out["mate_class_bins"].append({"class": name, "n": int(m.sum()),
