@@ -469,6 +469,24 @@ def side_grains(tess, th):
     return np.sort(n[tp], axis=1)
 
 
+def fragment_overlap(tess, th):
+    """(M,) the deepest overlap of two spheres of one grain in a conduit's fragment sides,
+    (r_i + r_j - l_ij) / min(r_i, r_j); -inf where neither side is a fragment
+    (:func:`side_grains`)."""
+    pv = tess.pore_vertices
+    gid = grain_ids(tess.packing)
+    c, r = tess.packing.centers, tess.packing.radii
+    ov = np.full(pv.shape[0], -np.inf)
+    for a in range(4):
+        for b in range(a + 1, 4):
+            i, j = pv[:, a], pv[:, b]
+            o = (r[i] + r[j] - np.linalg.norm(c[i] - c[j], axis=1)) / np.minimum(r[i], r[j])
+            ov = np.where(gid[i] == gid[j], np.maximum(ov, o), ov)
+    tp = tess.throat_pores[np.asarray(th, dtype=np.int64)].copy()
+    tp[tp[:, 1] < 0, 1] = tp[tp[:, 1] < 0, 0]
+    return ov[tp].max(axis=1)
+
+
 #: :func:`side_grains` classes of ``compare``'s ``mate_class_bins``: (label, test on (M, 2))
 SIDE_CLASSES = (("side tetrahedra: four grains both", lambda s: s[:, 0] == 4),
                 ("side tetrahedra: three and four grains", lambda s: (s[:, 0] == 3) & (s[:, 1] == 4)),
@@ -775,6 +793,7 @@ def compare(field_npz, log=print):
     out["mate_class_bins"] = []
     deep = cls == 2
     sides = side_grains(tess, th)
+    f_ov = fragment_overlap(tess, th)
     r3 = tess.throat_radii[th]
     ratio = r3.min(axis=1) / r3.max(axis=1)          # the window's smallest radius / largest
     for name, m in ([(MATE_CLASSES[c], mcode == c) for c in range(3)]
@@ -787,6 +806,8 @@ def compare(field_npz, log=print):
                        for op, small in (("<", True), (">=", False))
                        for c, m_c in (("", True), (" / untouched", mcode == 0))]
                     + [(label, test(sides)) for label, test in SIDE_CLASSES]
+                    + [(f"fragment pair overlap {lo_}-{hi_}", (f_ov >= lo_) & (f_ov < hi_))
+                       for lo_, hi_ in ((0.0, 0.5), (0.5, 1.0), (1.0, 1.5), (1.5, 2.0))]
                     + [("all", np.ones(th.size, bool))]):
         m = m & ~closed
         out["mate_class_bins"].append({"class": name, "n": int(m.sum()),
