@@ -13,6 +13,10 @@ fitted to the reference, and none changes the package.
               the tetrahedron on that side (the face triangle contracted towards the projection
               of the fourth vertex by 1 - h / h_4); halves into merged pore bodies keep the
               whole section. Asks whether ``all`` counts mates that lie in neighbouring pores.
+``slope``     k with the conduit integral's slope factor 1 + s/(1+s) set to 1 (every section's y
+              alone, :func:`network.conductance._sections.side_resistance`): whether the
+              bounded second-order correction is what the grain beds' short, steep conduit
+              halves get wrong.
 ``merge``     k with no pore bodies merged, and with each *fragment* (a tetrahedron whose four
               spheres belong to three grains: two spheres of one grain) joined to the
               neighbour across one of its two three-grain faces, when that neighbour spans
@@ -184,6 +188,31 @@ def tetra_k(packing, box, tess):
         conduit.grain_mates_of, conduit.section_factors = grain_mates0, factors0
 
 
+# -- slope: the integral without its slope factor ----------------------------------------
+
+class _FlatGradient:
+    """``numpy`` as ``_sections`` sees it, with ``gradient`` zero: s = 0, the factor 1."""
+
+    def __getattr__(self, name):
+        return getattr(np, name)
+
+    @staticmethod
+    def gradient(a, axis=None):
+        return np.zeros_like(a)
+
+
+def slope_k(packing, box, tess, grain_mates):
+    """k with the slope factor of the conduit integral set to 1."""
+    import network.conductance._sections as sections
+
+    saved = sections.np
+    sections.np = _FlatGradient()
+    try:
+        return solve_k(packing, box, tess, grain_mates=grain_mates, threads=1)
+    finally:
+        sections.np = saved
+
+
 # -- merge: grain fragments joined to a four-grain neighbour ------------------------------
 
 def fragment_merge(tess):
@@ -256,7 +285,7 @@ def fragment_merge(tess):
 
 def main(argv=None):
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
-    ap.add_argument("cmd", choices=("sections", "tetra", "merge"))
+    ap.add_argument("cmd", choices=("sections", "tetra", "slope", "merge"))
     ap.add_argument("--bed", action="append", default=[],
                     help="NAME=FILE for a bed not bundled (the corn bed)")
     ap.add_argument("--json", default=None)
@@ -281,12 +310,19 @@ def main(argv=None):
         cases = {"sections": [(f"{m}, {n} sections", dict(grain_mates=m, n_sections=n))
                               for m in ("off", "window", "all") for n in (6, 12, 24)],
                  "tetra": [("all", dict(grain_mates="all")), ("all, tetrahedron", None)],
+                 "slope": [(f"{m}{v}", dict(grain_mates=m, slope=v == ", no slope factor"))
+                           for m in ("window", "all") for v in ("", ", no slope factor")],
                  "merge": [(f"{m}, {v}", dict(grain_mates=m, merge=mg))
                            for m in ("window", "all")
                            for v, mg in (("default bodies", None), ("none merged", False),
                                          ("fragments joined", fragment_merge))]}[a.cmd]
         for label, kw in cases:
-            k = tetra_k(pk, box, tess) if kw is None else solve_k(pk, box, tess, **kw)
+            if kw is None:
+                k = tetra_k(pk, box, tess)
+            elif kw.pop("slope", False):
+                k = slope_k(pk, box, tess, kw["grain_mates"])
+            else:
+                k = solve_k(pk, box, tess, **kw)
             rows.append({"bed": name, "case": label, "k_m2": k, "k_lbm_m2": k_lbm,
                          "net_over_lbm_minus_1": k / k_lbm - 1.0})
             print(f"{name:8s} {label:32s} k {k:.4e} m2  network / LBM - 1 {k / k_lbm - 1:+.1%}",
