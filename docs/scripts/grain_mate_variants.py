@@ -19,10 +19,11 @@ fitted to the reference, and none changes the package.
               halves get wrong.
 ``merge``     k with no pore bodies merged, and with each *fragment* (a tetrahedron whose four
               spheres belong to three grains: two spheres of one grain) joined to the
-              neighbour across one of its two three-grain faces, when that neighbour spans
-              four grains, is no sliver and the face's three-disk section is open (the larger
-              face when both qualify). Asks whether the pieces a grain's spheres cut one void
-              into add spurious resistance in series.
+              neighbour across the wider of its two three-grain faces (the larger flow-rate
+              estimate, cell model times the grain mates' factor; the narrower face stays the
+              window), when that neighbour spans four grains, is no sliver and the face is
+              open. Asks whether the pieces a grain's spheres cut one void into add spurious
+              resistance in series.
 
     python docs/scripts/grain_mate_variants.py sections --bed corn=shelled_corn.csv
     python docs/scripts/grain_mate_variants.py tetra --bed corn=shelled_corn.csv
@@ -35,7 +36,6 @@ soybean and wheat beds are bundled.)
 from __future__ import annotations
 
 import argparse
-import functools
 import json
 import sys
 from pathlib import Path
@@ -216,8 +216,8 @@ def slope_k(packing, box, tess, grain_mates):
 # -- merge: grain fragments joined to a four-grain neighbour ------------------------------
 
 def fragment_merge(tess):
-    """``merge_pores`` with each fragment joined to a four-grain neighbour across an open
-    three-grain face (module docstring): a PoreMerge."""
+    """``merge_pores`` with each fragment joined to the four-grain neighbour across the wider
+    of its three-grain faces (module docstring): a PoreMerge."""
     import scipy.sparse as sp
     from scipy.sparse import csgraph
 
@@ -249,7 +249,6 @@ def fragment_merge(tess):
     flat = faces.ravel()
     rate = (section_estimate(tess.throat_radii[flat], tess.throat_sides[flat])
             * window_factors_compiled(tess.packing, tess.throat_vertices[flat])).reshape(faces.shape)
-    nbc = np.maximum(nb, 0)
     wide = np.argmax(np.where(dup, rate, -1.0), axis=1)
     rows_ = np.arange(frag.size)
     pick = nb[rows_, wide]
