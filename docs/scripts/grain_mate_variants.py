@@ -296,13 +296,22 @@ def main(argv=None):
     files = {n: f for n, (f, _) in ref.items()}
     for item in a.bed:
         name, _, path = item.partition("=")
+        if name not in GRAIN_BEDS or not path:
+            print(f"error: --bed {item!r}: give NAME=FILE, NAME one of {', '.join(GRAIN_BEDS)}",
+                  file=sys.stderr)
+            return 2
         files[name] = path
+    if a.json and not Path(a.json).resolve().parent.is_dir():
+        print(f"error: --json {a.json}: its folder does not exist", file=sys.stderr)
+        return 2
+    paths = {n: f if Path(f).is_absolute() else str(ROOT / f) for n, f in files.items()}
+    for name in GRAIN_BEDS:
+        if not Path(paths[name]).is_file():
+            print(f"error: --bed {name}: no file {paths[name]}", file=sys.stderr)
+            return 2
     rows = []
     for name in GRAIN_BEDS:
-        path = files[name] if Path(files[name]).is_absolute() else str(ROOT / files[name])
-        if not Path(path).is_file():
-            print(f"error: --bed {name}: no file {path}", file=sys.stderr)
-            return 2
+        path = paths[name]
         pk, box = read_packing(path), read_container(path)
         tess = tessellate(pk)
         k_lbm = ref[name][1]
