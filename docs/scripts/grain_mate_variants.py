@@ -293,18 +293,18 @@ def main(argv=None):
     from network.packing import read_container, read_packing
 
     ref = fine_reference()
-    files = {n: f for n, (f, _) in ref.items()}
+    files = {n: str(ROOT / f) for n, (f, _) in ref.items()}     # the reference's: repository
     for item in a.bed:
         name, _, path = item.partition("=")
         if name not in GRAIN_BEDS or not path:
             print(f"error: --bed {item!r}: give NAME=FILE, NAME one of {', '.join(GRAIN_BEDS)}",
                   file=sys.stderr)
             return 2
-        files[name] = path
+        files[name] = str(Path(path).resolve())                   # the caller's: working folder
     if a.json and not Path(a.json).resolve().parent.is_dir():
         print(f"error: --json {a.json}: its folder does not exist", file=sys.stderr)
         return 2
-    paths = {n: f if Path(f).is_absolute() else str(ROOT / f) for n, f in files.items()}
+    paths = files
     for name in GRAIN_BEDS:
         if not Path(paths[name]).is_file():
             print(f"error: --bed {name}: no file {paths[name]}", file=sys.stderr)
